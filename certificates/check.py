@@ -1,0 +1,773 @@
+#!/usr/bin/env python3
+"""Standalone checker for rescon certificates (format version 1, see FORMAT.md).
+
+This file is the trusted part of rescon: it uses the Python standard library only,
+never imports rescon, numpy or networkx, and re-derives every claim it can in exact
+integer arithmetic.  Node sets are Python-int bitmasks (bit i = node i).
+
+Usage::
+
+    python certificates/check.py CERT.json
+        exit 0  valid        (prints "valid", plus "accepted on trust: ..." if any)
+        exit 1  invalid      ("invalid: <reason>" on stderr)
+        exit 2  unreadable   ("unreadable: <reason>" on stderr)
+
+API: ``check(cert) -> CheckResult(valid, reason, trusted)`` and ``main(argv) -> int``.
+
+JSON arrays may also be given as Python tuples when ``check`` is called directly.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import dataclass
+from typing import Any, Callable
+
+__all__ = ["CheckResult", "check", "main", "FORMAT_VERSION", "MAX_ENUM_N", "MAX_N"]
+
+FORMAT_VERSION = 1
+MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
+MAX_N = 1_000_000  # resource limit on graph / matrix size
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """Outcome of :func:`check`.
+
+    ``valid``: the certificate proves its claim (possibly relying on ``trusted``).
+    ``reason``: what was proved, or why the certificate is invalid.
+    ``trusted``: proof methods accepted without re-verification (e.g. ``("milp",)``).
+    """
+
+    valid: bool
+    reason: str
+    trusted: tuple[str, ...] = ()
+
+    def __bool__(self) -> bool:
+        return self.valid
+
+
+class Invalid(Exception):
+    """Raised internally with the reason a certificate is invalid."""
+
+
+class _Ctx:
+    """Per-check state: proof methods accepted on trust."""
+
+    def __init__(self) -> None:
+        self.trusted: list[str] = []
+
+    def trust(self, method: str) -> None:
+        if method not in self.trusted:
+            self.trusted.append(method)
+
+
+# --------------------------------------------------------------------------- #
+# strict JSON-structure helpers
+# --------------------------------------------------------------------------- #
+
+_ARRAY = (list, tuple)
+
+
+def _obj(x: Any, where: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
+    if not isinstance(x, dict):
+        raise Invalid(f"{where} must be a JSON object, got {_tname(x)}")
+    for k in x:
+        if not isinstance(k, str):
+            raise Invalid(f"{where} has a non-string key {k!r}")
+    for k in required:
+        if k not in x:
+            raise Invalid(f"{where}: missing key '{k}'")
+    allowed = set(required) | set(optional)
+    extra = sorted(k for k in x if k not in allowed)
+    if extra:
+        raise Invalid(f"{where}: unknown key '{extra[0]}'")
+    return x
+
+
+def _tname(x: Any) -> str:
+    if x is None:
+        return "null"
+    if isinstance(x, bool):
+        return "boolean"
+    if isinstance(x, int):
+        return "integer"
+    if isinstance(x, float):
+        return "number (not an integer)"
+    if isinstance(x, str):
+        return "string"
+    if isinstance(x, _ARRAY):
+        return "array"
+    if isinstance(x, dict):
+        return "object"
+    return type(x).__name__
+
+
+def _is_int(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
+def _int(x: Any, where: str, lo: int | None = None, hi: int | None = None) -> int:
+    if not _is_int(x):
+        raise Invalid(f"{where} must be an integer, got {_tname(x)}")
+    if lo is not None and x < lo:
+        raise Invalid(f"{where} = {x} is out of range (must be >= {lo})")
+    if hi is not None and x > hi:
+        raise Invalid(f"{where} = {x} is out of range (must be <= {hi})")
+    return int(x)
+
+
+def _array(x: Any, where: str) -> list | tuple:
+    if not isinstance(x, _ARRAY):
+        raise Invalid(f"{where} must be an array, got {_tname(x)}")
+    return x
+
+
+def _node_set(x: Any, where: str, n: int, nonempty: bool = True) -> int:
+    """A duplicate-free list of node indices -> bitmask."""
+    _array(x, where)
+    if nonempty and not x:
+        raise Invalid(f"{where} is empty")
+    mask = 0
+    for k, v in enumerate(x):
+        v = _int(v, f"{where}[{k}]", 0, n - 1)
+        if mask >> v & 1:
+            raise Invalid(f"{where} lists node {v} twice")
+        mask |= 1 << v
+    return mask
+
+
+def _perm(x: Any, where: str, n: int) -> list[int]:
+    _array(x, where)
+    if len(x) != n:
+        raise Invalid(f"{where} is not a permutation of 0..{n - 1}: it has {len(x)} entries")
+    seen = 0
+    for k, v in enumerate(x):
+        v = _int(v, f"{where}[{k}]", 0, n - 1)
+        if seen >> v & 1:
+            raise Invalid(f"{where} is not a permutation of 0..{n - 1}: {v} appears twice")
+        seen |= 1 << v
+    return [int(v) for v in x]
+
+
+def _fmt(mask: int) -> str:
+    return "{" + ", ".join(str(i) for i in _bits(mask)) + "}"
+
+
+def _bits(mask: int) -> list[int]:
+    out = []
+    while mask:
+        low = mask & -mask
+        out.append(low.bit_length() - 1)
+        mask ^= low
+    return out
+
+
+# --------------------------------------------------------------------------- #
+# graphs and the two set operations everything rests on
+# --------------------------------------------------------------------------- #
+
+
+class Graph:
+    """Nodes 0..n-1; ``inmask[i]`` = bitmask of the in-neighbours N(i) of i."""
+
+    __slots__ = ("n", "inmask", "m")
+
+    def __init__(self, n: int, inmask: list[int], m: int) -> None:
+        self.n = n
+        self.inmask = inmask
+        self.m = m  # number of edges
+
+    @property
+    def full(self) -> int:
+        return (1 << self.n) - 1
+
+    def induced(self, nodes: list[int]) -> "Graph":
+        """Subgraph induced on ``nodes``, re-indexed so that ``nodes[j]`` becomes j."""
+        pos = {v: j for j, v in enumerate(nodes)}
+        inmask = []
+        m = 0
+        for v in nodes:
+            mk = 0
+            for u in _bits(self.inmask[v]):
+                j = pos.get(u)
+                if j is not None:
+                    mk |= 1 << j
+            inmask.append(mk)
+            m += mk.bit_count()
+        return Graph(len(nodes), inmask, m)
+
+
+def _graph(x: Any, where: str = "graph") -> Graph:
+    _obj(x, where, ("n", "edges"), ("nodes",))
+    n = _int(x["n"], f"{where}.n", 1, MAX_N)
+    if "nodes" in x:
+        labels = _array(x["nodes"], f"{where}.nodes")
+        if len(labels) != n:
+            raise Invalid(f"{where}.nodes has {len(labels)} labels, expected n = {n}")
+        for k, lab in enumerate(labels):
+            if not (isinstance(lab, str) or _is_int(lab)):
+                raise Invalid(f"{where}.nodes[{k}] must be a string or an integer, "
+                              f"got {_tname(lab)}")
+    edges = _array(x["edges"], f"{where}.edges")
+    inmask = [0] * n
+    for k, e in enumerate(edges):
+        w = f"{where}.edges[{k}]"
+        _array(e, w)
+        if len(e) != 2:
+            raise Invalid(f"{w} must be a pair [u, v], got {len(e)} entries")
+        u = _int(e[0], f"{w}[0]", 0, n - 1)
+        v = _int(e[1], f"{w}[1]", 0, n - 1)
+        if u == v:
+            raise Invalid(f"{w} = [{u}, {v}] is a self-loop")
+        if inmask[v] >> u & 1:
+            raise Invalid(f"{w} = [{u}, {v}] is a duplicate edge")
+        inmask[v] |= 1 << u
+    return Graph(n, inmask, len(edges))
+
+
+def reach(g: Graph, S: int, r: int) -> int:
+    """reach_r(S) = {i in S : |N(i) \\ S| >= r}."""
+    inmask = g.inmask
+    out = 0
+    m = S
+    while m:
+        low = m & -m
+        if (inmask[low.bit_length() - 1] & ~S).bit_count() >= r:
+            out |= low
+        m ^= low
+    return out
+
+
+def core(g: Graph, U: int, r: int) -> int:
+    """core_r(U): peel every i in U with |N(i) \\ U| >= r until none is left.
+
+    The result is the largest closed subset of U (closed sets are union-closed and
+    removability is monotone, so the peeling order does not matter).
+    """
+    inmask = g.inmask
+    while True:
+        removed = False
+        m = U
+        while m:
+            low = m & -m
+            m ^= low
+            if (inmask[low.bit_length() - 1] & ~U).bit_count() >= r:
+                U ^= low
+                removed = True
+        if not removed:
+            return U
+
+
+def _pair_failure(g: Graph, r: int, s: int, S1: int, S2: int) -> str | None:
+    """None if the disjoint nonempty pair (S1, S2) violates (r, s); else why not."""
+    R1 = reach(g, S1, r)
+    R2 = reach(g, S2, r)
+    if R1 == S1:
+        return f"S1 is fully {r}-reachable (every node of S1 has >= {r} in-neighbours outside S1)"
+    if R2 == S2:
+        return f"S2 is fully {r}-reachable (every node of S2 has >= {r} in-neighbours outside S2)"
+    c1, c2 = R1.bit_count(), R2.bit_count()
+    if c1 + c2 >= s:
+        return (f"|reach_{r}(S1)| + |reach_{r}(S2)| = {c1} + {c2} = {c1 + c2} >= s = {s} "
+                f"(reach_{r}(S1) = {_fmt(R1)}, reach_{r}(S2) = {_fmt(R2)})")
+    return None
+
+
+def _witness_pair(x: dict, where: str, g: Graph, k1: str = "S1", k2: str = "S2") -> tuple[int, int]:
+    S1 = _node_set(x[k1], f"{where}.{k1}", g.n)
+    S2 = _node_set(x[k2], f"{where}.{k2}", g.n)
+    common = S1 & S2
+    if common:
+        raise Invalid(f"{where}: {k1} and {k2} intersect at node {_bits(common)[0]}")
+    return S1, S2
+
+
+def _check_violation(g: Graph, r: int, s: int, S1: int, S2: int, where: str) -> None:
+    why = _pair_failure(g, r, s, S1, S2)
+    if why is not None:
+        raise Invalid(f"{where}: the pair S1 = {_fmt(S1)}, S2 = {_fmt(S2)} does not violate "
+                      f"({r}, {s}): {why}")
+
+
+# --------------------------------------------------------------------------- #
+# exhaustive re-verification (n <= 20), bit-parallel over all 2^n subsets
+# --------------------------------------------------------------------------- #
+#
+# A "family" is a Python int with 2^n bits: bit S is set iff the node set with
+# bitmask S belongs to the family.  Every operation below acts on all subsets at
+# once, so the whole enumeration costs O(n^2 * s) big-int operations.
+
+_BITREV = bytes(int(f"{b:08b}"[::-1], 2) for b in range(256))
+
+
+def _members(j: int, n: int) -> int:
+    """Family of the subsets of {0..n-1} that contain node j."""
+    N = 1 << n
+    half = 1 << j
+    x = ((1 << half) - 1) << half  # one period: 2^j absent, then 2^j present
+    length = half << 1
+    while length < N:
+        x |= x << length
+        length <<= 1
+    return x
+
+
+def _complement_family(x: int, n: int) -> int:
+    """{V \\ S : S in x}: bit S moves to bit (2^n - 1 - S), i.e. reverse 2^n bits."""
+    N = 1 << n
+    nb = max(1, N // 8)
+    y = int.from_bytes(x.to_bytes(nb, "little")[::-1].translate(_BITREV), "little")
+    return y >> (8 * nb - N)
+
+
+def _up_closure(x: int, n: int, members: list[int]) -> int:
+    """Family of all U containing some member of x (subset-OR transform)."""
+    for j in range(n):
+        x |= (x & ~members[j]) << (1 << j)
+    return x
+
+
+def enumerate_violation(g: Graph, r: int, s: int) -> tuple[int, int] | None:
+    """A pair violating (r, s), or None if g is (r, s)-robust.  Exhaustive, n <= 20.
+
+    For every S: c(S) = |reach_r(S)| and f(S) = [reach_r(S) != S].  A violating pair
+    is S1, S2 disjoint with f(S1), f(S2) and c(S1) + c(S2) <= s - 1; taking
+    c(S1) <= c(S2) we need, for some a <= (s-1)/2, S1 in F(a) with some member of
+    F(s-1-a) inside V \\ S1, where F(b) = {S : f(S), c(S) <= b}.  (f(empty) is false,
+    so both sets are nonempty.)  For s = 1 this is: two disjoint nonempty closed sets.
+    """
+    n = g.n
+    if n < 2:
+        return None
+    ALL = (1 << (1 << n)) - 1
+    members = [_members(j, n) for j in range(n)]
+    rr = min(r, n)  # |N(i) \ S| <= n - 1
+    kmax = min(s, n + 1)
+    # A[t] = family of S with c(S) >= t, t = 0..kmax
+    A = [ALL] + [0] * kmax
+    notfull = 0
+    for i in range(n):
+        nb = _bits(g.inmask[i])
+        if rr == 0:
+            R = members[i]
+        elif rr > len(nb):
+            R = 0
+        else:
+            # T[t] = family of S with at least t in-neighbours of i outside S
+            T = [ALL] + [0] * rr
+            for j in nb:
+                out_j = ALL ^ members[j]
+                for t in range(rr, 0, -1):
+                    T[t] |= T[t - 1] & out_j
+            R = members[i] & T[rr]  # S with i in reach_r(S)
+        notfull |= members[i] ^ R
+        if R:
+            for t in range(kmax, 0, -1):
+                A[t] |= A[t - 1] & R
+
+    def F(b: int) -> int:
+        return notfull if b + 1 > kmax else notfull & ~A[b + 1]
+
+    for a in range(min((s - 1) // 2, n) + 1):
+        b = s - 1 - a
+        Fb = F(b)
+        cand = F(a) & _complement_family(_up_closure(Fb, n, members), n)
+        if cand:
+            S1 = (cand & -cand).bit_length() - 1
+            sub = ALL  # family of the subsets of V \ S1
+            for j in _bits(S1):
+                sub &= ~members[j]
+            hit = Fb & sub
+            S2 = (hit & -hit).bit_length() - 1
+            return S1, S2
+    return None
+
+
+# --------------------------------------------------------------------------- #
+# proofs of (r, s)-robustness: method -> function
+# --------------------------------------------------------------------------- #
+
+
+def _proof_trivial(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method",))
+    if r != 0 and g.n != 1:
+        raise Invalid(f"{where}: method 'trivial' needs r = 0 or n = 1 (r = {r}, n = {g.n})")
+    return "trivial"
+
+
+def _proof_degree(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method",))
+    need = g.n // 2 + r - 1
+    for i, mk in enumerate(g.inmask):
+        d = mk.bit_count()
+        if d < need:
+            raise Invalid(f"{where}: node {i} has in-degree {d} < floor(n/2) + r - 1 = {need}")
+    return "degree"
+
+
+def _proof_complete(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method",))
+    full = g.full
+    for i, mk in enumerate(g.inmask):
+        missing = full & ~mk & ~(1 << i)
+        if missing:
+            u = _bits(missing)[0]
+            raise Invalid(f"{where}: graph is not complete: edge [{u}, {i}] is missing")
+    if g.n < 2 * r - 1:
+        raise Invalid(f"{where}: K_n with n = {g.n} < 2r - 1 = {2 * r - 1} is not {r}-robust")
+    return "complete"
+
+
+def _proof_construction(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method", "order", "seed_size", "seed_proof"))
+    order = _perm(p["order"], f"{where}.order", g.n)
+    m = _int(p["seed_size"], f"{where}.seed_size", 1, g.n)
+    need = r + s - 1
+    earlier = 0
+    for k, v in enumerate(order):
+        if k >= m:
+            c = (g.inmask[v] & earlier).bit_count()
+            if c < need:
+                raise Invalid(f"{where}: node order[{k}]={v} has {c} in-neighbours among earlier "
+                              f"nodes, needs {need} (r + s - 1)")
+        earlier |= 1 << v
+    seed = g.induced(order[:m])
+    sub = _proof(p["seed_proof"], f"{where}.seed_proof", seed, r, s, ctx)
+    return f"construction({sub})"
+
+
+def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method", "order", "tree"))
+    if s != 1:
+        raise Invalid(f"{where}: method 'search' proves r-robustness only (s = 1), got s = {s}")
+    n = g.n
+    order = _perm(p["order"], f"{where}.order", n)
+    tree = _array(p["tree"], f"{where}.tree")
+    for k, t in enumerate(tree):
+        if not _is_int(t) or not -2 <= t < n:
+            raise Invalid(f"{where}.tree[{k}] = {t!r} is not a token (-2, -1 or a node 0..{n - 1})")
+    full = g.full
+    pos = 0
+    ntok = len(tree)
+    B = 0
+    for k in range(n):
+        stack = [(1 << order[k], B)]  # (S, X) with X = B at the root
+        while stack:
+            S, X = stack.pop()
+            if pos >= ntok:
+                raise Invalid(f"{where}: search tree ends early (in the subtree of root {k})")
+            t = tree[pos]
+            if t >= 0:
+                bit = 1 << t
+                if (S | X) & bit:
+                    side = "S" if S & bit else "X"
+                    raise Invalid(f"{where}: search tree branches at token {pos} on node {t}, "
+                                  f"which is already in {side} = {_fmt(S if S & bit else X)}")
+                stack.append((S, X | bit))  # second: u forced out of S1
+                stack.append((S | bit, X))  # first: u in S1
+            elif t == -1:
+                c = core(g, full & ~S & ~B, r)
+                if c:
+                    raise Invalid(f"{where}: search tree leaf -1 at token {pos} is not justified: "
+                                  f"core(V \\ S \\ B) = {_fmt(c)} is nonempty "
+                                  f"(S = {_fmt(S)}, B = {_fmt(B)})")
+            else:  # t == -2
+                c = core(g, full & ~X, r)
+                if not S & ~c:
+                    raise Invalid(f"{where}: search tree leaf -2 at token {pos} is not justified: "
+                                  f"S = {_fmt(S)} is inside core(V \\ X) = {_fmt(c)} "
+                                  f"(X = {_fmt(X)})")
+            pos += 1
+        B |= 1 << order[k]
+    if pos != ntok:
+        raise Invalid(f"{where}: search tree has {ntok - pos} unused tokens after the {n} roots")
+    return "search"
+
+
+def _enumerate_or_fail(where: str, g: Graph, r: int, s: int) -> None:
+    hit = enumerate_violation(g, r, s)
+    if hit is not None:
+        S1, S2 = hit
+        raise Invalid(f"{where}: graph is not ({r}, {s})-robust: S1 = {_fmt(S1)}, "
+                      f"S2 = {_fmt(S2)} violate it (found by enumeration)")
+
+
+def _proof_enumeration(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method",))
+    if g.n > MAX_ENUM_N:
+        raise Invalid(f"{where}: too large to enumerate (n={g.n}>{MAX_ENUM_N})")
+    _enumerate_or_fail(where, g, r, s)
+    return "enumeration"
+
+
+def _info(p: dict, where: str) -> None:
+    if "info" in p and not isinstance(p["info"], dict):
+        raise Invalid(f"{where}.info must be a JSON object, got {_tname(p['info'])}")
+
+
+def _proof_dp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method",), ("info",))
+    _info(p, where)
+    if g.n > MAX_ENUM_N:
+        ctx.trust("dp")
+        return "dp (trusted)"
+    _enumerate_or_fail(where, g, r, s)
+    return "dp (re-verified by enumeration)"
+
+
+def _proof_milp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method", "solver"), ("info",))
+    if not isinstance(p["solver"], str) or not p["solver"]:
+        raise Invalid(f"{where}.solver must be a nonempty string")
+    _info(p, where)
+    ctx.trust("milp")
+    return "milp (trusted)"
+
+
+ProofFn = Callable[[dict, str, Graph, int, int, _Ctx], str]
+
+METHODS: dict[str, ProofFn] = {
+    "trivial": _proof_trivial,
+    "degree": _proof_degree,
+    "complete": _proof_complete,
+    "construction": _proof_construction,
+    "search": _proof_search,
+    "enumeration": _proof_enumeration,
+    "dp": _proof_dp,
+    "milp": _proof_milp,
+}
+
+
+def _method(p: Any, where: str) -> str:
+    if not isinstance(p, dict):
+        raise Invalid(f"{where} must be a JSON object, got {_tname(p)}")
+    if "method" not in p:
+        raise Invalid(f"{where}: missing key 'method'")
+    m = p["method"]
+    if not isinstance(m, str):
+        raise Invalid(f"{where}.method must be a string, got {_tname(m)}")
+    return m
+
+
+def _proof(p: Any, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    """Check that PROOF ``p`` proves g is (r, s)-robust; returns a short description.
+
+    ``s`` may exceed g.n inside a construction seed (the definition still makes sense:
+    then every pair must contain a fully reachable set)."""
+    m = _method(p, where)
+    fn = METHODS.get(m)
+    if fn is None:
+        raise Invalid(f"{where}: unknown proof method '{m}'")
+    return fn(p, where, g, r, s, ctx)
+
+
+# --------------------------------------------------------------------------- #
+# kinds: kind -> function
+# --------------------------------------------------------------------------- #
+
+_HEAD = ("rescon_certificate", "kind")
+
+
+def _r_s(c: dict, g: Graph) -> tuple[int, int]:
+    r = _int(c["r"], "r", 0)
+    s = _int(c["s"], "s", 1, g.n)
+    return r, s
+
+
+def _kind_not_rs_robust(c: dict, ctx: _Ctx) -> str:
+    _obj(c, "certificate", _HEAD + ("graph", "r", "s", "witness"))
+    g = _graph(c["graph"])
+    r, s = _r_s(c, g)
+    w = _obj(c["witness"], "witness", ("S1", "S2"))
+    S1, S2 = _witness_pair(w, "witness", g)
+    _check_violation(g, r, s, S1, S2, "witness")
+    return f"G (n={g.n}) is not ({r}, {s})-robust"
+
+
+def _kind_rs_robust(c: dict, ctx: _Ctx) -> str:
+    _obj(c, "certificate", _HEAD + ("graph", "r", "s", "proof"))
+    g = _graph(c["graph"])
+    r, s = _r_s(c, g)
+    how = _proof(c["proof"], "proof", g, r, s, ctx)
+    return f"G (n={g.n}) is ({r}, {s})-robust [{how}]"
+
+
+def _upper(u: Any, where: str, g: Graph, r: int, s: int, allow_half: bool) -> str:
+    """UPPER object proving g is not (r, s)-robust."""
+    m = _method(u, where)
+    if m == "witness":
+        _obj(u, where, ("method", "S1", "S2"))
+        S1, S2 = _witness_pair(u, where, g)
+        _check_violation(g, r, s, S1, S2, where)
+        return "witness"
+    if m == "half" and allow_half:
+        _obj(u, where, ("method",))
+        if g.n < 2:
+            raise Invalid(f"{where}: method 'half' needs n >= 2 (n = {g.n})")
+        h = (g.n + 1) // 2
+        if r != h + 1 or s != 1:
+            raise Invalid(f"{where}: method 'half' proves only 'not (ceil(n/2) + 1)-robust' = "
+                          f"not {h + 1}-robust, but not ({r}, {s})-robust is claimed")
+        return "half"
+    raise Invalid(f"{where}: unknown method '{m}' (expected 'witness'"
+                  + (" or 'half')" if allow_half else ")"))
+
+
+def _kind_robustness(c: dict, ctx: _Ctx) -> str:
+    if not isinstance(c.get("exact"), bool):
+        if "exact" not in c:
+            raise Invalid("certificate: missing key 'exact'")
+        raise Invalid(f"exact must be a boolean, got {_tname(c['exact'])}")
+    if c["exact"]:
+        _obj(c, "certificate",
+             _HEAD + ("graph", "exact", "r_max", "s_max", "lower", "upper_r", "upper_s"))
+        g = _graph(c["graph"])
+        r = _int(c["r_max"], "r_max", 0)
+        s = _int(c["s_max"], "s_max", 1, g.n)
+        if r == 0:
+            if s != g.n:
+                raise Invalid(f"r_max = 0 requires s_max = n = {g.n}, got s_max = {s}")
+            if _method(c["lower"], "lower") != "trivial":
+                raise Invalid("r_max = 0 requires lower = {\"method\": \"trivial\"}")
+        _proof(c["lower"], "lower", g, r, s, ctx)
+        _upper(c["upper_r"], "upper_r", g, r + 1, 1, allow_half=True)
+        if s == g.n:
+            if c["upper_s"] is not None:
+                raise Invalid(f"upper_s must be null when s_max = n = {g.n}")
+        else:
+            if c["upper_s"] is None:
+                raise Invalid(f"upper_s is null but s_max = {s} < n = {g.n}")
+            _upper(c["upper_s"], "upper_s", g, r, s + 1, allow_half=False)
+        return f"rho(G) = {r} and s*({r}) = {s} (n={g.n})"
+    _obj(c, "certificate", _HEAD + ("graph", "exact", "r_lower", "r_upper", "lower", "upper_r"))
+    g = _graph(c["graph"])
+    lo = _int(c["r_lower"], "r_lower", 0)
+    hi = _int(c["r_upper"], "r_upper", 0)
+    if lo > hi:
+        raise Invalid(f"r_lower = {lo} > r_upper = {hi}")
+    _proof(c["lower"], "lower", g, lo, 1, ctx)
+    _upper(c["upper_r"], "upper_r", g, hi + 1, 1, allow_half=True)
+    return f"{lo} <= rho(G) <= {hi} (n={g.n})"
+
+
+def _kind_not_sarymsakov(c: dict, ctx: _Ctx) -> str:
+    _obj(c, "certificate", _HEAD + ("n", "support", "witness"))
+    n = _int(c["n"], "n", 1, MAX_N)
+    sup = _array(c["support"], "support")
+    row = [0] * n  # row[i] = mask of the j with a_ij > 0
+    for k, e in enumerate(sup):
+        w = f"support[{k}]"
+        _array(e, w)
+        if len(e) != 2:
+            raise Invalid(f"{w} must be a pair [i, j], got {len(e)} entries")
+        i = _int(e[0], f"{w}[0]", 0, n - 1)
+        j = _int(e[1], f"{w}[1]", 0, n - 1)
+        if row[i] >> j & 1:
+            raise Invalid(f"{w} = [{i}, {j}] is a duplicate")
+        row[i] |= 1 << j
+    for i in range(n):
+        if not row[i]:
+            raise Invalid(f"row {i} has no entry in support (a row-stochastic matrix has one)")
+    w = _obj(c["witness"], "witness", ("V1", "V2"))
+    V1, V2 = _witness_pair(w, "witness", Graph(n, [], 0), "V1", "V2")
+    I1 = I2 = 0
+    for i in _bits(V1):
+        I1 |= row[i]
+    for i in _bits(V2):
+        I2 |= row[i]
+    if I1 & I2:
+        raise Invalid(f"witness: I(V1) and I(V2) intersect at index {_bits(I1 & I2)[0]}")
+    cu, cv = (I1 | I2).bit_count(), (V1 | V2).bit_count()
+    if cu > cv:
+        raise Invalid(f"witness: |I(V1) u I(V2)| = {cu} > |V1 u V2| = {cv}")
+    return f"the {n}x{n} matrix is not Sarymsakov"
+
+
+KINDS: dict[str, Callable[[dict, _Ctx], str]] = {
+    "not_rs_robust": _kind_not_rs_robust,
+    "rs_robust": _kind_rs_robust,
+    "robustness": _kind_robustness,
+    "not_sarymsakov": _kind_not_sarymsakov,
+}
+
+
+def check(cert: Any) -> CheckResult:
+    """Check a certificate (the parsed JSON object).  Never raises on bad input."""
+    ctx = _Ctx()
+    try:
+        if not isinstance(cert, dict):
+            raise Invalid(f"a certificate must be a JSON object, got {_tname(cert)}")
+        if "rescon_certificate" not in cert:
+            raise Invalid("certificate: missing key 'rescon_certificate'")
+        v = cert["rescon_certificate"]
+        if not _is_int(v) or v != FORMAT_VERSION:
+            raise Invalid(f"unsupported rescon_certificate version {v!r} "
+                          f"(expected {FORMAT_VERSION})")
+        if "kind" not in cert:
+            raise Invalid("certificate: missing key 'kind'")
+        kind = cert["kind"]
+        fn = KINDS.get(kind) if isinstance(kind, str) else None
+        if fn is None:
+            raise Invalid(f"unknown kind {kind!r}")
+        what = fn(cert, ctx)
+    except Invalid as e:
+        return CheckResult(False, str(e), ())
+    except RecursionError:
+        return CheckResult(False, "proof nested too deeply", ())
+    return CheckResult(True, what, tuple(ctx.trusted))
+
+
+# --------------------------------------------------------------------------- #
+# command line
+# --------------------------------------------------------------------------- #
+
+
+def _no_duplicate_keys(pairs: list[tuple[str, Any]]) -> dict:
+    d: dict = {}
+    for k, v in pairs:
+        if k in d:
+            raise ValueError(f"duplicate key {k!r}")
+        d[k] = v
+    return d
+
+
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not JSON")
+
+
+def load(path: str) -> dict:
+    """Read a certificate file; raises ValueError/OSError if unreadable."""
+    with open(path, "rb") as f:
+        data = f.read()
+    obj = json.loads(data.decode("utf-8"), object_pairs_hook=_no_duplicate_keys,
+                     parse_constant=_no_constant)
+    if not isinstance(obj, dict):
+        raise ValueError(f"top level is a JSON {_tname(obj)}, not an object")
+    return obj
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else list(argv)
+    if len(args) != 1 or args[0] in ("-h", "--help"):
+        print("usage: python certificates/check.py CERT.json", file=sys.stderr)
+        return 0 if args[:1] in (["-h"], ["--help"]) else 2
+    path = args[0]
+    try:
+        cert = load(path)
+    except (OSError, ValueError, RecursionError) as e:
+        print(f"unreadable: {path}: {e}", file=sys.stderr)
+        return 2
+    res = check(cert)
+    if not res.valid:
+        print(f"invalid: {res.reason}", file=sys.stderr)
+        return 1
+    print("valid")
+    if res.trusted:
+        print(f"accepted on trust: {', '.join(res.trusted)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""rescon.consensus (under construction)."""

@@ -1,0 +1,40 @@
+"""Exceptions raised by rescon.
+
+Every error derives from :class:`RESCONError`; subclasses also inherit the
+matching builtin so that ``except ValueError`` keeps working for bad input.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "RESCONError",
+    "InputError",
+    "GraphFormatError",
+    "SolverError",
+    "SolverNotFound",
+    "CertificateError",
+]
+
+
+class RESCONError(Exception):
+    """Base class of every exception rescon raises on purpose."""
+
+
+class InputError(RESCONError, ValueError):
+    """An argument or input file is malformed or out of range."""
+
+
+class GraphFormatError(InputError):
+    """A graph file cannot be parsed; the message names the file and line."""
+
+
+class SolverError(RESCONError, RuntimeError):
+    """A solver failed or returned a status rescon cannot use."""
+
+
+class SolverNotFound(SolverError):
+    """A requested backend is unknown or not installed."""
+
+
+class CertificateError(RESCONError, ValueError):
+    """A certificate could not be produced or is malformed."""

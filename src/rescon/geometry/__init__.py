@@ -1,0 +1,1 @@
+"""rescon.geometry (under construction)."""

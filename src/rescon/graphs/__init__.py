@@ -1,0 +1,1 @@
+"""Graph robustness: bounds, exact search, MILP, generators, Sarymsakov and attack-model checks."""

@@ -1,0 +1,124 @@
+"""Exact decision "is G r-robust?" by branch and bound over closed sets (n ≤ 64).
+
+G is not r-robust iff V contains two disjoint nonempty *r-closed* sets (sets none
+of whose members has r in-neighbours outside). Closed sets are closed under union,
+so for a fixed S1 the only candidate S2 worth trying is core_r(V \\ S1), found by
+peeling in O(|E|). The search enumerates S1 only, with three prunings — S2 must
+fit in core(V \\ S1 \\ B), S1 must fit in core(V \\ X), and a member with too many
+outside in-neighbours forces a branch — and the symmetry break "the first node of
+S1 ∪ S2 in the search order is in S1". The tree it explores is recorded token by
+token and is itself the certificate of robustness (certificates/FORMAT.md,
+method ``search``), replayed by the checker in polynomial time per leaf.
+
+Complexity: exponential in the worst case (the problem is coNP-complete); the tree
+is tiny on graphs whose robustness is decided by small or large sets.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from . import _kernels as K
+from .indexed import IndexedGraph
+
+__all__ = ["MAX_SEARCH_NODES", "MAX_TREE_TOKENS", "SearchOutcome", "decide_r_robust", "search_order"]
+
+MAX_SEARCH_NODES = 64
+MAX_TREE_TOKENS = 4_000_000
+_SLICE = 20_000
+
+
+@dataclass(frozen=True)
+class SearchOutcome:
+    """Result of one decision search.
+
+    ``status`` is "robust" (no violating pair; ``tree`` proves it unless it grew
+    past ``MAX_TREE_TOKENS``), "not_robust" (``witness`` = (S1, S2) index sets), or
+    "stopped" (deadline reached; ``progress`` ∈ [0, 1) is the share of the search
+    space refuted so far).
+    """
+
+    status: str
+    r: int
+    order: tuple[int, ...]
+    witness: tuple[frozenset[int], frozenset[int]] | None
+    tree: tuple[int, ...] | None
+    nodes: int
+    progress: float
+
+
+def search_order(ig: IndexedGraph) -> np.ndarray:
+    """Roots in ascending in-degree (ties by index): small-degree nodes are the
+    likeliest members of closed sets, so witnesses surface from the first roots."""
+    deg = np.array(ig.in_degrees)
+    return np.lexsort((np.arange(ig.n), deg)).astype(np.int64)
+
+
+def _mask_array(ig: IndexedGraph) -> np.ndarray:
+    return np.array(ig.in_masks(), dtype=np.uint64)
+
+
+def _bits(mask: int) -> frozenset[int]:
+    return frozenset(i for i in range(int(mask).bit_length()) if (int(mask) >> i) & 1)
+
+
+def decide_r_robust(
+    ig: IndexedGraph,
+    r: int,
+    *,
+    record: bool = True,
+    deadline: float | None = None,
+    on_progress: Callable[[float], None] | None = None,
+) -> SearchOutcome:
+    """Decide whether ``ig`` is r-robust, exactly.
+
+    Parameters
+    ----------
+    ig : IndexedGraph with n ≤ 64 nodes.
+    r : int ≥ 1.
+    record : keep the search tree as a certificate (dropped if it exceeds
+        ``MAX_TREE_TOKENS`` tokens; the answer stays exact).
+    deadline : ``time.perf_counter()`` value after which the search stops.
+    on_progress : called with the refuted share of the search space.
+    """
+    n = ig.n
+    if n > MAX_SEARCH_NODES:
+        raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
+    inmask = _mask_array(ig)
+    order = search_order(ig)
+    stack_S = np.zeros(2 * n + 2, dtype=np.uint64)
+    stack_X = np.zeros(2 * n + 2, dtype=np.uint64)
+    stack_depth = np.zeros(2 * n + 2, dtype=np.int64)
+    state = np.zeros(K.STATE_LEN, dtype=np.int64)
+    ubuf = np.zeros(K.UBUF_LEN, dtype=np.uint64)
+    progress = np.zeros(1, dtype=np.float64)
+    tokens = np.empty(1 << 12 if record else 1, dtype=np.int32)
+    while True:
+        state[K.ST_STATUS] = K.RUNNING
+        K.decide_step(inmask, order, r, stack_S, stack_X, stack_depth, state, ubuf,
+                      tokens, record, _SLICE, progress)
+        status = state[K.ST_STATUS]
+        if status == K.NEED_ROOM:
+            if 2 * tokens.shape[0] > MAX_TREE_TOKENS:
+                record = False
+                tokens = np.empty(1, dtype=np.int32)
+            else:
+                tokens = np.concatenate([tokens, np.empty_like(tokens)])
+            continue
+        if on_progress is not None:
+            on_progress(float(progress[0]))
+        if status != K.RUNNING:
+            break
+        if deadline is not None and time.perf_counter() > deadline:
+            return SearchOutcome("stopped", r, tuple(order.tolist()), None, None,
+                                 int(state[K.ST_NODES]), float(progress[0]))
+    nodes = int(state[K.ST_NODES])
+    if status == K.SAT:
+        witness = (_bits(ubuf[K.UB_W1]), _bits(ubuf[K.UB_W2]))
+        return SearchOutcome("not_robust", r, tuple(order.tolist()), witness, None, nodes, 1.0)
+    tree = tuple(tokens[: state[K.ST_NTOK]].tolist()) if record else None
+    return SearchOutcome("robust", r, tuple(order.tolist()), None, tree, nodes, 1.0)

@@ -1,0 +1,1 @@
+"""rescon.models (under construction)."""

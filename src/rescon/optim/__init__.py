@@ -1,0 +1,1 @@
+"""rescon.optim (under construction)."""

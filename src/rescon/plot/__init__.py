@@ -1,0 +1,1 @@
+"""rescon.plot (under construction)."""

@@ -1,0 +1,1 @@
+"""rescon.sweep (under construction)."""
