@@ -1,0 +1,469 @@
+"""Read graphs and point sets from files; write results as JSON.
+
+Graph convention (SPEC §1): a directed edge ``(u, v)`` means **v receives u's
+state** (u is an in-neighbour of v). Every reader returns a simple graph:
+self-loops are dropped without error (robustness ignores them) and parallel
+edges of multigraph files collapse to one edge.
+
+Every error is a single line that names the file, and the line where one
+applies (``path:line: message``).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+import os
+import re
+from fractions import Fraction
+from pathlib import Path
+from typing import Any, Callable, Hashable, Iterator, TextIO
+from xml.etree.ElementTree import ParseError
+
+import networkx as nx
+import numpy as np
+
+from .errors import GraphFormatError, InputError
+
+__all__ = ["read_graph", "read_points", "to_jsonable", "write_json"]
+
+_INT = re.compile(r"[+-]?\d+")
+
+
+# --------------------------------------------------------------------------- graphs
+
+
+def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.Graph:
+    """Read a graph file into a simple networkx graph.
+
+    The format is chosen by the file suffix:
+
+    ``.graphml`` / ``.gml``
+        Read with networkx. GML nodes are named by their ``label`` attributes
+        when all are distinct strings, else by their ids. Node names that are
+        all decimal integers become ``int``. An undirected file counts each edge
+        both ways.
+    ``.json``
+        networkx node-link data: ``{"directed": bool, "nodes": [{"id": ...}, ...],
+        "links": [{"source": u, "target": v}, ...]}``; the edge list may also be
+        under ``"edges"``. Node ids are integers or strings; a missing
+        ``"directed"`` means directed (as for edge lists).
+    ``.csv``
+        Adjacency matrix :math:`A`: :math:`a_{ij} \\ne 0` is the edge
+        :math:`i \\to j`. Entries are nonnegative finite numbers (0/1 usually).
+        An optional first row holds the node labels; it is recognised when it
+        contains a non-number, or when the file has one more row than columns
+        and the first row holds distinct integers. Without it the nodes are
+        ``0..n-1``. The matrix must be square.
+    anything else
+        Edge list: ``u v`` per line is the edge :math:`u \\to v`; a line with a
+        single label declares a (possibly isolated) node. Labels must be
+        integers. ``#`` starts a comment; blank lines are ignored. Nodes are
+        sorted by label.
+
+    Lines starting with ``#`` are comments in ``.csv`` files too.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The graph file.
+    undirected : bool, default False
+        Return an undirected :class:`networkx.Graph`; edges of a directed file
+        are symmetrised (:math:`u \\to v` becomes :math:`\\{u, v\\}`).
+
+    Returns
+    -------
+    networkx.DiGraph or networkx.Graph
+        A :class:`~networkx.DiGraph` (an undirected file gives both directions of
+        every edge), or a :class:`~networkx.Graph` when ``undirected`` is true.
+        Self-loops are dropped without error; parallel edges collapse to one.
+        Node and graph attributes of GraphML, GML and JSON files are kept; edge
+        attributes are not.
+
+    Raises
+    ------
+    InputError
+        ``path`` does not name an existing file.
+    GraphFormatError
+        The file cannot be parsed, or the graph has no nodes. The message names
+        the file, and the line where one applies.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "g.edgelist"
+    >>> _ = p.write_text("# a path 1 -> 2 -> 3 and node 4\\n1 2\\n2 3\\n4\\n")
+    >>> G = read_graph(p)
+    >>> sorted(G.edges()), sorted(G.nodes())
+    ([(1, 2), (2, 3)], [1, 2, 3, 4])
+    """
+    p = _existing_file(path, "graph file")
+    reader = _GRAPH_READERS.get(p.suffix.lower(), _read_edge_list)
+    G = reader(p)
+    if G.number_of_nodes() == 0:
+        raise GraphFormatError(f"{p}: the graph has no nodes")
+    out: nx.Graph = nx.Graph() if undirected else nx.DiGraph()
+    out.graph.update(G.graph)
+    out.add_nodes_from(G.nodes(data=True))
+    both_ways = not undirected and not G.is_directed()
+    for u, v in G.edges():
+        if u != v:
+            out.add_edge(u, v)
+            if both_ways:
+                out.add_edge(v, u)
+    return out
+
+
+def _read_edge_list(p: Path) -> nx.DiGraph:
+    G = nx.DiGraph()
+    for lineno, line in _data_lines(p, inline_comments=True):
+        tokens = line.split()
+        if len(tokens) > 2:
+            raise GraphFormatError(
+                f"{p}:{lineno}: expected 'u v' (edge u -> v) or a single node 'u'; "
+                f"got {len(tokens)} fields"
+            )
+        labels = [_int_label(p, lineno, t) for t in tokens]
+        if len(labels) == 1:
+            G.add_node(labels[0])
+        else:
+            G.add_edge(labels[0], labels[1])
+    H = nx.DiGraph()
+    H.add_nodes_from(sorted(G.nodes()))
+    H.add_edges_from(G.edges())
+    return H
+
+
+def _int_label(p: Path, lineno: int, token: str) -> int:
+    if not _INT.fullmatch(token):
+        raise GraphFormatError(f"{p}:{lineno}: node label {token!r} is not an integer")
+    return int(token)
+
+
+def _read_adjacency_csv(p: Path) -> nx.DiGraph:
+    rows = _csv_rows(p)
+    if not rows:
+        raise GraphFormatError(f"{p}: the graph has no nodes")
+    labels: list[Hashable] | None = None
+    first_line, first = rows[0]
+    width = len(first)
+    if any(_number(c) is None for c in first) or (
+        len(rows) == width + 1 and all(_INT.fullmatch(c) for c in first)
+    ):
+        labels = [_header_label(p, first_line, c) for c in first]
+        if len(set(labels)) != len(labels):
+            raise GraphFormatError(f"{p}:{first_line}: header labels are not distinct")
+        rows = rows[1:]
+    matrix = [_number_row(p, lineno, cells, width, first_line, GraphFormatError)
+              for lineno, cells in rows]
+    if len(matrix) != width:
+        raise GraphFormatError(
+            f"{p}: adjacency matrix must be square; got {len(matrix)} rows and {width} columns"
+        )
+    for (lineno, _), values in zip(rows, matrix):
+        for j, a in enumerate(values):
+            if not (math.isfinite(a) and a >= 0):
+                raise GraphFormatError(
+                    f"{p}:{lineno}: column {j + 1}: entry {a} is not a nonnegative finite "
+                    "number (expected 0/1 or a nonnegative weight)"
+                )
+    nodes: list[Hashable] = labels if labels is not None else list(range(width))
+    G = nx.DiGraph()
+    G.add_nodes_from(nodes)
+    G.add_edges_from(
+        (nodes[i], nodes[j]) for i, values in enumerate(matrix) for j, a in enumerate(values) if a
+    )
+    return G
+
+
+def _header_label(p: Path, lineno: int, cell: str) -> Hashable:
+    if not cell:
+        raise GraphFormatError(f"{p}:{lineno}: header has an empty node label")
+    return int(cell) if _INT.fullmatch(cell) else cell
+
+
+def _read_node_link(p: Path) -> nx.Graph:
+    data = _load_json(p)
+    if not isinstance(data, dict) or "nodes" not in data:
+        raise GraphFormatError(
+            f"{p}: expected a node-link JSON object with 'nodes' and 'links' (or 'edges')"
+        )
+    if ("links" in data) == ("edges" in data):
+        raise GraphFormatError(f"{p}: node-link JSON needs exactly one of 'links' or 'edges'")
+    links = data["links"] if "links" in data else data["edges"]
+    directed = data.get("directed", True)
+    if not isinstance(directed, bool) or not isinstance(data["nodes"], list) or not isinstance(
+        links, list
+    ):
+        raise GraphFormatError(
+            f"{p}: 'directed' must be a boolean and 'nodes', 'links' must be lists"
+        )
+    G: nx.Graph = nx.DiGraph() if directed else nx.Graph()
+    graph_attrs = data.get("graph", {})
+    if isinstance(graph_attrs, dict):
+        G.graph.update(graph_attrs)
+    for k, node in enumerate(data["nodes"]):
+        if not isinstance(node, dict) or not _is_label(node.get("id")):
+            raise GraphFormatError(
+                f"{p}: nodes[{k}] must be an object with an integer or string 'id'"
+            )
+        if node["id"] in G:
+            raise GraphFormatError(f"{p}: nodes[{k}]: duplicate node id {node['id']!r}")
+        G.add_node(node["id"], **{a: v for a, v in node.items() if a != "id"})
+    for k, link in enumerate(links):
+        if not isinstance(link, dict) or "source" not in link or "target" not in link:
+            raise GraphFormatError(f"{p}: links[{k}] must be an object with 'source' and 'target'")
+        for end in (link["source"], link["target"]):
+            if not _is_label(end) or end not in G:
+                raise GraphFormatError(f"{p}: links[{k}] refers to unknown node {end!r}")
+        G.add_edge(link["source"], link["target"])
+    return G
+
+
+def _is_label(x: Any) -> bool:
+    return isinstance(x, (int, str)) and not isinstance(x, bool)
+
+
+def _load_json(p: Path) -> Any:
+    text = _read_text(p, GraphFormatError)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise GraphFormatError(f"{p}:{exc.lineno}: invalid JSON: {exc.msg}") from exc
+
+
+def _read_networkx(p: Path, read: Callable[[Path], nx.Graph]) -> nx.Graph:
+    try:
+        G = read(p)
+    except ParseError as exc:
+        raise GraphFormatError(f"{p}:{exc.position[0]}: invalid XML: {exc}") from exc
+    except (nx.NetworkXError, ValueError, KeyError, TypeError) as exc:
+        raise GraphFormatError(f"{p}: cannot read as {p.suffix[1:]}: {exc}") from exc
+    labels = list(G.nodes())
+    if all(isinstance(v, str) and _INT.fullmatch(v) for v in labels) and len(
+        {int(v) for v in labels}
+    ) == len(labels):
+        G = nx.relabel_nodes(G, {v: int(v) for v in labels})
+    return G
+
+
+def _read_gml_file(p: Path) -> nx.Graph:
+    G = nx.read_gml(p, label=None)
+    names = [G.nodes[v].get("label") for v in G]
+    if all(isinstance(s, str) for s in names) and len(set(names)) == len(names):
+        G = nx.relabel_nodes(G, dict(zip(G.nodes(), names)))
+    return G
+
+
+_GRAPH_READERS: dict[str, Callable[[Path], nx.Graph]] = {
+    ".graphml": lambda p: _read_networkx(p, nx.read_graphml),
+    ".gml": lambda p: _read_networkx(p, _read_gml_file),
+    ".json": _read_node_link,
+    ".csv": _read_adjacency_csv,
+}
+
+
+# --------------------------------------------------------------------------- points
+
+
+def read_points(path: str | os.PathLike[str]) -> np.ndarray:
+    """Read a point set :math:`X \\in \\mathbb{R}^{n \\times d}` (one point per row).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.npy``: a 2-D numeric array (no pickles). Anything else: CSV with n rows
+        of d comma-separated numbers, an optional header row (recognised by a
+        non-number cell, ignored), ``#`` comment lines and blank lines ignored.
+
+    Returns
+    -------
+    numpy.ndarray
+        Float array of shape ``(n, d)``, n ≥ 1, d ≥ 1, all entries finite.
+
+    Raises
+    ------
+    InputError
+        Missing file, ragged rows, non-numeric cells, NaN or infinite entries,
+        no points, or an ``.npy`` array that is not 2-D. CSV messages name the
+        file and line.
+    """
+    p = _existing_file(path, "points file")
+    if p.suffix.lower() == ".npy":
+        return _read_npy_points(p)
+    rows = _csv_rows(p, error=InputError)
+    if not rows:
+        raise InputError(f"{p}: no points (expected n >= 1 rows of d numbers)")
+    first_line, width = rows[0][0], len(rows[0][1])
+    if any(_number(c) is None for c in rows[0][1]):
+        rows = rows[1:]
+        if not rows:
+            raise InputError(f"{p}: no points after the header row")
+    values = [_number_row(p, lineno, cells, width, first_line, InputError)
+              for lineno, cells in rows]
+    for (lineno, _), row in zip(rows, values):
+        bad = [j + 1 for j, x in enumerate(row) if not math.isfinite(x)]
+        if bad:
+            raise InputError(f"{p}:{lineno}: column {bad[0]}: coordinates must be finite numbers")
+    return np.array(values, dtype=float)
+
+
+def _read_npy_points(p: Path) -> np.ndarray:
+    try:
+        arr = np.load(p, allow_pickle=False)
+    except (OSError, ValueError, EOFError) as exc:
+        raise InputError(f"{p}: not a readable .npy array: {exc}") from exc
+    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1 or arr.dtype.kind not in "biuf":
+        raise InputError(
+            f"{p}: points must be a numeric (n, d) array with n, d >= 1; "
+            f"got shape {arr.shape}, dtype {arr.dtype}"
+        )
+    X = arr.astype(float)
+    bad = ~np.isfinite(X)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise InputError(
+            f"{p}: points must be finite; got {int(bad.sum())} NaN/inf entries, "
+            f"first at row {i}, column {j}"
+        )
+    return X
+
+
+# --------------------------------------------------------------------------- text helpers
+
+
+def _existing_file(path: Any, what: str) -> Path:
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"path must be a str or os.PathLike; got {type(path).__name__}")
+    p = Path(path)
+    if not p.is_file():
+        reason = "is a directory" if p.is_dir() else "not found"
+        raise InputError(f"{what} {reason}: {p}")
+    return p
+
+
+def _read_text(p: Path, error: type[InputError]) -> str:
+    try:
+        return p.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"{p}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
+
+
+def _data_lines(p: Path, *, inline_comments: bool = False,
+                error: type[InputError] = GraphFormatError) -> Iterator[tuple[int, str]]:
+    for lineno, raw in enumerate(_read_text(p, error).splitlines(), start=1):
+        line = raw.split("#", 1)[0] if inline_comments else raw
+        line = line.strip()
+        if line and not line.startswith("#"):
+            yield lineno, line
+
+
+def _csv_rows(p: Path, error: type[InputError] = GraphFormatError) -> list[tuple[int, list[str]]]:
+    return [
+        (lineno, [c.strip() for c in next(csv.reader([line]))])
+        for lineno, line in _data_lines(p, error=error)
+    ]
+
+
+def _number(cell: str) -> float | None:
+    try:
+        return float(cell)
+    except ValueError:
+        return None
+
+
+def _number_row(p: Path, lineno: int, cells: list[str], width: int, first_line: int,
+                error: type[InputError]) -> list[float]:
+    if len(cells) != width:
+        raise error(
+            f"{p}:{lineno}: row has {len(cells)} entries; "
+            f"expected {width} (as in line {first_line})"
+        )
+    row = []
+    for j, cell in enumerate(cells):
+        x = _number(cell)
+        if x is None:
+            raise error(f"{p}:{lineno}: column {j + 1}: {cell!r} is not a number")
+        row.append(x)
+    return row
+
+
+# --------------------------------------------------------------------------- JSON output
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert ``obj`` recursively into plain JSON types.
+
+    Conversions: numpy scalars → Python scalars; numpy arrays, tuples → lists;
+    sets, frozensets → sorted lists (mixed types: by type name first); dataclass
+    instances → dicts of their fields; :class:`fractions.Fraction` → exact
+    strings such as ``"3/4"``; paths → strings; mapping keys → strings;
+    non-finite floats → ``None`` (JSON has no NaN or infinity).
+
+    Raises
+    ------
+    InputError
+        ``obj`` contains a value with no JSON form (e.g. complex, bytes).
+
+    Examples
+    --------
+    >>> from fractions import Fraction
+    >>> to_jsonable({"S": {3, 1}, "x": np.float64(0.5), "q": Fraction(3, 4)})
+    {'S': [1, 3], 'x': 0.5, 'q': '3/4'}
+    """
+    if obj is None or isinstance(obj, (bool, int, str)):
+        return obj
+    if isinstance(obj, float):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.generic):
+        return to_jsonable(obj.item())
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, Fraction):
+        return str(obj)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: to_jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, dict):
+        return {k if isinstance(k, str) else str(to_jsonable(k)): to_jsonable(v)
+                for k, v in obj.items()}
+    if isinstance(obj, (set, frozenset)):
+        items = [to_jsonable(x) for x in obj]
+        try:
+            return sorted(items)
+        except TypeError:
+            return sorted(items, key=lambda x: (type(x).__name__, json.dumps(x, sort_keys=True)))
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(x) for x in obj]
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    raise InputError(f"obj contains a {type(obj).__name__} value, which has no JSON form")
+
+
+def write_json(obj: Any, path_or_stream: str | os.PathLike[str] | TextIO) -> None:
+    """Write ``to_jsonable(obj)`` as indented JSON (UTF-8, trailing newline).
+
+    Parameters
+    ----------
+    obj : Any
+        Anything :func:`to_jsonable` accepts.
+    path_or_stream : str, os.PathLike or text stream
+        A file path (overwritten) or an object with a ``write(str)`` method.
+
+    Raises
+    ------
+    InputError
+        ``obj`` has no JSON form, or ``path_or_stream`` is neither a path nor a
+        writable stream.
+    """
+    text = json.dumps(to_jsonable(obj), indent=2) + "\n"
+    if isinstance(path_or_stream, (str, os.PathLike)):
+        Path(path_or_stream).write_text(text, encoding="utf-8")
+    elif callable(getattr(path_or_stream, "write", None)):
+        path_or_stream.write(text)
+    else:
+        raise InputError(
+            "path_or_stream must be a path or a writable text stream; "
+            f"got {type(path_or_stream).__name__}"
+        )
