@@ -439,15 +439,19 @@ def _proof_construction(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx
 
 
 def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
-    _obj(p, where, ("method", "order", "tree"))
+    _obj(p, where, ("method", "order", "tree"), ("info",))
+    _info(p, where)
     if s != 1:
         raise Invalid(f"{where}: method 'search' proves r-robustness only (s = 1), got s = {s}")
     n = g.n
     order = _perm(p["order"], f"{where}.order", n)
+    if p["tree"] is None:
+        ctx.trust("search")
+        return "search (tree not recorded: trusted)"
     tree = _array(p["tree"], f"{where}.tree")
     for k, t in enumerate(tree):
-        if not _is_int(t) or not -2 <= t < n:
-            raise Invalid(f"{where}.tree[{k}] = {t!r} is not a token (-2, -1 or a node 0..{n - 1})")
+        if not _is_int(t) or not -3 <= t < n:
+            raise Invalid(f"{where}.tree[{k}] = {t!r} is not a token (-3..-1 or a node 0..{n - 1})")
     full = g.full
     pos = 0
     ntok = len(tree)
@@ -473,17 +477,54 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
                     raise Invalid(f"{where}: search tree leaf -1 at token {pos} is not justified: "
                                   f"core(V \\ S \\ B) = {_fmt(c)} is nonempty "
                                   f"(S = {_fmt(S)}, B = {_fmt(B)})")
-            else:  # t == -2
+            elif t == -2:
                 c = core(g, full & ~X, r)
                 if not S & ~c:
                     raise Invalid(f"{where}: search tree leaf -2 at token {pos} is not justified: "
                                   f"S = {_fmt(S)} is inside core(V \\ X) = {_fmt(c)} "
                                   f"(X = {_fmt(X)})")
+            else:  # t == -3
+                fits = _sizes_fit(g, S, X, B, r)
+                if fits:
+                    raise Invalid(f"{where}: search tree leaf -3 at token {pos} is not justified: "
+                                  f"{fits}")
             pos += 1
         B |= 1 << order[k]
     if pos != ntok:
         raise Invalid(f"{where}: search tree has {ntok - pos} unused tokens after the {n} roots")
     return "search"
+
+
+def _sizes_fit(g: Graph, S: int, X: int, B: int, r: int) -> str:
+    """'' when a closed S1 ⊇ S avoiding X and a closed nonempty S2 ⊆ core(V \\ S \\ B)
+    provably cannot fit together; otherwise the reason they might.
+
+    |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺ and |S2| ≥ min_{j∈Q} max(1, d_j − r + 2),
+    while S1 ⊆ P = core(V \\ X), S2 ⊆ Q = core(V \\ S \\ B) are disjoint: |S1| + |S2| ≤ |P ∪ Q|.
+    """
+    full = g.full
+    Q = core(g, full & ~S & ~B, r)
+    P = core(g, full & ~X, r)
+    need1 = S.bit_count() + max([0] + [(g.inmask[i] & ~S).bit_count() - r + 1 for i in _bits(S)])
+    need2 = min([g.n + 1] + [max(1, g.inmask[j].bit_count() - r + 2) for j in _bits(Q)])
+    room = (P | Q).bit_count()
+    if need1 + need2 > room:
+        return ""
+    return (f"|S1| >= {need1} and |S2| >= {need2} fit in |P u Q| = {room} "
+            f"(S = {_fmt(S)}, X = {_fmt(X)}, B = {_fmt(B)})")
+
+
+def _proof_implied(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    """(r', s')-robust implies (r, s)-robust when r' >= r and s' >= s (fewer reachable
+    nodes at a larger threshold), or when r' >= r + s - 1 (an (r, s)-violating pair
+    minus its reachable nodes is a pair of (r + s - 1)-closed sets)."""
+    _obj(p, where, ("method", "r", "s", "proof"))
+    r2 = _int(p["r"], f"{where}.r", 0)
+    s2 = _int(p["s"], f"{where}.s", 1, g.n)
+    if not ((r2 >= r and s2 >= s) or r2 >= r + s - 1):
+        raise Invalid(f"{where}: ({r2}, {s2})-robustness does not imply ({r}, {s})-robustness")
+    sub = _proof(p["proof"], f"{where}.proof", g, r2, s2, ctx)
+    return f"implied({sub})"
 
 
 def _enumerate_or_fail(where: str, g: Graph, r: int, s: int) -> None:
@@ -536,6 +577,7 @@ METHODS: dict[str, ProofFn] = {
     "search": _proof_search,
     "enumeration": _proof_enumeration,
     "dp": _proof_dp,
+    "implied": _proof_implied,
     "milp": _proof_milp,
 }
 
@@ -622,7 +664,8 @@ def _kind_robustness(c: dict, ctx: _Ctx) -> str:
         raise Invalid(f"exact must be a boolean, got {_tname(c['exact'])}")
     if c["exact"]:
         _obj(c, "certificate",
-             _HEAD + ("graph", "exact", "r_max", "s_max", "lower", "upper_r", "upper_s"))
+             _HEAD + ("graph", "exact", "r_max", "s_max", "lower", "lower_s", "upper_r",
+                      "upper_s"))
         g = _graph(c["graph"])
         r = _int(c["r_max"], "r_max", 0)
         s = _int(c["s_max"], "s_max", 1, g.n)
@@ -631,7 +674,12 @@ def _kind_robustness(c: dict, ctx: _Ctx) -> str:
                 raise Invalid(f"r_max = 0 requires s_max = n = {g.n}, got s_max = {s}")
             if _method(c["lower"], "lower") != "trivial":
                 raise Invalid("r_max = 0 requires lower = {\"method\": \"trivial\"}")
-        _proof(c["lower"], "lower", g, r, s, ctx)
+        _proof(c["lower"], "lower", g, r, 1, ctx)
+        if c["lower_s"] is None:
+            if s != 1:
+                raise Invalid(f"lower_s is null but s_max = {s} > 1 needs a proof")
+        else:
+            _proof(c["lower_s"], "lower_s", g, r, s, ctx)
         _upper(c["upper_r"], "upper_r", g, r + 1, 1, allow_half=True)
         if s == g.n:
             if c["upper_s"] is not None:

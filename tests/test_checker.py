@@ -172,7 +172,8 @@ def robustness_cert(n, edges):
         S1, S2 = first_violation(n, inm, r, s + 1)
         upper_s = {"method": "witness", "S1": bits(S1), "S2": bits(S2)}
     return {"rescon_certificate": 1, "kind": "robustness", "graph": graph_json(n, edges),
-            "exact": True, "r_max": r, "s_max": s, "lower": lower, "upper_r": upper_r,
+            "exact": True, "r_max": r, "s_max": s, "lower": lower, "lower_s": lower,
+            "upper_r": upper_r,
             "upper_s": upper_s}
 
 
@@ -634,7 +635,7 @@ def test_search_tree_bad_tokens():
     tokens, _ = search_tree(3, in_masks(3, k3), 2, [0, 1, 2])
     cert = search_cert(3, k3, 2, [0, 1, 2], tokens)
     assert check(cert).valid and len(tokens) > 3
-    for tok in (-3, 3, True, 1.0, "x", None):
+    for tok in (-4, 3, True, 1.0, "x", None):
         bad = copy.deepcopy(cert)
         bad["proof"]["tree"][1] = tok
         res = check(bad)
@@ -692,7 +693,7 @@ def test_robustness_certificates_and_tampering():
             assert "must be null" in check(bad).reason
         if r == 0:
             bad = copy.deepcopy(cert)
-            bad["lower"] = {"method": "enumeration"}
+            bad["lower"] = bad["lower_s"] = {"method": "enumeration"}
             assert "trivial" in check(bad).reason
         # the bounds variant
         bounds = {k: cert[k] for k in ("rescon_certificate", "kind", "graph", "upper_r")}
@@ -715,10 +716,11 @@ def test_robustness_half_and_lower_on_trust():
     cert = {"rescon_certificate": 1, "kind": "robustness",
             "graph": graph_json(n, complete_edges(n)),
             "exact": True, "r_max": 3, "s_max": 5, "lower": {"method": "milp", "solver": "highs"},
+            "lower_s": {"method": "milp", "solver": "highs"},
             "upper_r": {"method": "half"}, "upper_s": None}
     res = check(cert)
     assert res.valid and res.trusted == ("milp",)
-    cert["lower"] = {"method": "complete"}
+    cert["lower"] = cert["lower_s"] = {"method": "complete"}
     res = check(cert)
     assert res.valid and res.trusted == ()
     bad = copy.deepcopy(cert)
@@ -730,7 +732,7 @@ def test_robustness_half_and_lower_on_trust():
     bad["s_max"] = 4
     assert not check(bad).valid
     one = {"rescon_certificate": 1, "kind": "robustness", "graph": {"n": 1, "edges": []},
-           "exact": True, "r_max": 1, "s_max": 1, "lower": {"method": "trivial"},
+           "exact": True, "r_max": 1, "s_max": 1, "lower": {"method": "trivial"}, "lower_s": None,
            "upper_r": {"method": "half"}, "upper_s": None}
     assert "n >= 2" in check(one).reason
 

@@ -33,12 +33,6 @@ def popcount(x: np.uint64) -> np.int64:
     return np.int64((x * np.uint64(0x0101010101010101)) >> np.uint64(56))
 
 
-@njit(cache=True, inline="always")
-def lowest_bit_index(x: np.uint64) -> np.int64:
-    """Index of the lowest set bit of a nonzero uint64."""
-    return popcount((x & (~x + U1)) - U1)
-
-
 @njit(cache=True)
 def core(U: np.uint64, inmask: np.ndarray, n: int, r: int) -> np.uint64:
     """Largest r-closed subset of U: peel every i ∈ U with |N(i) \\ U| ≥ r.
@@ -70,6 +64,47 @@ def max_outside(S: np.uint64, inmask: np.ndarray, n: int) -> np.int64:
 
 
 @njit(cache=True)
+def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, n: int, r: int) -> bool:
+    """True when a closed S1 ⊇ S and a nonempty closed S2 ⊆ Q cannot both fit,
+    disjoint, in W = core(V \\ X) ∪ core(V \\ S \\ B).
+
+    S1 holds S and, for each i ∈ S, ≥ |N(i) \\ S| − r + 1 more of i's in-neighbours:
+    |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺. A closed set holding j holds
+    ≥ d_j − r + 1 of j's in-neighbours: |S2| ≥ min_{j∈Q} max(1, d_j − r + 2).
+    """
+    extra = 0
+    need2 = n + 1
+    for i in range(n):
+        b = U1 << np.uint64(i)
+        if S & b:
+            m = popcount(inmask[i] & ~S) - r + 1
+            if m > extra:
+                extra = m
+        if Q & b:
+            m = popcount(inmask[i]) - r + 2
+            if m < need2:
+                need2 = m
+    if need2 < 1:
+        need2 = 1
+    return popcount(S) + extra + need2 > popcount(W)
+
+
+@njit(cache=True)
+def fewest_in_neighbours(cand: np.uint64, inmask: np.ndarray, n: int) -> np.int64:
+    """The node of ``cand`` with the fewest in-neighbours (the branching choice:
+    such nodes are the cheapest to keep closed, so witnesses surface early)."""
+    u = -1
+    best = n + 1
+    for j in range(n):
+        if cand & (U1 << np.uint64(j)):
+            v = popcount(inmask[j])
+            if v < best:
+                best = v
+                u = j
+    return u
+
+
+@njit(cache=True)
 def decide_step(
     inmask: np.ndarray,
     order: np.ndarray,
@@ -90,7 +125,8 @@ def decide_step(
     Root k fixes order[k] ∈ S1 as the first node of S1 ∪ S2 (B = order[:k] is
     outside both). A state (S, X) asks for a closed S1 ⊇ S avoiding X; S2 is
     implicit: it must lie in core(V \\ S \\ B). Leaves (certificates/FORMAT.md):
-    -1 when core(V \\ S \\ B) = ∅, -2 when S ⊄ core(V \\ X). Otherwise a member i
+    -1 when core(V \\ S \\ B) = ∅, -2 when S ⊄ core(V \\ X), -3 when the sizes
+    cannot fit (``size_bound``). Otherwise a member i
     of S with ≥ r outside in-neighbours needs one more of them inside: branch on
     u ∈ N(i) ∩ core(V \\ X) \\ S (include first, then exclude). A state without
     such a member is closed and, with S2 = core(V \\ S \\ B) ≠ ∅, a witness.
@@ -141,6 +177,12 @@ def decide_step(
             ntok += 1
             progress[0] += 0.5 ** depth / n
             continue
+        if size_bound(S, Q, P | Q, inmask, n, r):
+            if record:
+                tokens[ntok] = -3
+            ntok += 1
+            progress[0] += 0.5 ** depth / n
+            continue
         best_slack = n + 1
         best_cand = ZERO
         for i in range(n):
@@ -157,7 +199,7 @@ def decide_step(
             ubuf[UB_W2] = Q
             state[ST_STATUS] = SAT
             break
-        u = lowest_bit_index(best_cand)
+        u = fewest_in_neighbours(best_cand, inmask, n)
         if record:
             tokens[ntok] = u
         ntok += 1
@@ -173,3 +215,55 @@ def decide_step(
     state[ST_ROOT] = root
     state[ST_NTOK] = ntok
     state[ST_NODES] += done
+
+
+@njit(cache=True)
+def min_pair_cost(inmask: np.ndarray, r: int):
+    """Exact s*(r) by the O(n·2^n) subset DP (n ≤ 26 or so).
+
+    c(S) = |reach_r(S)|; a set is *open* when c(S) < |S| (some member closed).
+    h(U) = min over open S ⊆ U of c(S) (subset-min transform). Then
+    s*(r) = min over open S1 of c(S1) + h(V \\ S1), or n when no two disjoint open
+    sets exist. Returns (s*, S1, S2) with S1 = S2 = 0 when s* = n from exhaustion.
+    """
+    n = inmask.shape[0]
+    N = np.int64(1) << n
+    big = np.int8(127)
+    c = np.empty(N, dtype=np.int8)
+    h = np.empty(N, dtype=np.int8)
+    arg = np.empty(N, dtype=np.int64)
+    c[0] = 0
+    h[0] = big
+    arg[0] = 0
+    for S in range(1, N):
+        su = np.uint64(S)
+        cnt = 0
+        for i in range(n):
+            if su & (U1 << np.uint64(i)):
+                if popcount(inmask[i] & ~su) >= r:
+                    cnt += 1
+        c[S] = cnt
+        h[S] = big if cnt == popcount(su) else cnt
+        arg[S] = S
+    for b in range(n):
+        bit = np.int64(1) << b
+        for S in range(N):
+            if S & bit:
+                T = S ^ bit
+                if h[T] < h[S]:
+                    h[S] = h[T]
+                    arg[S] = arg[T]
+    full = N - 1
+    best = np.int64(n)
+    w1 = np.int64(0)
+    w2 = np.int64(0)
+    for S in range(1, N):
+        if c[S] < popcount(np.uint64(S)):  # S is open
+            rest = full ^ S
+            if h[rest] != big:
+                v = np.int64(c[S]) + np.int64(h[rest])
+                if v < best:
+                    best = v
+                    w1 = S
+                    w2 = arg[rest]
+    return best, w1, w2

@@ -22,7 +22,6 @@ from typing import Callable
 
 import numpy as np
 
-from . import _kernels as K
 from .indexed import IndexedGraph
 
 __all__ = ["MAX_SEARCH_NODES", "MAX_TREE_TOKENS", "SearchOutcome", "decide_r_robust", "search_order"]
@@ -85,6 +84,8 @@ def decide_r_robust(
     deadline : ``time.perf_counter()`` value after which the search stops.
     on_progress : called with the refuted share of the search space.
     """
+    from . import _kernels as K  # numba: imported on first use, not with rescon
+
     n = ig.n
     if n > MAX_SEARCH_NODES:
         raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")

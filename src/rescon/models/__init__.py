@@ -1,1 +1,1 @@
-"""rescon.models (under construction)."""
+"""Symbolic formulations (CVXPY / CasADi) and the solver backend registry."""

@@ -1,0 +1,50 @@
+"""rescon: resilient multi-agent consensus and distributed optimisation with certificates.
+
+Graph convention: a networkx DiGraph edge ``(u, v)`` means **v receives u's state**.
+Every answer that can be certified carries a JSON-ready certificate, checked by the
+standalone checker in ``certificates/`` (see :func:`check_certificate`).
+"""
+
+from __future__ import annotations
+
+from .certify import CheckResult, check_certificate
+from .errors import (
+    CertificateError,
+    GraphFormatError,
+    InputError,
+    RESCONError,
+    SolverError,
+    SolverNotFound,
+)
+from .graphs.attacks import check_assumption2, check_attack_model
+from .graphs.robustness import (
+    RobustnessCheck,
+    RobustnessReport,
+    is_r_robust,
+    is_rs_robust,
+    max_s,
+    robustness,
+)
+from .graphs.sarymsakov import is_sarymsakov
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "CertificateError",
+    "CheckResult",
+    "GraphFormatError",
+    "InputError",
+    "RESCONError",
+    "RobustnessCheck",
+    "RobustnessReport",
+    "SolverError",
+    "SolverNotFound",
+    "check_assumption2",
+    "check_attack_model",
+    "check_certificate",
+    "is_r_robust",
+    "is_rs_robust",
+    "is_sarymsakov",
+    "max_s",
+    "robustness",
+]

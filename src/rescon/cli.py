@@ -1,0 +1,165 @@
+"""``rescon`` command line: thin subcommands over the Python API.
+
+Every subcommand takes ``--json`` (one JSON object on stdout). Bad input exits 2
+with one line on stderr, never a traceback; ``rescon check`` exits 0 (valid),
+1 (invalid, reason on stderr) or 2 (unreadable).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any, Callable, Sequence
+
+from .errors import RESCONError
+
+__all__ = ["main"]
+
+
+def _pair_json(pair: Any) -> dict[str, list[Any]] | None:
+    if pair is None:
+        return None
+    S1, S2 = pair
+    return {"S1": sorted(S1, key=str), "S2": sorted(S2, key=str)}
+
+
+def _write_certificate(cert: dict[str, Any] | None, path: str | None) -> None:
+    if path is None:
+        return
+    if cert is None:
+        raise RESCONError("no certificate: the time limit stopped the search before an answer")
+    from .io import write_json
+
+    write_json(cert, path)
+
+
+def _emit(result: dict[str, Any], as_json: bool, lines: list[str]) -> None:
+    if as_json:
+        print(json.dumps(result))
+    else:
+        print("\n".join(lines))
+
+
+def _cmd_robustness(args: argparse.Namespace) -> int:
+    from .graphs.robustness import is_rs_robust, max_s, robustness
+    from .io import read_graph
+
+    G = read_graph(args.graph, undirected=args.undirected)
+    kw = {"time_limit": args.time_limit, "method": args.method}
+    if args.s is not None and args.r is None:
+        raise RESCONError("--s needs --r")
+    if args.r is None:
+        rep = robustness(G, **kw)
+        _write_certificate(rep.certificate, args.certificate)
+        out = {"n": rep.n, "r_max": rep.r_max, "s_max": rep.s_max, "exact": rep.exact,
+               "witness": _pair_json(rep.witness), "method": rep.method,
+               "seconds": round(rep.seconds, 6)}
+        if not rep.exact:
+            out.update(r_lower=rep.r_lower, r_upper=rep.r_upper)
+        lines = [f"n = {rep.n}"]
+        if rep.exact:
+            lines.append(f"rho(G) = {rep.r_max} (proof: {rep.lower_proof}); "
+                         f"s*({rep.r_max}) = {rep.s_max}")
+        else:
+            lines.append(f"time limit reached: {rep.r_lower} <= rho(G) <= {rep.r_upper}")
+        if rep.witness is not None:
+            lines.append(f"witness that G is not {rep.r_upper + 1}-robust: "
+                         f"S1 = {sorted(rep.witness[0], key=str)}, "
+                         f"S2 = {sorted(rep.witness[1], key=str)}")
+        lines.append(f"method: {rep.method}, {rep.seconds:.3f} s")
+        _emit(out, args.json, lines)
+        return 0
+    if args.s is None:
+        res = is_rs_robust(G, args.r, 1, **kw)
+        _write_certificate(res.certificate, args.certificate)
+        s_max = max_s(G, args.r, **kw) if res.holds else 0
+        out = {"r": args.r, "r_robust": res.holds, "s_max": s_max,
+               "witness": _pair_json(res.witness)}
+        verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
+        lines = [f"G {verdict} {args.r}-robust; s*({args.r}) = {s_max}"]
+    else:
+        res = is_rs_robust(G, args.r, args.s, **kw)
+        _write_certificate(res.certificate, args.certificate)
+        out = {"r": args.r, "s": args.s, "holds": res.holds, "witness": _pair_json(res.witness)}
+        verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
+        lines = [f"G {verdict} ({args.r}, {args.s})-robust"]
+    if res.witness is not None:
+        lines.append(f"witness: S1 = {sorted(res.witness[0], key=str)}, "
+                     f"S2 = {sorted(res.witness[1], key=str)}")
+    _emit(out, args.json, lines)
+    return 0
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from rescon_certificates.check import main as check_main
+
+    return check_main([args.certificate])
+
+
+def _nonneg_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a nonnegative integer, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a nonnegative integer, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text}")
+    return value
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"rescon: error: {message}\n")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="rescon", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    rob = sub.add_parser("robustness", help="rho(G), s*(r), (r,s)-robustness with certificates")
+    rob.add_argument("graph", help="edge list (u v: u->v), .graphml, .gml, .json, .csv")
+    rob.add_argument("--r", type=_nonneg_int, help="check r-robustness (and s*(r))")
+    rob.add_argument("--s", type=_nonneg_int, help="with --r: check (r,s)-robustness")
+    rob.add_argument("--undirected", action="store_true", help="treat edges as undirected")
+    rob.add_argument("--time-limit", type=_positive_float, metavar="SEC",
+                     help="stop and report proven bounds after SEC seconds")
+    rob.add_argument("--method", default="auto", choices=["auto", "search", "milp", "dp"],
+                     help="exact method when the bounds do not meet")
+    rob.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
+    rob.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    rob.set_defaults(func=_cmd_robustness)
+
+    chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
+    chk.add_argument("certificate", help="certificate JSON file")
+    chk.set_defaults(func=_cmd_check)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``rescon`` console script; returns the exit status."""
+    args = _parser().parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except (RESCONError, OSError) as exc:
+        print(f"rescon: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("rescon: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,309 @@
+"""Polynomial-time bounds on ρ(G) and s*(r), each with its proof object.
+
+Upper bounds are witness pairs (S1, S2): max(e(S1), e(S2)) = m shows G is not
+(m+1)-robust, where e(S) = max_{i∈S} |N(i) \\ S|. Lower bounds are proofs in the
+format of certificates/FORMAT.md:
+
+* ``degree``: min in-degree ≥ ⌊n/2⌋ + r − 1 ⇒ (r, s)-robust for every s;
+* ``complete``: K_n is (r, s)-robust for every s when n ≥ 2r − 1;
+* ``construction``: an ordering from a certified seed in which every later node has
+  ≥ r + s − 1 in-neighbours among the earlier ones (adding such a node preserves
+  (r, s)-robustness);
+* ``implied``: (r', s')-robust ⇒ (r, s)-robust when r' ≥ r and s' ≥ s, or when
+  r' ≥ r + s − 1 (for s' ≥ 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Iterable
+
+import networkx as nx
+import numpy as np
+
+from .indexed import IndexedGraph
+
+__all__ = [
+    "Pair",
+    "pair_value",
+    "pair_cost",
+    "violates",
+    "upper_witness",
+    "source_components_witness",
+    "degree_r",
+    "is_complete",
+    "construction_proof",
+    "greedy_cliques",
+    "greedy_order",
+    "s_candidates",
+    "closure_order",
+]
+
+Proof = dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Pair:
+    """A pair of disjoint nonempty node-index sets."""
+
+    S1: frozenset[int]
+    S2: frozenset[int]
+
+    def to_json(self) -> dict[str, list[int]]:
+        return {"S1": sorted(self.S1), "S2": sorted(self.S2)}
+
+
+def _outside(ig: IndexedGraph, S: frozenset[int]) -> list[int]:
+    return [len(ig.in_nbrs[i] - S) for i in S]
+
+
+def pair_value(ig: IndexedGraph, pair: Pair) -> int:
+    """max(e(S1), e(S2)): the pair shows G is not (value + 1)-robust."""
+    return max(max(_outside(ig, pair.S1)), max(_outside(ig, pair.S2)))
+
+
+def pair_cost(ig: IndexedGraph, pair: Pair, r: int) -> int | None:
+    """|reach_r(S1)| + |reach_r(S2)| when neither set is fully r-reachable, else None.
+
+    A pair with cost c violates (r, s) for every s > c, so s*(r) ≤ c.
+    """
+    total = 0
+    for S in (pair.S1, pair.S2):
+        reach = sum(1 for c in _outside(ig, S) if c >= r)
+        if reach == len(S):
+            return None
+        total += reach
+    return total
+
+
+def violates(ig: IndexedGraph, pair: Pair, r: int, s: int) -> bool:
+    """True when the pair violates (r, s)-robustness."""
+    cost = pair_cost(ig, pair, r)
+    return cost is not None and cost < s
+
+
+def source_components_witness(ig: IndexedGraph) -> Pair | None:
+    """Two source strongly connected components, if G has them (then ρ = 0).
+
+    G is 1-robust iff it has exactly one source SCC: a source SCC has no in-edge
+    from outside, so two of them form a pair of closed sets.
+    """
+    D = nx.DiGraph()
+    D.add_nodes_from(range(ig.n))
+    D.add_edges_from((u, v) for v, s in enumerate(ig.in_nbrs) for u in s)
+    C = nx.condensation(D)
+    sources = [c for c in C.nodes if C.in_degree(c) == 0]
+    if len(sources) < 2:
+        return None
+    members = C.graph["mapping"]
+    comp: dict[int, set[int]] = {}
+    for v, c in members.items():
+        comp.setdefault(c, set()).add(v)
+    return Pair(frozenset(comp[sources[0]]), frozenset(comp[sources[1]]))
+
+
+def _out_lists(ig: IndexedGraph) -> list[list[int]]:
+    out: list[list[int]] = [[] for _ in range(ig.n)]
+    for v, s in enumerate(ig.in_nbrs):
+        for u in s:
+            out[u].append(v)
+    return out
+
+
+def greedy_order(ig: IndexedGraph, start: int) -> list[int]:
+    """All nodes, from ``start``, each step absorbing the outside node with the most
+    in-neighbours already absorbed (ties: lowest index). Its prefixes are compact
+    sets (good witness candidates) and it is the natural construction order."""
+    n = ig.n
+    out = _out_lists(ig)
+    absorbed = np.zeros(n, dtype=bool)
+    cnt = np.zeros(n, dtype=np.int64)
+    order = []
+    u = start
+    for _ in range(n):
+        absorbed[u] = True
+        order.append(u)
+        cnt[out[u]] += 1
+        if len(order) < n:
+            u = int(np.where(absorbed, -1, cnt).argmax())
+    return order
+
+
+def _prefix_stats(ig: IndexedGraph, order: list[int], r: int | None):
+    """For each proper prefix S of ``order``: (size, e(S), e(V \\ S), cost_r) where
+    cost_r = |reach_r(S)| + |reach_r(V \\ S)| if both keep a closed member, else -1."""
+    n = ig.n
+    deg = np.array(ig.in_degrees, dtype=np.int64)
+    out = _out_lists(ig)
+    in_S = np.zeros(n, dtype=bool)
+    cnt = np.zeros(n, dtype=np.int64)  # |N(j) ∩ S|
+    for size, u in enumerate(order[:-1], start=1):
+        in_S[u] = True
+        cnt[out[u]] += 1
+        inside_out = (deg - cnt)[in_S]  # |N(i) \ S| for i in S
+        comp_out = cnt[~in_S]  # |N(j) ∩ S| = |N(j) \ (V \ S)| for j outside
+        cost = -1
+        if r is not None:
+            c1 = int((inside_out >= r).sum())
+            c2 = int((comp_out >= r).sum())
+            if c1 < size and c2 < n - size:
+                cost = c1 + c2
+        yield size, int(inside_out.max()), int(comp_out.max()), cost
+
+
+def _growth_pairs(ig: IndexedGraph, starts: Iterable[int]) -> Iterable[tuple[int, Pair]]:
+    """Best bipartition (S, V \\ S) along the greedy order of each start."""
+    full = frozenset(range(ig.n))
+    for v in starts:
+        order = greedy_order(ig, v)
+        value, size = min((max(e1, e2), size) for size, e1, e2, _ in _prefix_stats(ig, order, None))
+        S = frozenset(order[:size])
+        yield value, Pair(S, full - S)
+
+
+def s_candidates(ig: IndexedGraph, r: int, *, starts: int | None = None) -> list[Pair]:
+    """Pairs whose sets both keep an r-closed member, cheapest first (s*(r) ≤ cost):
+    bipartitions along greedy orders, and each low-degree node v with one
+    in-neighbour against the rest (v stays closed when d_v ≤ r)."""
+    n = ig.n
+    if starts is None:
+        starts = 12 if n <= 200 else 4
+    full = frozenset(range(n))
+    deg = ig.in_degrees
+    found: dict[Pair, int] = {}
+    by_degree = sorted(range(n), key=lambda i: (deg[i], i))
+    for v in by_degree[:starts]:
+        order = greedy_order(ig, v)
+        best = min(((cost, size) for size, _, _, cost in _prefix_stats(ig, order, r) if cost >= 0),
+                   default=None)
+        if best is not None:
+            S = frozenset(order[: best[1]])
+            found[Pair(S, full - S)] = best[0]
+        for u in sorted(ig.in_nbrs[v])[:4]:
+            S = frozenset((v, u))
+            pair = Pair(S, full - S)
+            cost = pair_cost(ig, pair, r)
+            if cost is not None:
+                found[pair] = cost
+    return sorted(found, key=lambda p: (found[p], len(p.S1)))
+
+
+def upper_witness(ig: IndexedGraph, *, starts: int | None = None) -> tuple[int, Pair]:
+    """The best witness pair found by cheap heuristics: (value, pair), ρ ≤ value.
+
+    Candidates: two source SCCs (value 0); the minimum in-degree node against the
+    rest; greedy growths from the lowest-degree nodes (``starts`` of them; default
+    24, or 6 when n > 200: each growth costs O(n²)).
+    """
+    n = ig.n
+    if starts is None:
+        starts = 24 if n <= 200 else 6
+    src = source_components_witness(ig)
+    if src is not None:
+        return 0, src
+    deg = ig.in_degrees
+    v = min(range(n), key=lambda i: (deg[i], i))
+    best_pair = Pair(frozenset([v]), frozenset(range(n)) - {v})
+    best = pair_value(ig, best_pair)
+    by_degree = sorted(range(n), key=lambda i: (deg[i], i))
+    for value, pair in _growth_pairs(ig, by_degree[:starts]):
+        if value < best:
+            best, best_pair = value, pair
+    return best, best_pair
+
+
+def degree_r(ig: IndexedGraph) -> int:
+    """Largest r that the degree bound proves: min in-degree − ⌊n/2⌋ + 1 (may be ≤ 0)."""
+    return min(ig.in_degrees) - ig.n // 2 + 1
+
+
+def is_complete(ig: IndexedGraph) -> bool:
+    return all(len(s) == ig.n - 1 for s in ig.in_nbrs)
+
+
+def greedy_cliques(ig: IndexedGraph, *, limit: int = 32) -> list[list[int]]:
+    """Cliques of the mutual graph (u → v and v → u), grown greedily from up to
+    ``limit`` high-degree nodes; largest first. Seeds for construction proofs."""
+    n = ig.n
+    masks = ig.in_masks()
+    out_masks = [0] * n
+    for v, s in enumerate(ig.in_nbrs):
+        for u in s:
+            out_masks[u] |= 1 << v
+    mutual = [masks[i] & out_masks[i] for i in range(n)]
+    starts = sorted(range(n), key=lambda i: -mutual[i].bit_count())[:limit]
+    seen = set()
+    cliques = []
+    for v in starts:
+        clique = [v]
+        cand = mutual[v]
+        while cand:
+            best_u, best_c = -1, -1
+            c = cand
+            while c:
+                low = c & -c
+                u = low.bit_length() - 1
+                c ^= low
+                k = (mutual[u] & cand).bit_count()
+                if k > best_c:
+                    best_u, best_c = u, k
+            clique.append(best_u)
+            cand &= mutual[best_u]
+        key = frozenset(clique)
+        if key not in seen:
+            seen.add(key)
+            cliques.append(sorted(clique))
+    cliques.sort(key=len, reverse=True)
+    return cliques
+
+
+def closure_order(ig: IndexedGraph, seed: list[int], threshold: int) -> list[int] | None:
+    """Order extending ``seed`` in which every later node has ≥ threshold in-neighbours
+    among the earlier ones, or None if some node can never be added. The closure is
+    unique (adding nodes only raises counts), so greedy is exact. O(|E|)."""
+    n = ig.n
+    out = _out_lists(ig)
+    placed = [False] * n
+    count = [0] * n
+    order = list(seed)
+    for v in seed:
+        placed[v] = True
+    for v in seed:
+        for w in out[v]:
+            count[w] += 1
+    ready = [w for w in range(n) if not placed[w] and count[w] >= threshold]
+    queued = set(ready)
+    while ready:
+        v = ready.pop()
+        placed[v] = True
+        order.append(v)
+        for w in out[v]:
+            count[w] += 1
+            if not placed[w] and w not in queued and count[w] >= threshold:
+                ready.append(w)
+                queued.add(w)
+    return order if len(order) == n else None
+
+
+def construction_proof(
+    ig: IndexedGraph, r: int, s: int, *, seeds: list[list[int]] | None = None
+) -> Proof | None:
+    """A ``construction`` proof of (r, s)-robustness from a complete seed, or None.
+
+    Tries each clique of size ≥ 2r − 1 (K_m with m ≥ 2r − 1 is (r, s)-robust for
+    every s) and closes it under "≥ r + s − 1 in-neighbours among earlier nodes".
+    """
+    if seeds is None:
+        seeds = greedy_cliques(ig)
+    for clique in seeds:
+        if len(clique) < 2 * r - 1:
+            break
+        order = closure_order(ig, clique, r + s - 1)
+        if order is not None:
+            return {
+                "method": "construction",
+                "order": order,
+                "seed_size": len(clique),
+                "seed_proof": {"method": "complete"},
+            }
+    return None

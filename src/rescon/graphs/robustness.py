@@ -1,0 +1,552 @@
+"""Public robustness API: ρ(G), s*(r), r- and (r, s)-robustness, with certificates.
+
+For S ⊆ V, reach_r(S) = {i ∈ S : |N(i) \\ S| ≥ r}. G is (r, s)-robust when every pair
+of disjoint nonempty S1, S2 has reach_r(S1) = S1, reach_r(S2) = S2 or
+|reach_r(S1)| + |reach_r(S2)| ≥ s; r-robust = (r, 1)-robust. ρ(G) = max r such
+that G is r-robust, s*(r) = max s such that G is (r, s)-robust (0 when G is not
+r-robust).
+
+Strategy: polynomial bounds first (witness pairs above; degree, complete and
+construction proofs below); only when they do not meet, an exact method: the
+bitmask branch and bound (n ≤ 64, its search tree is the certificate) or the
+improved MILP for ρ; the subset DP (n ≤ 26) or the MILP for s*.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Hashable
+
+import numpy as np
+
+from ..errors import InputError
+from . import bounds as bd
+from .indexed import IndexedGraph, index_graph
+from .milp import milp_min_cost
+from .search import MAX_SEARCH_NODES, decide_r_robust
+
+__all__ = [
+    "RobustnessReport",
+    "RobustnessCheck",
+    "robustness",
+    "is_r_robust",
+    "is_rs_robust",
+    "max_s",
+    "METHODS",
+]
+
+METHODS = ("auto", "search", "milp", "dp")
+DP_MAX_NODES = 26
+Proof = dict[str, Any]
+LabelPair = tuple[frozenset[Hashable], frozenset[Hashable]]
+
+
+@dataclass(frozen=True)
+class RobustnessReport:
+    """ρ(G) and s*(ρ) with their proofs.
+
+    Attributes
+    ----------
+    n : number of nodes.
+    r_max : ρ(G) when ``exact``; otherwise the proven lower bound ``r_lower``.
+    s_max : s*(r_max), or None when the time limit stopped before it was settled.
+    witness : (S1, S2) in node labels showing G is not (r_max + 1)-robust, or None
+        when r_max = ⌈n/2⌉ (no n-node graph is more robust).
+    s_witness : (S1, S2) showing G is not (r_max, s_max + 1)-robust, None if s_max = n.
+    lower_proof : how r_max was proven ("trivial", "degree", "complete",
+        "construction", "search", "milp", "dp").
+    certificate : JSON-ready ``robustness`` certificate (certificates/FORMAT.md).
+    exact : False only when ``time_limit`` cut the search; then ρ ∈ [r_lower, r_upper].
+    method : the exact method that ran ("bounds" when the bounds met).
+    seconds : wall time.
+    """
+
+    n: int
+    r_max: int
+    s_max: int | None
+    witness: LabelPair | None
+    s_witness: LabelPair | None
+    lower_proof: str
+    certificate: dict[str, Any] = field(repr=False)
+    exact: bool
+    r_lower: int
+    r_upper: int
+    method: str
+    seconds: float
+
+
+@dataclass(frozen=True)
+class RobustnessCheck:
+    """Answer to "is G (r, s)-robust?": ``holds`` with a ``witness`` pair (labels) when
+    it does not, the proof method when it does, and the certificate either way.
+    ``holds`` is None only when the time limit stopped the search."""
+
+    r: int
+    s: int
+    holds: bool | None
+    witness: LabelPair | None
+    proof_method: str | None
+    certificate: dict[str, Any] | None = field(repr=False)
+    method: str
+    seconds: float
+
+
+# --------------------------------------------------------------------------- #
+# input validation
+# --------------------------------------------------------------------------- #
+
+
+def _int_arg(name: str, value: Any, low: int, high: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InputError(f"{name} must be an integer; got {value!r}")
+    value = int(value)
+    if value < low or (high is not None and value > high):
+        upper = f" and ≤ {high}" if high is not None else ""
+        raise InputError(f"{name} must be ≥ {low}{upper}; got {value}")
+    return value
+
+
+def _check_options(method: str, time_limit: float | None) -> float | None:
+    if method not in METHODS:
+        raise InputError(f"method must be one of {METHODS}; got {method!r}")
+    if time_limit is None:
+        return None
+    if isinstance(time_limit, bool) or not isinstance(time_limit, (int, float)) or not (
+        time_limit > 0 and np.isfinite(time_limit)
+    ):
+        raise InputError(f"time_limit must be a positive number of seconds; got {time_limit!r}")
+    return time.perf_counter() + float(time_limit)
+
+
+def _remaining(deadline: float | None) -> float | None:
+    return None if deadline is None else max(deadline - time.perf_counter(), 0.0)
+
+
+# --------------------------------------------------------------------------- #
+# deciding r-robustness
+# --------------------------------------------------------------------------- #
+
+
+@dataclass(frozen=True)
+class _Decision:
+    holds: bool | None
+    proof: Proof | None = None
+    pair: bd.Pair | None = None
+    method: str = "bounds"
+
+
+def _half_pair(ig: IndexedGraph) -> bd.Pair:
+    half = frozenset(range(ig.n // 2))
+    return bd.Pair(half, frozenset(range(ig.n)) - half)
+
+
+def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]]) -> Proof | None:
+    """A proof of (r, s)-robustness from the bounds, if one gives it: trivial, degree,
+    complete, construction from a clique, or (s = 1) construction from a small seed
+    proven r-robust by the search."""
+    if r <= 0:
+        return {"method": "trivial"}
+    if bd.degree_r(ig) >= r:
+        return {"method": "degree"}
+    if bd.is_complete(ig):
+        return {"method": "complete"} if ig.n >= 2 * r - 1 else None
+    proof = bd.construction_proof(ig, r, s, seeds=seeds)
+    if proof is None and s == 1:
+        proof = _searched_seed_construction(ig, r)
+    return proof
+
+
+SEED_SIZES = (2, 3, 4)  # seed sizes tried, in units of r (capped at the search's limit)
+SEED_SEARCH_SECONDS = 1.0
+
+
+def _searched_seed_construction(ig: IndexedGraph, r: int) -> Proof | None:
+    """A construction whose seed (a prefix of a greedy order from the highest-degree
+    node) is proven r-robust by a short search: e.g. circulants, whose seeds are
+    path powers rather than cliques."""
+    start = max(range(ig.n), key=lambda i: (ig.in_degrees[i], -i))
+    order = bd.greedy_order(ig, start)
+    for m in sorted({min(k * r, MAX_SEARCH_NODES, ig.n) for k in SEED_SIZES}):
+        closure = bd.closure_order(ig, order[:m], r)
+        if closure is None or m < 2:
+            continue
+        out = decide_r_robust(ig.induced(order[:m]), r,
+                              deadline=time.perf_counter() + SEED_SEARCH_SECONDS)
+        if out.status == "robust" and out.tree is not None:
+            return {"method": "construction", "order": closure, "seed_size": m,
+                    "seed_proof": {"method": "search", "order": list(out.order),
+                                   "tree": list(out.tree)}}
+    return None
+
+
+def _decide_r(
+    ig: IndexedGraph,
+    r: int,
+    method: str,
+    deadline: float | None,
+    seeds: list[list[int]],
+    known_pair: tuple[int, bd.Pair] | None = None,
+    on_progress: Callable[[float], None] | None = None,
+) -> _Decision:
+    """Is ig r-robust? Bounds first, then the exact ``method``."""
+    if r > (ig.n + 1) // 2:
+        return _Decision(False, pair=_half_pair(ig))
+    proof = _cheap_proof(ig, r, 1, seeds)
+    if proof is not None:
+        return _Decision(True, proof=proof)
+    value, pair = known_pair if known_pair is not None else bd.upper_witness(ig)
+    if value < r:
+        return _Decision(False, pair=pair)
+    if method == "auto":
+        method = "search" if ig.n <= MAX_SEARCH_NODES else "milp"
+    if method == "search":
+        out = decide_r_robust(ig, r, deadline=deadline, on_progress=on_progress)
+        if out.status == "stopped":
+            return _Decision(None, method="search")
+        if out.status == "not_robust":
+            assert out.witness is not None
+            return _Decision(False, pair=bd.Pair(*out.witness), method="search")
+        tree = list(out.tree) if out.tree is not None else None
+        return _Decision(True, proof={"method": "search", "order": list(out.order), "tree": tree,
+                                      "info": {"nodes": out.nodes}}, method="search")
+    if method == "dp":
+        cost, pair = _dp_min_cost(ig, r)
+        if cost >= 1:
+            return _Decision(True, proof={"method": "dp"}, method="dp")
+        assert pair is not None
+        return _Decision(False, pair=pair, method="dp")
+    out = milp_min_cost(ig, r, upper=1, decision_only=True, time_limit=_remaining(deadline))
+    if out.status == "infeasible":
+        return _Decision(True, proof={"method": "milp", "solver": "highs",
+                                      "info": {"seconds": round(out.seconds, 3)}}, method="milp")
+    if out.pair is None:
+        return _Decision(None, method="milp")
+    return _Decision(False, pair=bd.Pair(*out.pair), method="milp")
+
+
+def _dp_min_cost(ig: IndexedGraph, r: int) -> tuple[int, bd.Pair | None]:
+    if ig.n > DP_MAX_NODES + 2:
+        raise InputError(f"method 'dp' handles n ≤ {DP_MAX_NODES + 2}; got n = {ig.n}")
+    from ._kernels import min_pair_cost  # numba: imported on first use
+
+    inmask = np.array(ig.in_masks(), dtype=np.uint64)
+    best, w1, w2 = min_pair_cost(inmask, r)
+    if w1 == 0:
+        return int(best), None
+    to_set = lambda m: frozenset(i for i in range(ig.n) if (int(m) >> i) & 1)  # noqa: E731
+    return int(best), bd.Pair(to_set(w1), to_set(w2))
+
+
+# --------------------------------------------------------------------------- #
+# s*(r)
+# --------------------------------------------------------------------------- #
+
+
+@dataclass(frozen=True)
+class _SStar:
+    value: int | None  # None: not settled before the deadline
+    lower: int
+    upper: int
+    proof: Proof | None  # proves (r, lower)-robust
+    pair: bd.Pair | None  # violates (r, upper + 1), None when upper = n
+    method: str
+
+
+def _s_star(
+    ig: IndexedGraph,
+    r: int,
+    method: str,
+    deadline: float | None,
+    seeds: list[list[int]],
+    r_proof: Proof,
+    candidates: list[bd.Pair],
+) -> _SStar:
+    """s*(r) for an r-robust graph (r ≥ 1), ``r_proof`` proving (r, 1)-robustness."""
+    n = ig.n
+    all_s = _cheap_proof(ig, r, n, seeds)
+    if all_s is not None:
+        return _SStar(n, n, n, all_s, None, "bounds")
+    # upper: the cheapest candidate pair whose sets both keep a closed member
+    upper, pair = n, None
+    for cand in candidates + bd.s_candidates(ig, r):
+        cost = bd.pair_cost(ig, cand, r)
+        if cost is not None and cost < upper:
+            upper, pair = cost, cand
+    # lower: the r-robustness proof itself (s = 1), or a construction with r + s − 1
+    lower, proof = 1, r_proof
+    for s in range(upper, 1, -1):
+        con = bd.construction_proof(ig, r, s, seeds=seeds)
+        if con is not None:
+            lower, proof = s, con
+            break
+    if lower >= upper:
+        return _SStar(upper, upper, upper, proof, pair, "bounds")
+    if method == "auto":
+        method = "dp" if n <= DP_MAX_NODES else "milp"
+    if method == "dp":
+        cost, dp_pair = _dp_min_cost(ig, r)
+        if dp_pair is None:
+            return _SStar(n, n, n, {"method": "dp"}, None, "dp")
+        return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
+    while lower < upper:
+        out = milp_min_cost(ig, r, lower=lower, upper=upper, time_limit=_remaining(deadline))
+        if out.status == "infeasible":
+            proof = {"method": "milp", "solver": "highs",
+                     "info": {"seconds": round(out.seconds, 3)}}
+            return _SStar(upper, upper, upper, proof, pair, "milp")
+        if out.pair is None:
+            return _SStar(None, lower, upper, proof, pair, "milp")
+        found = bd.Pair(*out.pair)
+        cost = bd.pair_cost(ig, found, r)
+        assert cost is not None and cost < upper, "MILP solution is not a cheaper pair"
+        upper, pair = cost, found
+        if out.status == "optimal":
+            proof = {"method": "milp", "solver": "highs",
+                     "info": {"seconds": round(out.seconds, 3)}}
+            return _SStar(upper, upper, upper, proof, pair, "milp")
+    return _SStar(upper, upper, upper, proof, pair, "milp")
+
+
+# --------------------------------------------------------------------------- #
+# public API
+# --------------------------------------------------------------------------- #
+
+
+def _labels(ig: IndexedGraph, pair: bd.Pair | None) -> LabelPair | None:
+    if pair is None:
+        return None
+    return frozenset(ig.nodes[i] for i in pair.S1), frozenset(ig.nodes[i] for i in pair.S2)
+
+
+def _head(kind: str, ig: IndexedGraph) -> dict[str, Any]:
+    return {"rescon_certificate": 1, "kind": kind, "graph": ig.graph_json()}
+
+
+def _upper_json(pair: bd.Pair | None) -> dict[str, Any]:
+    if pair is None:
+        return {"method": "half"}
+    return {"method": "witness", **pair.to_json()}
+
+
+def robustness(
+    G: Any,
+    *,
+    method: str = "auto",
+    time_limit: float | None = None,
+    undirected: bool | None = None,
+    progress: bool | None = None,
+) -> RobustnessReport:
+    """ρ(G) and s*(ρ(G)), exactly, with a certificate.
+
+    Parameters
+    ----------
+    G : networkx.Graph or DiGraph; edge (u, v) means v receives u's state.
+    method : "auto" (bounds, then search for n ≤ 64 else MILP; s* by DP for n ≤ 26
+        else MILP), or force "search", "milp" or "dp" for the exact steps.
+    time_limit : seconds; when reached, returns proven bounds with ``exact=False``.
+    undirected : treat the edges of a DiGraph as undirected.
+    progress : show a progress bar (default: when stderr is a terminal).
+
+    Returns
+    -------
+    RobustnessReport
+
+    Notes
+    -----
+    Deciding r-robustness is coNP-complete; the bounds settle most structured
+    graphs in O(n·|E|) and the exact methods are exponential in the worst case.
+
+    Examples
+    --------
+    >>> import networkx as nx, rescon
+    >>> rep = rescon.robustness(nx.complete_graph(6))
+    >>> rep.r_max, rep.s_max, rep.lower_proof
+    (3, 6, 'complete')
+    """
+    t0 = time.perf_counter()
+    deadline = _check_options(method, time_limit)
+    ig = index_graph(G, undirected=undirected)
+    n = ig.n
+    seeds = bd.greedy_cliques(ig)
+    up_value, up_pair = bd.upper_witness(ig)
+    half = (n + 1) // 2
+    r_upper, r_upper_pair = (half, None) if up_value >= half else (up_value, up_pair)
+    # lower bound: the best cheap proof at or below r_upper
+    r_lower, lower = 0, {"method": "trivial"}
+    for r in range(r_upper, 0, -1):
+        proof = _cheap_proof(ig, r, 1, seeds)
+        if proof is not None:
+            r_lower, lower = r, proof
+            break
+    used = "bounds"
+    bar = _progress_bar(progress, n)
+    candidates = [up_pair]
+    while r_lower < r_upper:
+        dec = _decide_r(ig, r_upper, method, deadline, seeds,
+                        known_pair=(up_value, up_pair), on_progress=bar)
+        used = dec.method
+        if dec.holds is None:
+            break
+        if dec.holds:
+            assert dec.proof is not None
+            r_lower, lower = r_upper, dec.proof
+        else:
+            assert dec.pair is not None
+            candidates.append(dec.pair)
+            r_upper_pair = dec.pair
+            r_upper = bd.pair_value(ig, dec.pair)
+            up_value, up_pair = r_upper, dec.pair
+    if bar is not None:
+        bar(None)
+    exact = r_lower == r_upper
+    if not exact:
+        cert = {**_head("robustness", ig), "exact": False, "r_lower": r_lower,
+                "r_upper": r_upper, "lower": lower, "upper_r": _upper_json(r_upper_pair)}
+        return RobustnessReport(n, r_lower, None, _labels(ig, r_upper_pair), None,
+                                lower["method"], cert, False, r_lower, r_upper, used,
+                                time.perf_counter() - t0)
+    rho = r_lower
+    if rho == 0:
+        ss = _SStar(n, n, n, {"method": "trivial"}, None, "bounds")
+    else:
+        ss = _s_star(ig, rho, method, deadline, seeds, lower, candidates)
+    if ss.value is None:
+        cert = {**_head("robustness", ig), "exact": False, "r_lower": rho, "r_upper": rho,
+                "lower": lower, "upper_r": _upper_json(r_upper_pair)}
+        return RobustnessReport(n, rho, None, _labels(ig, r_upper_pair), None,
+                                lower["method"], cert, False, rho, rho, used,
+                                time.perf_counter() - t0)
+    if ss.method != "bounds":
+        used = ss.method if used == "bounds" else f"{used}+{ss.method}"
+    cert = {**_head("robustness", ig), "exact": True, "r_max": rho, "s_max": ss.value,
+            "lower": lower, "lower_s": None if ss.value == 1 else ss.proof,
+            "upper_r": _upper_json(r_upper_pair),
+            "upper_s": None if ss.value == n else _upper_json(ss.pair)}
+    return RobustnessReport(n, rho, ss.value, _labels(ig, r_upper_pair), _labels(ig, ss.pair),
+                            lower["method"], cert, True, rho, rho, used,
+                            time.perf_counter() - t0)
+
+
+def is_rs_robust(
+    G: Any,
+    r: int,
+    s: int,
+    *,
+    method: str = "auto",
+    time_limit: float | None = None,
+    undirected: bool | None = None,
+) -> RobustnessCheck:
+    """Is G (r, s)-robust? With a witness pair when not, a proof when it is.
+
+    Parameters
+    ----------
+    r : int ≥ 0.  s : int, 1 ≤ s ≤ n.
+
+    Raises
+    ------
+    InputError
+        For r < 0, s < 1, s > n, non-integer r or s, fewer than 2 nodes.
+    """
+    t0 = time.perf_counter()
+    deadline = _check_options(method, time_limit)
+    ig = index_graph(G, undirected=undirected)
+    r = _int_arg("r", r, 0)
+    s = _int_arg("s", s, 1, ig.n)
+    seeds = bd.greedy_cliques(ig)
+    dec = _decide_r(ig, r, method, deadline, seeds)
+    if dec.holds and s > 1:
+        if r == 0:
+            dec = _Decision(True, proof={"method": "trivial"})
+        else:
+            up_value, up_pair = bd.upper_witness(ig)
+            cands = [up_pair]
+            ss = _s_star(ig, r, method, deadline, seeds, dec.proof or {"method": "trivial"}, cands)
+            if ss.value is None and ss.lower < s <= ss.upper:
+                dec = _Decision(None, method=ss.method)
+            elif ss.lower >= s:
+                proof = ss.proof if ss.lower == s else {
+                    "method": "implied", "r": r, "s": ss.lower, "proof": ss.proof}
+                dec = _Decision(True, proof=proof, method=ss.method)
+            else:
+                dec = _Decision(False, pair=ss.pair, method=ss.method)
+    return _check_result(ig, r, s, dec, time.perf_counter() - t0)
+
+
+def _check_result(ig: IndexedGraph, r: int, s: int, dec: _Decision, seconds: float) -> RobustnessCheck:
+    if dec.holds is None:
+        return RobustnessCheck(r, s, None, None, None, None, dec.method, seconds)
+    if dec.holds:
+        assert dec.proof is not None
+        cert = {**_head("rs_robust", ig), "r": r, "s": s, "proof": dec.proof}
+        return RobustnessCheck(r, s, True, None, dec.proof["method"], cert, dec.method, seconds)
+    assert dec.pair is not None
+    cert = {**_head("not_rs_robust", ig), "r": r, "s": s, "witness": dec.pair.to_json()}
+    return RobustnessCheck(r, s, False, _labels(ig, dec.pair), None, cert, dec.method, seconds)
+
+
+def is_r_robust(
+    G: Any,
+    r: int,
+    *,
+    method: str = "auto",
+    time_limit: float | None = None,
+    undirected: bool | None = None,
+) -> RobustnessCheck:
+    """Is G r-robust (= (r, 1)-robust)? See :func:`is_rs_robust`."""
+    return is_rs_robust(G, r, 1, method=method, time_limit=time_limit, undirected=undirected)
+
+
+def max_s(
+    G: Any,
+    r: int,
+    *,
+    method: str = "auto",
+    time_limit: float | None = None,
+    undirected: bool | None = None,
+) -> int:
+    """s*(r) = max s such that G is (r, s)-robust; 0 when G is not r-robust.
+
+    Raises
+    ------
+    InputError
+        Bad r, or the time limit stopped the search before s*(r) was settled.
+    """
+    deadline = _check_options(method, time_limit)
+    ig = index_graph(G, undirected=undirected)
+    r = _int_arg("r", r, 0)
+    if r == 0:
+        return ig.n
+    seeds = bd.greedy_cliques(ig)
+    dec = _decide_r(ig, r, method, deadline, seeds)
+    if dec.holds is None:
+        raise InputError(f"time limit reached before deciding whether G is {r}-robust")
+    if not dec.holds:
+        return 0
+    _, up_pair = bd.upper_witness(ig)
+    ss = _s_star(ig, r, method, deadline, seeds, dec.proof or {"method": "trivial"}, [up_pair])
+    if ss.value is None:
+        raise InputError(f"time limit reached: {ss.lower} ≤ s*({r}) ≤ {ss.upper}")
+    return ss.value
+
+
+def _progress_bar(enabled: bool | None, n: int) -> Callable[[float | None], None] | None:
+    """A tqdm bar over the refuted share of the search space (TTY only by default)."""
+    import sys
+
+    if enabled is None:
+        enabled = sys.stderr.isatty()
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    bar = tqdm(total=1000, desc=f"robustness search (n={n})", leave=False, unit="‰")
+
+    def update(fraction: float | None) -> None:
+        if fraction is None:
+            bar.close()
+            return
+        bar.n = min(int(fraction * 1000), 1000)
+        bar.refresh()
+
+    return update

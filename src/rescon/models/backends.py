@@ -1,0 +1,79 @@
+"""One registry of solver backends: name → capabilities, availability, install hint.
+
+Availability is checked with :func:`importlib.util.find_spec`, so listing backends
+never imports a heavy module. There is no silent fallback: asking for a backend
+that is unknown, missing or lacks a capability raises :class:`SolverNotFound`
+naming the backends that would do.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+
+from ..errors import SolverNotFound
+
+__all__ = ["Backend", "BACKENDS", "STATUSES", "available_backends", "require_backend"]
+
+#: The shared status set every backend's native statuses map onto.
+STATUSES = ("optimal", "infeasible", "time_limit", "error")
+
+
+@dataclass(frozen=True)
+class Backend:
+    """A solver backend: ``module`` is what must be importable."""
+
+    name: str
+    module: str
+    capabilities: frozenset[str]
+    install: str
+
+    def is_available(self) -> bool:
+        return importlib.util.find_spec(self.module) is not None
+
+
+BACKENDS: dict[str, Backend] = {
+    b.name: b
+    for b in (
+        Backend("highs", "highspy", frozenset({"LP", "MILP"}), "pip install highspy"),
+        Backend("clarabel", "clarabel", frozenset({"LP", "QP", "SOCP"}), "pip install clarabel"),
+        Backend("proxsuite", "proxsuite", frozenset({"QP", "batch"}), "pip install proxsuite"),
+        Backend("cvxpy", "cvxpy", frozenset({"LP", "QP", "SOCP", "model"}), "pip install cvxpy"),
+        Backend("casadi", "casadi", frozenset({"LP", "QP", "model"}), "pip install casadi"),
+    )
+}
+
+
+def available_backends(capability: str | None = None) -> list[str]:
+    """Names of the installed backends (with ``capability``, if given)."""
+    return [
+        name
+        for name, b in BACKENDS.items()
+        if (capability is None or capability in b.capabilities) and b.is_available()
+    ]
+
+
+def require_backend(name: str, capability: str) -> Backend:
+    """The backend ``name`` if it is known, installed and has ``capability``.
+
+    Raises
+    ------
+    SolverNotFound
+        Naming the installed backends with that capability and how to install ``name``.
+    """
+    ok = available_backends(capability)
+    b = BACKENDS.get(name)
+    if b is None:
+        raise SolverNotFound(
+            f"unknown backend {name!r}; backends with {capability}: {ok or 'none installed'}"
+        )
+    if capability not in b.capabilities:
+        raise SolverNotFound(
+            f"backend {name!r} cannot solve {capability}; use one of {ok or 'none installed'}"
+        )
+    if not b.is_available():
+        raise SolverNotFound(
+            f"backend {name!r} is not installed ({b.install}); available for {capability}: "
+            f"{ok or 'none'}"
+        )
+    return b
