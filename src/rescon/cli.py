@@ -17,11 +17,17 @@ from .errors import RESCONError
 __all__ = ["main"]
 
 
+def _sorted(labels: Any) -> list[Any]:
+    """Node labels in natural order: numbers first by value, then the rest by text."""
+    return sorted(labels, key=lambda v: (0, v, "") if isinstance(v, (int, float)) and
+                  not isinstance(v, bool) else (1, 0, str(v)))
+
+
 def _pair_json(pair: Any) -> dict[str, list[Any]] | None:
     if pair is None:
         return None
     S1, S2 = pair
-    return {"S1": sorted(S1, key=str), "S2": sorted(S2, key=str)}
+    return {"S1": _sorted(S1), "S2": _sorted(S2)}
 
 
 def _write_certificate(cert: dict[str, Any] | None, path: str | None) -> None:
@@ -29,9 +35,12 @@ def _write_certificate(cert: dict[str, Any] | None, path: str | None) -> None:
         return
     if cert is None:
         raise RESCONError("no certificate: the time limit stopped the search before an answer")
-    from .io import write_json
+    from pathlib import Path
 
-    write_json(cert, path)
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    # compact: a search-tree proof can hold millions of tokens
+    target.write_text(json.dumps(cert, separators=(",", ":")) + "\n", encoding="utf-8")
 
 
 def _emit(result: dict[str, Any], as_json: bool, lines: list[str]) -> None:
@@ -65,8 +74,8 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
             lines.append(f"time limit reached: {rep.r_lower} <= rho(G) <= {rep.r_upper}")
         if rep.witness is not None:
             lines.append(f"witness that G is not {rep.r_upper + 1}-robust: "
-                         f"S1 = {sorted(rep.witness[0], key=str)}, "
-                         f"S2 = {sorted(rep.witness[1], key=str)}")
+                         f"S1 = {_sorted(rep.witness[0])}, "
+                         f"S2 = {_sorted(rep.witness[1])}")
         lines.append(f"method: {rep.method}, {rep.seconds:.3f} s")
         _emit(out, args.json, lines)
         return 0
@@ -85,8 +94,8 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
         lines = [f"G {verdict} ({args.r}, {args.s})-robust"]
     if res.witness is not None:
-        lines.append(f"witness: S1 = {sorted(res.witness[0], key=str)}, "
-                     f"S2 = {sorted(res.witness[1], key=str)}")
+        lines.append(f"witness: S1 = {_sorted(res.witness[0])}, "
+                     f"S2 = {_sorted(res.witness[1])}")
     _emit(out, args.json, lines)
     return 0
 
