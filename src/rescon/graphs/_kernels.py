@@ -33,8 +33,14 @@ def popcount(x: np.uint64) -> np.int64:
     return np.int64((x * np.uint64(0x0101010101010101)) >> np.uint64(56))
 
 
-@njit(cache=True)
-def core(U: np.uint64, inmask: np.ndarray, n: int, r: int) -> np.uint64:
+@njit(cache=True, inline="always")
+def low_index(x: np.uint64) -> np.int64:
+    """Index of the lowest set bit of a nonzero uint64."""
+    return popcount((x & (~x + U1)) - U1)
+
+
+@njit(cache=True, nogil=True)
+def core(U: np.uint64, inmask: np.ndarray, r: int) -> np.uint64:
     """Largest r-closed subset of U: peel every i ∈ U with |N(i) \\ U| ≥ r.
 
     Closed sets (no member has r in-neighbours outside) are closed under union,
@@ -43,28 +49,41 @@ def core(U: np.uint64, inmask: np.ndarray, n: int, r: int) -> np.uint64:
     changed = True
     while changed:
         changed = False
-        for i in range(n):
+        m = U
+        while m:
+            i = low_index(m)
             b = U1 << np.uint64(i)
-            if U & b and popcount(inmask[i] & ~U) >= r:
+            m &= ~b
+            if popcount(inmask[i] & ~U) >= r:
                 U &= ~b
                 changed = True
     return U
 
 
-@njit(cache=True)
-def max_outside(S: np.uint64, inmask: np.ndarray, n: int) -> np.int64:
-    """e(S) = max over i ∈ S of |N(i) \\ S| (0 for the empty set)."""
-    best = 0
-    for i in range(n):
-        if S & (U1 << np.uint64(i)):
-            c = popcount(inmask[i] & ~S)
-            if c > best:
-                best = c
-    return best
+@njit(cache=True, nogil=True)
+def core_after_removal(U: np.uint64, removed: np.uint64, inmask: np.ndarray,
+                       outmask: np.ndarray, r: int) -> np.uint64:
+    """core(U) when U is a closed set minus ``removed``: only out-neighbours of
+    removed nodes can have gained outside in-neighbours, so peel from a worklist."""
+    work = ZERO
+    m = removed
+    while m:
+        u = low_index(m)
+        m &= ~(U1 << np.uint64(u))
+        work |= outmask[u]
+    work &= U
+    while work:
+        i = low_index(work)
+        b = U1 << np.uint64(i)
+        work &= ~b
+        if popcount(inmask[i] & ~U) >= r:
+            U &= ~b
+            work |= outmask[i] & U
+    return U
 
 
-@njit(cache=True)
-def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, n: int, r: int) -> bool:
+@njit(cache=True, nogil=True)
+def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, r: int) -> bool:
     """True when a closed S1 ⊇ S and a nonempty closed S2 ⊆ Q cannot both fit,
     disjoint, in W = core(V \\ X) ∪ core(V \\ S \\ B).
 
@@ -73,44 +92,55 @@ def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, n: 
     ≥ d_j − r + 1 of j's in-neighbours: |S2| ≥ min_{j∈Q} max(1, d_j − r + 2).
     """
     extra = 0
-    need2 = n + 1
-    for i in range(n):
-        b = U1 << np.uint64(i)
-        if S & b:
-            m = popcount(inmask[i] & ~S) - r + 1
-            if m > extra:
-                extra = m
-        if Q & b:
-            m = popcount(inmask[i]) - r + 2
-            if m < need2:
-                need2 = m
+    m = S
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        e = popcount(inmask[i] & ~S) - r + 1
+        if e > extra:
+            extra = e
+    need2 = 1 << 30
+    m = Q
+    while m:
+        j = low_index(m)
+        m &= ~(U1 << np.uint64(j))
+        e = popcount(inmask[j]) - r + 2
+        if e < need2:
+            need2 = e
     if need2 < 1:
         need2 = 1
     return popcount(S) + extra + need2 > popcount(W)
 
 
-@njit(cache=True)
-def fewest_in_neighbours(cand: np.uint64, inmask: np.ndarray, n: int) -> np.int64:
-    """The node of ``cand`` with the fewest in-neighbours (the branching choice:
-    such nodes are the cheapest to keep closed, so witnesses surface early)."""
+@njit(cache=True, nogil=True)
+def branch_node(cand: np.uint64, Q: np.uint64, inmask: np.ndarray, outmask: np.ndarray) -> np.int64:
+    """The candidate that, put into S1, takes an in-neighbour from the most nodes of
+    Q (so S2's room shrinks fastest); ties: fewest in-neighbours."""
     u = -1
-    best = n + 1
-    for j in range(n):
-        if cand & (U1 << np.uint64(j)):
-            v = popcount(inmask[j])
-            if v < best:
-                best = v
-                u = j
+    best = np.int64(-(1 << 40))
+    m = cand
+    while m:
+        j = low_index(m)
+        m &= ~(U1 << np.uint64(j))
+        v = popcount(outmask[j] & Q) * 128 - popcount(inmask[j])
+        if v > best:
+            best = v
+            u = j
     return u
 
 
-@njit(cache=True)
+# rows of the search stack
+SK_S, SK_X, SK_P, SK_Q, SK_DP, SK_DQ = 0, 1, 2, 3, 4, 5
+STACK_WIDTH = 6
+
+
+@njit(cache=True, nogil=True)
 def decide_step(
     inmask: np.ndarray,
+    outmask: np.ndarray,
     order: np.ndarray,
     r: int,
-    stack_S: np.ndarray,
-    stack_X: np.ndarray,
+    stack: np.ndarray,
     stack_depth: np.ndarray,
     state: np.ndarray,
     ubuf: np.ndarray,
@@ -119,20 +149,23 @@ def decide_step(
     max_nodes: int,
     progress: np.ndarray,
 ) -> None:
-    """Advance the branch-and-bound for "is there a pair of disjoint closed sets?".
+    """Advance the branch-and-bound for "are there two disjoint closed sets?".
 
     G is **not** r-robust iff there are disjoint nonempty S1, S2, both r-closed.
     Root k fixes order[k] ∈ S1 as the first node of S1 ∪ S2 (B = order[:k] is
     outside both). A state (S, X) asks for a closed S1 ⊇ S avoiding X; S2 is
-    implicit: it must lie in core(V \\ S \\ B). Leaves (certificates/FORMAT.md):
-    -1 when core(V \\ S \\ B) = ∅, -2 when S ⊄ core(V \\ X), -3 when the sizes
-    cannot fit (``size_bound``). Otherwise a member i
-    of S with ≥ r outside in-neighbours needs one more of them inside: branch on
-    u ∈ N(i) ∩ core(V \\ X) \\ S (include first, then exclude). A state without
-    such a member is closed and, with S2 = core(V \\ S \\ B) ≠ ∅, a witness.
+    implicit: it must lie in Q = core(V \\ S \\ B), and S1 in P = core(V \\ X).
+    Leaves (certificates/FORMAT.md): -1 when Q = ∅, -2 when S ⊄ P, -3 when the
+    sizes cannot fit (``size_bound``). Otherwise a member i of S with ≥ r outside
+    in-neighbours needs one more of them inside: take the member with the least
+    slack and branch on one of its candidates u ∈ N(i) ∩ P \\ S (``branch_node``),
+    include first, then exclude. A state without such a member is closed and,
+    with S2 = Q ≠ ∅, a witness.
 
-    Runs until ``max_nodes`` states were expanded, the token buffer is full
-    (status NEED_ROOM), or the search ends (SAT / UNSAT).
+    P and Q are maintained incrementally: a child differs from its parent by one
+    node removed from Q (include) or from P (exclude). Runs until ``max_nodes``
+    states were expanded, the token buffer is full (status NEED_ROOM), or the
+    search ends (SAT / UNSAT).
     """
     n = inmask.shape[0]
     full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
@@ -152,63 +185,78 @@ def decide_step(
             for j in range(root):
                 B |= U1 << np.uint64(order[j])
             ubuf[UB_B] = B
-            stack_S[0] = U1 << np.uint64(order[root])
-            stack_X[0] = B
+            S0 = U1 << np.uint64(order[root])
+            stack[0, SK_S] = S0
+            stack[0, SK_X] = B
+            stack[0, SK_P] = core(full & ~B, inmask, r)
+            stack[0, SK_Q] = core(full & ~B & ~S0, inmask, r)
+            stack[0, SK_DP] = ZERO
+            stack[0, SK_DQ] = ZERO
             stack_depth[0] = 0
             sp = 1
             root += 1
         sp -= 1
-        S = stack_S[sp]
-        X = stack_X[sp]
+        S = stack[sp, SK_S]
+        X = stack[sp, SK_X]
+        P = stack[sp, SK_P]
+        Q = stack[sp, SK_Q]
+        if stack[sp, SK_DP]:
+            P = core_after_removal(P & ~stack[sp, SK_DP], stack[sp, SK_DP], inmask, outmask, r)
+        if stack[sp, SK_DQ]:
+            Q = core_after_removal(Q & ~stack[sp, SK_DQ], stack[sp, SK_DQ], inmask, outmask, r)
         depth = stack_depth[sp]
-        B = ubuf[UB_B]
         done += 1
-        Q = core(full & ~S & ~B, inmask, n, r)
+        leaf = 0
         if Q == ZERO:
+            leaf = -1
+        elif S & ~P:
+            leaf = -2
+        elif size_bound(S, Q, P | Q, inmask, r):
+            leaf = -3
+        if leaf != 0:
             if record:
-                tokens[ntok] = -1
-            ntok += 1
-            progress[0] += 0.5 ** depth / n
-            continue
-        P = core(full & ~X, inmask, n, r)
-        if S & ~P:
-            if record:
-                tokens[ntok] = -2
-            ntok += 1
-            progress[0] += 0.5 ** depth / n
-            continue
-        if size_bound(S, Q, P | Q, inmask, n, r):
-            if record:
-                tokens[ntok] = -3
+                tokens[ntok] = leaf
             ntok += 1
             progress[0] += 0.5 ** depth / n
             continue
         best_slack = n + 1
         best_cand = ZERO
-        for i in range(n):
-            if S & (U1 << np.uint64(i)):
-                out = popcount(inmask[i] & ~S)
-                if out >= r:
-                    cand = inmask[i] & P & ~S
-                    slack = popcount(cand) - (out - r + 1)
-                    if slack < best_slack:
-                        best_slack = slack
-                        best_cand = cand
+        m = S
+        while m:
+            i = low_index(m)
+            m &= ~(U1 << np.uint64(i))
+            out = popcount(inmask[i] & ~S)
+            if out >= r:
+                cand = inmask[i] & P & ~S
+                slack = popcount(cand) - (out - r + 1)
+                if slack < best_slack:
+                    best_slack = slack
+                    best_cand = cand
         if best_cand == ZERO:
             ubuf[UB_W1] = S
             ubuf[UB_W2] = Q
             state[ST_STATUS] = SAT
             break
-        u = fewest_in_neighbours(best_cand, inmask, n)
+        u = branch_node(best_cand, Q, inmask, outmask)
         if record:
             tokens[ntok] = u
         ntok += 1
         bu = U1 << np.uint64(u)
-        stack_S[sp] = S
-        stack_X[sp] = X | bu
+        # exclude child (expanded second): X + u, P loses u
+        stack[sp, SK_S] = S
+        stack[sp, SK_X] = X | bu
+        stack[sp, SK_P] = P
+        stack[sp, SK_Q] = Q
+        stack[sp, SK_DP] = bu
+        stack[sp, SK_DQ] = ZERO
         stack_depth[sp] = depth + 1
-        stack_S[sp + 1] = S | bu
-        stack_X[sp + 1] = X
+        # include child (expanded first): S + u, Q loses u
+        stack[sp + 1, SK_S] = S | bu
+        stack[sp + 1, SK_X] = X
+        stack[sp + 1, SK_P] = P
+        stack[sp + 1, SK_Q] = Q
+        stack[sp + 1, SK_DP] = ZERO
+        stack[sp + 1, SK_DQ] = bu & Q
         stack_depth[sp + 1] = depth + 1
         sp += 2
     state[ST_SP] = sp
@@ -267,3 +315,248 @@ def min_pair_cost(inmask: np.ndarray, r: int):
                     w1 = S
                     w2 = arg[rest]
     return best, w1, w2
+
+
+@njit(cache=True, nogil=True)
+def core_free(U: np.uint64, free: np.uint64, inmask: np.ndarray, r: int) -> np.uint64:
+    """Largest subset A of U whose members have < r in-neighbours outside A ∪ free
+    (the nodes of ``free`` count as inside and are never peeled)."""
+    changed = True
+    while changed:
+        changed = False
+        m = U
+        while m:
+            i = low_index(m)
+            b = U1 << np.uint64(i)
+            m &= ~b
+            if popcount(inmask[i] & ~(U | free)) >= r:
+                U &= ~b
+                changed = True
+    return U
+
+
+@njit(cache=True, nogil=True)
+def cheapest_side(U: np.uint64, budget: int, inmask: np.ndarray, r: int, out: np.ndarray) -> np.int64:
+    """Fewest charged nodes Q2 ⊆ U (at most ``budget``) such that some nonempty A2 ⊆ U \\ Q2
+    has every member with < r in-neighbours outside A2 ∪ Q2; -1 if none.
+
+    Then S2 = A2 ∪ Q2 has |reach_r(S2)| ≤ |Q2| and a closed member. Tries |Q2| = 0, 1, 2, ...
+    by enumerating subsets of U; writes (A2, Q2) into ``out``.
+    """
+    n = inmask.shape[0]
+    A = core(U, inmask, r)
+    if A != ZERO:
+        out[0] = A
+        out[1] = ZERO
+        return 0
+    members = np.empty(64, dtype=np.int64)
+    k = 0
+    m = U
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        members[k] = i
+        k += 1
+    idx = np.empty(64, dtype=np.int64)
+    for size in range(1, min(budget, k) + 1):
+        for t in range(size):
+            idx[t] = t
+        while True:
+            Q2 = ZERO
+            for t in range(size):
+                Q2 |= U1 << np.uint64(members[idx[t]])
+            A = core_free(U & ~Q2, Q2, inmask, r)
+            if A != ZERO:
+                out[0] = A
+                out[1] = Q2
+                return size
+            # next combination
+            t = size - 1
+            while t >= 0 and idx[t] == k - size + t:
+                t -= 1
+            if t < 0:
+                break
+            idx[t] += 1
+            for v in range(t + 1, size):
+                idx[v] = idx[v - 1] + 1
+    return -1
+
+
+# rows of the cost-search stack
+CK_S, CK_X, CK_C, CK_M = 0, 1, 2, 3
+COST_STACK_WIDTH = 4
+# indices into the int64 state of the cost search
+CS_SP, CS_ROOT, CS_STATUS, CS_NODES, CS_BEST = 0, 1, 2, 3, 4
+COST_STATE_LEN = 5
+# uint64 buffer: current B, best S1, best S2
+CB_B, CB_W1, CB_W2 = 0, 1, 2
+
+
+@njit(cache=True, nogil=True)
+def min_cost_step(
+    inmask: np.ndarray,
+    outmask: np.ndarray,
+    order: np.ndarray,
+    r: int,
+    stack: np.ndarray,
+    stack_depth: np.ndarray,
+    state: np.ndarray,
+    ubuf: np.ndarray,
+    max_nodes: int,
+    progress: np.ndarray,
+) -> None:
+    """Advance the branch and bound for s*(r) = min |reach_r(S1)| + |reach_r(S2)| over
+    disjoint pairs whose sets both keep an r-closed member.
+
+    A pair of cost ≤ c is: disjoint S_k = A_k ∪ Q_k with charged nodes Q_k (paid
+    for, unconstrained), |Q1| + |Q2| ≤ c, and every member of A_k ≠ ∅ with < r
+    in-neighbours outside S_k. S1 is enumerated from root order[k] (the first node of
+    S1 ∪ S2; B = order[:k] is outside both), state (S, X, C, M): S ⊆ S1, X ∩ S1 = ∅,
+    C ⊆ S charged, M ⊆ S must be closed. With budget b = best − 1 − |C| (``best`` is
+    the incumbent in state[CS_BEST]):
+
+    * S2's uncharged part is (r + b)-closed, so core_{r+b}(V \\ S \\ B) ≠ ∅ is needed;
+    * S1's uncharged part is (r + |C| + b)-closed and avoids X, so M ⊆ core(V \\ X);
+    * a member of M with r in-neighbours in X cannot be closed.
+
+    An unmarked member of S with ≥ r outside in-neighbours is charged or marked
+    closed (two branches); a member of M with ≥ r outside in-neighbours takes one of
+    its in-neighbours (include / exclude). When nothing is left to fix, the best S2
+    outside S ∪ B is found by ``cheapest_side``; a cheaper pair becomes the incumbent.
+    """
+    n = inmask.shape[0]
+    full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
+    sp = state[CS_SP]
+    root = state[CS_ROOT]
+    done = 0
+    side = np.zeros(2, dtype=np.uint64)
+    while done < max_nodes:
+        if sp == 0:
+            if root >= n or state[CS_BEST] == 0:
+                state[CS_STATUS] = UNSAT
+                break
+            B = ZERO
+            for j in range(root):
+                B |= U1 << np.uint64(order[j])
+            ubuf[CB_B] = B
+            stack[0, CK_S] = U1 << np.uint64(order[root])
+            stack[0, CK_X] = B
+            stack[0, CK_C] = ZERO
+            stack[0, CK_M] = ZERO
+            stack_depth[0] = 0
+            sp = 1
+            root += 1
+        sp -= 1
+        S = stack[sp, CK_S]
+        X = stack[sp, CK_X]
+        C = stack[sp, CK_C]
+        M = stack[sp, CK_M]
+        depth = stack_depth[sp]
+        B = ubuf[CB_B]
+        done += 1
+        nc = popcount(C)
+        # unmarked members that can no longer be closed must be charged
+        forced = 0
+        m = S & ~C & ~M
+        while m:
+            i = low_index(m)
+            m &= ~(U1 << np.uint64(i))
+            if popcount(inmask[i] & X) >= r:
+                forced += 1
+        budget = state[CS_BEST] - 1 - nc - forced
+        prune = budget < 0
+        if not prune:
+            # S2 needs ≥ k charges when core_{r+k−1}(V \ S \ B) is empty
+            rest = full & ~S & ~B
+            k = 0
+            while k <= budget and core(rest, inmask, r + k) == ZERO:
+                k += 1
+            if k > budget:
+                prune = True
+            else:
+                budget -= k
+                if M & ~core(full & ~X, inmask, r + nc + forced + k + budget):
+                    prune = True
+        if not prune:
+            m = M
+            while m:
+                i = low_index(m)
+                m &= ~(U1 << np.uint64(i))
+                if popcount(inmask[i] & X) >= r:
+                    prune = True
+                    break
+        if prune:
+            progress[0] += 0.5 ** depth / n
+            continue
+        # 1. an unmarked member with r outside in-neighbours: charge it, or mark it closed
+        unmarked = S & ~C & ~M
+        pick = -1
+        m = unmarked
+        while m:
+            i = low_index(m)
+            m &= ~(U1 << np.uint64(i))
+            if popcount(inmask[i] & ~S) >= r:
+                pick = i
+                break
+        if pick >= 0:
+            bp = U1 << np.uint64(pick)
+            stack[sp, CK_S] = S
+            stack[sp, CK_X] = X
+            stack[sp, CK_C] = C
+            stack[sp, CK_M] = M | bp
+            stack_depth[sp] = depth + 1
+            stack[sp + 1, CK_S] = S
+            stack[sp + 1, CK_X] = X
+            stack[sp + 1, CK_C] = C | bp
+            stack[sp + 1, CK_M] = M
+            stack_depth[sp + 1] = depth + 1
+            sp += 2
+            continue
+        # 2. a closed-to-be member short of inside in-neighbours: take one more
+        best_slack = n + 1
+        best_cand = ZERO
+        m = M
+        while m:
+            i = low_index(m)
+            m &= ~(U1 << np.uint64(i))
+            outside = popcount(inmask[i] & ~S)
+            if outside >= r:
+                cand = inmask[i] & ~S & ~X
+                slack = popcount(cand) - (outside - r + 1)
+                if slack < best_slack:
+                    best_slack = slack
+                    best_cand = cand
+        if best_slack < 0:
+            progress[0] += 0.5 ** depth / n
+            continue  # some member of M can no longer be closed
+        if best_cand == ZERO and S & ~C == ZERO:
+            # every member is charged: S1 still needs a closed member
+            best_cand = full & ~S & ~X
+            if best_cand == ZERO:
+                progress[0] += 0.5 ** depth / n
+                continue
+        if best_cand != ZERO:
+            u = branch_node(best_cand, full & ~S & ~B, inmask, outmask)
+            bu = U1 << np.uint64(u)
+            stack[sp, CK_S] = S
+            stack[sp, CK_X] = X | bu
+            stack[sp, CK_C] = C
+            stack[sp, CK_M] = M
+            stack_depth[sp] = depth + 1
+            stack[sp + 1, CK_S] = S | bu
+            stack[sp + 1, CK_X] = X
+            stack[sp + 1, CK_C] = C
+            stack[sp + 1, CK_M] = M
+            stack_depth[sp + 1] = depth + 1
+            sp += 2
+            continue
+        # 3. S1 = S is settled at cost |C|: the cheapest S2 outside S ∪ B
+        k2 = cheapest_side(full & ~S & ~B, state[CS_BEST] - 1 - nc, inmask, r, side)
+        if k2 >= 0:
+            state[CS_BEST] = nc + k2
+            ubuf[CB_W1] = S
+            ubuf[CB_W2] = side[0] | side[1]
+        progress[0] += 0.5 ** depth / n
+    state[CS_SP] = sp
+    state[CS_ROOT] = root
+    state[CS_NODES] += done

@@ -25,7 +25,7 @@ from ..errors import SolverError
 from ..models.backends import require_backend
 from .indexed import IndexedGraph
 
-__all__ = ["MilpOutcome", "milp_min_cost"]
+__all__ = ["MilpOutcome", "RobustnessMilp", "milp_min_cost"]
 
 
 @dataclass(frozen=True)
@@ -76,6 +76,95 @@ def _rows(ig: IndexedGraph, r: int, with_y: bool):
     return rows
 
 
+class RobustnessMilp:
+    """The robustness MILP, built once, solved synchronously or in the background.
+
+    Minimises |reach_r(S1)| + |reach_r(S2)| over pairs with a closed member each,
+    subject to lower ≤ cost ≤ upper − 1. With ``decision_only`` (upper = 1) the
+    model has no y: it asks whether two disjoint nonempty r-closed sets exist, i.e.
+    whether G is *not* r-robust. Infeasible means every such pair costs ≥ ``upper``.
+    ``start()`` runs HiGHS in its own thread (HiGHS releases the GIL), so the
+    combinatorial search can race it on the other core.
+    """
+
+    def __init__(self, ig: IndexedGraph, r: int, *, upper: int, lower: int = 0,
+                 decision_only: bool = False, time_limit: float | None = None) -> None:
+        require_backend("highs", "MILP")
+        import highspy
+
+        self._highspy = highspy
+        n = ig.n
+        self.n = n
+        self.with_y = not decision_only
+        ncol = 4 * n if self.with_y else 2 * n
+        rows = _rows(ig, r, self.with_y)
+        if self.with_y:
+            rows.append((float(lower), float(upper - 1), {2 * n + i: 1.0 for i in range(2 * n)}))
+        h = highspy.Highs()
+        h.setOptionValue("output_flag", False)
+        h.setOptionValue("mip_rel_gap", 0.0)
+        if time_limit is not None:
+            h.setOptionValue("time_limit", float(max(time_limit, 0.01)))
+        h.addVars(ncol, np.zeros(ncol), np.ones(ncol))
+        h.changeColsIntegrality(ncol, np.arange(ncol, dtype=np.int32),
+                                np.full(ncol, highspy.HighsVarType.kInteger))
+        if self.with_y:
+            h.changeColsCost(2 * n, np.arange(2 * n, 4 * n, dtype=np.int32), np.ones(2 * n))
+        starts, index, value, lo, up = [], [], [], [], []
+        for low, high, row in rows:
+            starts.append(len(index))
+            index.extend(row.keys())
+            value.extend(row.values())
+            lo.append(low)
+            up.append(high)
+        h.addRows(len(rows), np.array(lo), np.array(up), len(index),
+                  np.array(starts, dtype=np.int32), np.array(index, dtype=np.int32),
+                  np.array(value, dtype=np.float64))
+        self.h = h
+        self._thread = None
+        self._t0 = 0.0
+
+    def start(self) -> None:
+        self._t0 = time.perf_counter()
+        self._thread = self.h.startSolve()
+
+    def running(self) -> bool:
+        return self.h.is_solver_running()
+
+    def cancel(self) -> None:
+        """Stop a background solve and wait for its thread."""
+        if self._thread is not None:
+            self.h.cancelSolve()
+            self._thread.join()
+            self._thread = None
+
+    def outcome(self) -> MilpOutcome:
+        """Wait for the solve and map HiGHS's status onto the shared status set."""
+        if self._thread is None:
+            self.start()
+        assert self._thread is not None
+        self._thread.join()
+        self._thread = None
+        seconds = time.perf_counter() - self._t0
+        h = self.h
+        S = self._highspy.HighsModelStatus
+        status = h.getModelStatus()
+        if status == S.kInfeasible:
+            return MilpOutcome("infeasible", None, None, seconds)
+        if status not in (S.kOptimal, S.kTimeLimit, S.kInterrupt):
+            raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} "
+                              "on the robustness MILP")
+        if h.getInfo().primal_solution_status != 2:
+            return MilpOutcome("time_limit", None, None, seconds)
+        n = self.n
+        x = np.asarray(h.getSolution().col_value)
+        S1 = frozenset(int(i) for i in np.flatnonzero(x[:n] > 0.5))
+        S2 = frozenset(int(i) for i in np.flatnonzero(x[n:2 * n] > 0.5))
+        cost = int(round(x[2 * n:].sum())) if self.with_y else 0
+        return MilpOutcome("optimal" if status == S.kOptimal else "time_limit", cost,
+                           (S1, S2), seconds)
+
+
 def milp_min_cost(
     ig: IndexedGraph,
     r: int,
@@ -85,57 +174,6 @@ def milp_min_cost(
     decision_only: bool = False,
     time_limit: float | None = None,
 ) -> MilpOutcome:
-    """Minimise |reach_r(S1)| + |reach_r(S2)| over pairs with a closed member each,
-    subject to lower ≤ cost ≤ upper − 1.
-
-    With ``decision_only`` (and upper = 1) the model has no y: it asks whether two
-    disjoint nonempty r-closed sets exist, i.e. whether G is *not* r-robust.
-    Infeasible means every such pair costs ≥ ``upper``.
-    """
-    require_backend("highs", "MILP")
-    import highspy
-
-    n = ig.n
-    with_y = not decision_only
-    ncol = 4 * n if with_y else 2 * n
-    rows = _rows(ig, r, with_y)
-    if with_y:
-        cost_row = {2 * n + i: 1.0 for i in range(2 * n)}
-        rows.append((float(lower), float(upper - 1), cost_row))
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
-    h.setOptionValue("mip_rel_gap", 0.0)
-    if time_limit is not None:
-        h.setOptionValue("time_limit", float(max(time_limit, 0.01)))
-    h.addVars(ncol, np.zeros(ncol), np.ones(ncol))
-    h.changeColsIntegrality(ncol, np.arange(ncol, dtype=np.int32),
-                            np.full(ncol, highspy.HighsVarType.kInteger))
-    if with_y:
-        h.changeColsCost(2 * n, np.arange(2 * n, 4 * n, dtype=np.int32), np.ones(2 * n))
-    starts, index, value, lo, up = [], [], [], [], []
-    for low, high, row in rows:
-        starts.append(len(index))
-        index.extend(row.keys())
-        value.extend(row.values())
-        lo.append(low)
-        up.append(high)
-    h.addRows(len(rows), np.array(lo), np.array(up), len(index),
-              np.array(starts, dtype=np.int32), np.array(index, dtype=np.int32),
-              np.array(value, dtype=np.float64))
-    t0 = time.perf_counter()
-    h.run()
-    seconds = time.perf_counter() - t0
-    status = h.getModelStatus()
-    S = highspy.HighsModelStatus
-    if status == S.kInfeasible:
-        return MilpOutcome("infeasible", None, None, seconds)
-    if status not in (S.kOptimal, S.kTimeLimit, S.kInterrupt):
-        raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} on the robustness MILP")
-    has_solution = h.getInfo().primal_solution_status == 2
-    if not has_solution:
-        return MilpOutcome("time_limit", None, None, seconds)
-    x = np.asarray(h.getSolution().col_value)
-    S1 = frozenset(int(i) for i in np.flatnonzero(x[:n] > 0.5))
-    S2 = frozenset(int(i) for i in np.flatnonzero(x[n:2 * n] > 0.5))
-    cost = int(round(x[2 * n:].sum())) if with_y else 0
-    return MilpOutcome("optimal" if status == S.kOptimal else "time_limit", cost, (S1, S2), seconds)
+    """Solve :class:`RobustnessMilp` and wait for the answer."""
+    return RobustnessMilp(ig, r, upper=upper, lower=lower, decision_only=decision_only,
+                          time_limit=time_limit).outcome()

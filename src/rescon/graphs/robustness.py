@@ -23,8 +23,8 @@ import numpy as np
 from ..errors import InputError
 from . import bounds as bd
 from .indexed import IndexedGraph, index_graph
-from .milp import milp_min_cost
-from .search import MAX_SEARCH_NODES, decide_r_robust
+from .milp import MilpOutcome, RobustnessMilp, milp_min_cost
+from .search import MAX_SEARCH_NODES, SearchOutcome, decide_r_robust
 
 __all__ = [
     "RobustnessReport",
@@ -198,31 +198,65 @@ def _decide_r(
     value, pair = known_pair if known_pair is not None else bd.upper_witness(ig)
     if value < r:
         return _Decision(False, pair=pair)
+    if method == "auto" and ig.n > MAX_SEARCH_NODES:
+        method = "milp"
     if method == "auto":
-        method = "search" if ig.n <= MAX_SEARCH_NODES else "milp"
+        return _race(ig, r, deadline, on_progress)
     if method == "search":
-        out = decide_r_robust(ig, r, deadline=deadline, on_progress=on_progress)
-        if out.status == "stopped":
-            return _Decision(None, method="search")
-        if out.status == "not_robust":
-            assert out.witness is not None
-            return _Decision(False, pair=bd.Pair(*out.witness), method="search")
-        tree = list(out.tree) if out.tree is not None else None
-        return _Decision(True, proof={"method": "search", "order": list(out.order), "tree": tree,
-                                      "info": {"nodes": out.nodes}}, method="search")
+        return _search_decision(decide_r_robust(ig, r, deadline=deadline, on_progress=on_progress))
     if method == "dp":
         cost, pair = _dp_min_cost(ig, r)
         if cost >= 1:
             return _Decision(True, proof={"method": "dp"}, method="dp")
         assert pair is not None
         return _Decision(False, pair=pair, method="dp")
-    out = milp_min_cost(ig, r, upper=1, decision_only=True, time_limit=_remaining(deadline))
+    return _milp_decision(milp_min_cost(ig, r, upper=1, decision_only=True,
+                                        time_limit=_remaining(deadline)))
+
+
+def _search_decision(out: SearchOutcome) -> _Decision:
+    if out.status == "stopped":
+        return _Decision(None, method="search")
+    if out.status == "not_robust":
+        assert out.witness is not None
+        return _Decision(False, pair=bd.Pair(*out.witness), method="search")
+    tree = list(out.tree) if out.tree is not None else None
+    return _Decision(True, proof={"method": "search", "order": list(out.order), "tree": tree,
+                                  "info": {"nodes": out.nodes}}, method="search")
+
+
+def _milp_decision(out: MilpOutcome) -> _Decision:
     if out.status == "infeasible":
         return _Decision(True, proof={"method": "milp", "solver": "highs",
                                       "info": {"seconds": round(out.seconds, 3)}}, method="milp")
     if out.pair is None:
         return _Decision(None, method="milp")
     return _Decision(False, pair=bd.Pair(*out.pair), method="milp")
+
+
+def _race(ig: IndexedGraph, r: int, deadline: float | None,
+          on_progress: Callable[[float], None] | None) -> _Decision:
+    """The search and the MILP race, one core each; the first answer wins.
+
+    The search wins on sparse and mid-density graphs (and its tree is a checkable
+    certificate); the MILP wins on dense ones, where its LP bound bites (its proof
+    is accepted on trust). Whichever loses is cancelled.
+    """
+    milp = RobustnessMilp(ig, r, upper=1, decision_only=True, time_limit=_remaining(deadline))
+    milp.start()
+    try:
+        out = decide_r_robust(ig, r, deadline=deadline, on_progress=on_progress,
+                              should_stop=lambda: not milp.running())
+    except BaseException:
+        milp.cancel()
+        raise
+    if out.status != "stopped":
+        milp.cancel()
+        return _search_decision(out)
+    if deadline is not None and time.perf_counter() > deadline:
+        milp.cancel()
+        return _Decision(None, method="search+milp")
+    return _milp_decision(milp.outcome())
 
 
 def _dp_min_cost(ig: IndexedGraph, r: int) -> tuple[int, bd.Pair | None]:

@@ -24,7 +24,15 @@ import numpy as np
 
 from .indexed import IndexedGraph
 
-__all__ = ["MAX_SEARCH_NODES", "MAX_TREE_TOKENS", "SearchOutcome", "decide_r_robust", "search_order"]
+__all__ = [
+    "MAX_SEARCH_NODES",
+    "MAX_TREE_TOKENS",
+    "CostOutcome",
+    "SearchOutcome",
+    "decide_r_robust",
+    "min_cost_pair",
+    "search_order",
+]
 
 MAX_SEARCH_NODES = 64
 MAX_TREE_TOKENS = 4_000_000
@@ -72,6 +80,7 @@ def decide_r_robust(
     record: bool = True,
     deadline: float | None = None,
     on_progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
 ) -> SearchOutcome:
     """Decide whether ``ig`` is r-robust, exactly.
 
@@ -83,6 +92,8 @@ def decide_r_robust(
         ``MAX_TREE_TOKENS`` tokens; the answer stays exact).
     deadline : ``time.perf_counter()`` value after which the search stops.
     on_progress : called with the refuted share of the search space.
+    should_stop : polled between slices; True abandons the search ("stopped"),
+        e.g. when a racing MILP has answered.
     """
     from . import _kernels as K  # numba: imported on first use, not with rescon
 
@@ -91,8 +102,11 @@ def decide_r_robust(
         raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
     inmask = _mask_array(ig)
     order = search_order(ig)
-    stack_S = np.zeros(2 * n + 2, dtype=np.uint64)
-    stack_X = np.zeros(2 * n + 2, dtype=np.uint64)
+    outmask = np.zeros(n, dtype=np.uint64)
+    for v, nbrs in enumerate(ig.in_nbrs):
+        for u in nbrs:
+            outmask[u] |= np.uint64(1) << np.uint64(v)
+    stack = np.zeros((2 * n + 2, K.STACK_WIDTH), dtype=np.uint64)
     stack_depth = np.zeros(2 * n + 2, dtype=np.int64)
     state = np.zeros(K.STATE_LEN, dtype=np.int64)
     ubuf = np.zeros(K.UBUF_LEN, dtype=np.uint64)
@@ -100,7 +114,7 @@ def decide_r_robust(
     tokens = np.empty(1 << 12 if record else 1, dtype=np.int32)
     while True:
         state[K.ST_STATUS] = K.RUNNING
-        K.decide_step(inmask, order, r, stack_S, stack_X, stack_depth, state, ubuf,
+        K.decide_step(inmask, outmask, order, r, stack, stack_depth, state, ubuf,
                       tokens, record, _SLICE, progress)
         status = state[K.ST_STATUS]
         if status == K.NEED_ROOM:
@@ -114,7 +128,9 @@ def decide_r_robust(
             on_progress(float(progress[0]))
         if status != K.RUNNING:
             break
-        if deadline is not None and time.perf_counter() > deadline:
+        if (deadline is not None and time.perf_counter() > deadline) or (
+            should_stop is not None and should_stop()
+        ):
             return SearchOutcome("stopped", r, tuple(order.tolist()), None, None,
                                  int(state[K.ST_NODES]), float(progress[0]))
     nodes = int(state[K.ST_NODES])
@@ -123,3 +139,64 @@ def decide_r_robust(
         return SearchOutcome("not_robust", r, tuple(order.tolist()), witness, None, nodes, 1.0)
     tree = tuple(tokens[: state[K.ST_NTOK]].tolist()) if record else None
     return SearchOutcome("robust", r, tuple(order.tolist()), None, tree, nodes, 1.0)
+
+
+@dataclass(frozen=True)
+class CostOutcome:
+    """Result of the s*(r) branch and bound: ``status`` "done" (``best`` = s*(r)
+    when < ``upper``, with ``pair`` the cheapest pair; otherwise s*(r) = ``upper``)
+    or "stopped" (``best`` is still an upper bound)."""
+
+    status: str
+    best: int
+    pair: tuple[frozenset[int], frozenset[int]] | None
+    nodes: int
+    order: tuple[int, ...]
+
+
+def min_cost_pair(
+    ig: IndexedGraph,
+    r: int,
+    upper: int,
+    *,
+    deadline: float | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> CostOutcome:
+    """s*(r) = min |reach_r(S1)| + |reach_r(S2)| over pairs whose sets both keep an
+    r-closed member, searched below ``upper`` (a known pair's cost, or n).
+
+    Exact branch and bound over S1 with charged members (see
+    ``_kernels.min_cost_step``); n ≤ 64.
+    """
+    from . import _kernels as K
+
+    n = ig.n
+    if n > MAX_SEARCH_NODES:
+        raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
+    inmask = _mask_array(ig)
+    outmask = np.zeros(n, dtype=np.uint64)
+    for v, nbrs in enumerate(ig.in_nbrs):
+        for u in nbrs:
+            outmask[u] |= np.uint64(1) << np.uint64(v)
+    order = search_order(ig)
+    stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
+    depth = np.zeros(3 * n + 3, dtype=np.int64)
+    state = np.zeros(K.COST_STATE_LEN, dtype=np.int64)
+    state[K.CS_BEST] = upper
+    ubuf = np.zeros(3, dtype=np.uint64)
+    progress = np.zeros(1, dtype=np.float64)
+    status = "done"
+    while True:
+        K.min_cost_step(inmask, outmask, order, r, stack, depth, state, ubuf, _SLICE, progress)
+        if state[K.CS_STATUS] != K.RUNNING:
+            break
+        if (deadline is not None and time.perf_counter() > deadline) or (
+            should_stop is not None and should_stop()
+        ):
+            status = "stopped"
+            break
+    best = int(state[K.CS_BEST])
+    pair = None
+    if best < upper:
+        pair = (_bits(ubuf[K.CB_W1]), _bits(ubuf[K.CB_W2]))
+    return CostOutcome(status, best, pair, int(state[K.CS_NODES]), tuple(order.tolist()))
