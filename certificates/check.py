@@ -558,6 +558,17 @@ def _proof_dp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
     return "dp (re-verified by enumeration)"
 
 
+def _proof_cost_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    _obj(p, where, ("method", "order"), ("info",))
+    _perm(p["order"], f"{where}.order", g.n)
+    _info(p, where)
+    if g.n > MAX_ENUM_N:
+        ctx.trust("cost_search")
+        return "cost_search (trusted)"
+    _enumerate_or_fail(where, g, r, s)
+    return "cost_search (re-verified by enumeration)"
+
+
 def _proof_milp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
     _obj(p, where, ("method", "solver"), ("info",))
     if not isinstance(p["solver"], str) or not p["solver"]:
@@ -579,6 +590,7 @@ METHODS: dict[str, ProofFn] = {
     "dp": _proof_dp,
     "implied": _proof_implied,
     "milp": _proof_milp,
+    "cost_search": _proof_cost_search,
 }
 
 

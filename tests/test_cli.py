@@ -216,9 +216,6 @@ def test_check_subprocess_exit_codes(tmp_path):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: DESIGN.md says every subcommand has --json, "
-                   "but `rescon check CERT --json` is rejected by argparse (exit 2, "
-                   "'unrecognized arguments: --json')")
 def test_check_has_json_option(capsys, tmp_path):
     cert_path = tmp_path / "c.json"
     run(["robustness", PAPER, "--certificate", cert_path], capsys)
@@ -502,10 +499,6 @@ def test_help_subprocess():
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: with --r and a time limit that stops the "
-                   "decision (r_robust null), the CLI reports s_max = 0, i.e. claims "
-                   "'not r-robust'; real reproducer: gnp(40, 0.5, directed, seed=1) edge list, "
-                   "--r 10 --time-limit 0.2 --json -> {\"r_robust\": null, \"s_max\": 0}")
 def test_undecided_r_does_not_report_s_max_zero(capsys, monkeypatch):
     import rescon.graphs.robustness as rb
 
@@ -529,24 +522,19 @@ def test_undecided_r_s_reports_null(capsys, monkeypatch):
     assert data == {"r": 5, "s": 2, "holds": None, "witness": None}
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: --r R --time-limit T where G is proven R-robust "
-                   "but s*(R) is not settled in time exits 2 ('rescon: error: time limit "
-                   "reached: 1 ≤ s*(9) ≤ 4') and loses the answer; real reproducer: "
-                   "gnp(40, 0.5, directed, seed=1) edge list, --r 9 --time-limit 0.5 --json")
 def test_r_proven_but_s_unsettled_is_not_an_error(capsys, monkeypatch):
     import rescon.graphs.robustness as rb
 
-    def unsettled(G, r, **kw):  # max_s documents InputError when the time limit stops it
-        raise rescon.InputError(f"time limit reached: 1 ≤ s*({r}) ≤ 4")
+    def unsettled(G, r, **kw):  # max_s raises TimeLimitReached when the time limit stops it
+        raise rescon.TimeLimitReached(f"time limit reached: 1 ≤ s*({r}) ≤ 4")
 
     monkeypatch.setattr(rb, "max_s", unsettled)
     code, out, err = run(["robustness", PAPER, "--r", 5, "--time-limit", 1, "--json"], capsys)
     assert code == 0, err
     assert json.loads(out)["r_robust"] is True
+    assert json.loads(out)["s_max"] is None
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: --method search on a graph with n > 64 ends in a "
-                   "Python traceback (ValueError from decide_r_robust) and exit 1")
 def test_search_method_beyond_64_nodes_cli(capsys, tmp_path):
     G = nx.gnp_random_graph(66, 0.1, directed=True, seed=2)
     path = write_edgelist(tmp_path / "g66.edgelist", G)

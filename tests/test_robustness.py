@@ -789,10 +789,6 @@ def test_time_limit_decision_and_max_s():
     assert rescon.max_s(G, 21, time_limit=0.5) == 0
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: time_limit is not honoured: the bounds phase "
-                   "(_searched_seed_construction, 1 s per seed search, per r) ignores the "
-                   "caller's deadline; gnp(50, 0.5, directed, seed=1) with time_limit=0.05 "
-                   "takes ~6 s")
 def test_time_limit_is_honoured_for_tiny_limits():
     G = nx.gnp_random_graph(50, 0.5, directed=True, seed=1)
     rescon.robustness(nx.cycle_graph(5))
@@ -968,10 +964,6 @@ def test_regression_exact_engines(n, p, seed):
             assert pair_violates(G, *full.pair, r, ss[r] + 1)
 
 
-@pytest.mark.xfail(strict=True, reason="BUG: method='search' on a graph with n > 64 raises a "
-                   "plain ValueError from rescon.graphs.search.decide_r_robust ('the bitmask "
-                   "search handles n ≤ 64'), not rescon.InputError (so the CLI prints a "
-                   "traceback)")
 def test_search_method_beyond_64_nodes():
     G = nx.gnp_random_graph(66, 0.1, directed=True, seed=2)
     try:

@@ -15,6 +15,7 @@ from .errors import (
     RESCONError,
     SolverError,
     SolverNotFound,
+    TimeLimitReached,
 )
 from .graphs.attacks import check_assumption2, check_attack_model
 from .graphs.robustness import (
@@ -39,6 +40,7 @@ __all__ = [
     "RobustnessReport",
     "SolverError",
     "SolverNotFound",
+    "TimeLimitReached",
     "check_assumption2",
     "check_attack_model",
     "check_certificate",

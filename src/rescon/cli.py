@@ -1,4 +1,4 @@
-"""``rescon`` command line: thin subcommands over the Python API.
+"""rescon command line: thin subcommands over the Python API.
 
 Every subcommand takes ``--json`` (one JSON object on stdout). Bad input exits 2
 with one line on stderr, never a traceback; ``rescon check`` exits 0 (valid),
@@ -12,7 +12,7 @@ import json
 import sys
 from typing import Any, Callable, Sequence
 
-from .errors import RESCONError
+from .errors import RESCONError, TimeLimitReached
 
 __all__ = ["main"]
 
@@ -34,7 +34,9 @@ def _write_certificate(cert: dict[str, Any] | None, path: str | None) -> None:
     if path is None:
         return
     if cert is None:
-        raise RESCONError("no certificate: the time limit stopped the search before an answer")
+        print(f"rescon: no certificate written to {path}: the time limit stopped the search "
+              "before an answer", file=sys.stderr)
+        return
     from pathlib import Path
 
     target = Path(path)
@@ -82,11 +84,17 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
     if args.s is None:
         res = is_rs_robust(G, args.r, 1, **kw)
         _write_certificate(res.certificate, args.certificate)
-        s_max = max_s(G, args.r, **kw) if res.holds else 0
+        s_max: int | None = 0 if res.holds is False else None
+        if res.holds:
+            try:
+                s_max = max_s(G, args.r, **kw)
+            except TimeLimitReached:
+                s_max = None
         out = {"r": args.r, "r_robust": res.holds, "s_max": s_max,
                "witness": _pair_json(res.witness)}
         verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
-        lines = [f"G {verdict} {args.r}-robust; s*({args.r}) = {s_max}"]
+        shown = "not settled (time limit)" if s_max is None else s_max
+        lines = [f"G {verdict} {args.r}-robust; s*({args.r}) = {shown}"]
     else:
         res = is_rs_robust(G, args.r, args.s, **kw)
         _write_certificate(res.certificate, args.certificate)
@@ -101,9 +109,19 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from rescon_certificates.check import main as check_main
+    from rescon_certificates.check import check, load, main as check_main
 
-    return check_main([args.certificate])
+    if not args.json:
+        return check_main([args.certificate])
+    try:
+        cert = load(args.certificate)
+    except (ValueError, OSError) as exc:  # what the checker calls unreadable
+        print(json.dumps({"valid": False, "readable": False, "reason": str(exc)}))
+        return 2
+    res = check(cert)
+    print(json.dumps({"valid": res.valid, "readable": True, "reason": res.reason,
+                      "trusted": list(res.trusted)}))
+    return 0 if res.valid else 1
 
 
 def _nonneg_int(text: str) -> int:
@@ -152,6 +170,8 @@ def _parser() -> argparse.ArgumentParser:
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")
+    chk.add_argument("--json", action="store_true",
+                     help="one JSON object: valid, readable, reason, trusted")
     chk.set_defaults(func=_cmd_check)
     return p
 

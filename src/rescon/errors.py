@@ -13,6 +13,7 @@ __all__ = [
     "SolverError",
     "SolverNotFound",
     "CertificateError",
+    "TimeLimitReached",
 ]
 
 
@@ -38,3 +39,7 @@ class SolverNotFound(SolverError):
 
 class CertificateError(RESCONError, ValueError):
     """A certificate could not be produced or is malformed."""
+
+
+class TimeLimitReached(RESCONError, RuntimeError):
+    """A time limit stopped a computation before it had an answer to return."""

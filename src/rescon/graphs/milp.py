@@ -105,6 +105,7 @@ class RobustnessMilp:
         h.setOptionValue("mip_rel_gap", 0.0)
         if time_limit is not None:
             h.setOptionValue("time_limit", float(max(time_limit, 0.01)))
+        h.HandleUserInterrupt = True  # lets cancel() stop a background solve
         h.addVars(ncol, np.zeros(ncol), np.ones(ncol))
         h.changeColsIntegrality(ncol, np.arange(ncol, dtype=np.int32),
                                 np.full(ncol, highspy.HighsVarType.kInteger))

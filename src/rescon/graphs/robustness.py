@@ -20,11 +20,17 @@ from typing import Any, Callable, Hashable
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, SolverError, TimeLimitReached
 from . import bounds as bd
 from .indexed import IndexedGraph, index_graph
 from .milp import MilpOutcome, RobustnessMilp, milp_min_cost
-from .search import MAX_SEARCH_NODES, SearchOutcome, decide_r_robust
+from .search import (
+    MAX_SEARCH_NODES,
+    CostOutcome,
+    SearchOutcome,
+    decide_r_robust,
+    min_cost_pair,
+)
 
 __all__ = [
     "RobustnessReport",
@@ -38,6 +44,7 @@ __all__ = [
 
 METHODS = ("auto", "search", "milp", "dp")
 DP_MAX_NODES = 26
+DP_AUTO_NODES = 22
 Proof = dict[str, Any]
 LabelPair = tuple[frozenset[Hashable], frozenset[Hashable]]
 
@@ -112,7 +119,7 @@ def _check_options(method: str, time_limit: float | None) -> float | None:
         raise InputError(f"method must be one of {METHODS}; got {method!r}")
     if time_limit is None:
         return None
-    if isinstance(time_limit, bool) or not isinstance(time_limit, (int, float)) or not (
+    if isinstance(time_limit, bool) or not isinstance(time_limit, (int, float, np.number)) or not (
         time_limit > 0 and np.isfinite(time_limit)
     ):
         raise InputError(f"time_limit must be a positive number of seconds; got {time_limit!r}")
@@ -136,15 +143,26 @@ class _Decision:
     method: str = "bounds"
 
 
+def _check_method_size(method: str, n: int) -> None:
+    if method == "search" and n > MAX_SEARCH_NODES:
+        raise InputError(f"method 'search' handles n ≤ {MAX_SEARCH_NODES}; got n = {n} "
+                         "(use method='auto' or 'milp')")
+    if method == "dp" and n > DP_MAX_NODES:
+        raise InputError(f"method 'dp' handles n ≤ {DP_MAX_NODES}; got n = {n} "
+                         "(use method='auto' or 'milp')")
+
+
 def _half_pair(ig: IndexedGraph) -> bd.Pair:
     half = frozenset(range(ig.n // 2))
     return bd.Pair(half, frozenset(range(ig.n)) - half)
 
 
-def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]]) -> Proof | None:
+def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]], *,
+                 seed_search: bool = False, deadline: float | None = None) -> Proof | None:
     """A proof of (r, s)-robustness from the bounds, if one gives it: trivial, degree,
-    complete, construction from a clique, or (s = 1) construction from a small seed
-    proven r-robust by the search."""
+    complete, construction from a clique, or (s = 1, ``seed_search``) construction
+    from a small seed proven r-robust by a short search (≤ 1 s, and within
+    ``deadline``)."""
     if r <= 0:
         return {"method": "trivial"}
     if bd.degree_r(ig) >= r:
@@ -152,8 +170,8 @@ def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]]) -> Pr
     if bd.is_complete(ig):
         return {"method": "complete"} if ig.n >= 2 * r - 1 else None
     proof = bd.construction_proof(ig, r, s, seeds=seeds)
-    if proof is None and s == 1:
-        proof = _searched_seed_construction(ig, r)
+    if proof is None and s == 1 and seed_search:
+        proof = _searched_seed_construction(ig, r, deadline)
     return proof
 
 
@@ -161,7 +179,7 @@ SEED_SIZES = (2, 3, 4)  # seed sizes tried, in units of r (capped at the search'
 SEED_SEARCH_SECONDS = 1.0
 
 
-def _searched_seed_construction(ig: IndexedGraph, r: int) -> Proof | None:
+def _searched_seed_construction(ig: IndexedGraph, r: int, deadline: float | None) -> Proof | None:
     """A construction whose seed (a prefix of a greedy order from the highest-degree
     node) is proven r-robust by a short search: e.g. circulants, whose seeds are
     path powers rather than cliques."""
@@ -171,8 +189,9 @@ def _searched_seed_construction(ig: IndexedGraph, r: int) -> Proof | None:
         closure = bd.closure_order(ig, order[:m], r)
         if closure is None or m < 2:
             continue
+        stop = time.perf_counter() + SEED_SEARCH_SECONDS
         out = decide_r_robust(ig.induced(order[:m]), r,
-                              deadline=time.perf_counter() + SEED_SEARCH_SECONDS)
+                              deadline=stop if deadline is None else min(stop, deadline))
         if out.status == "robust" and out.tree is not None:
             return {"method": "construction", "order": closure, "seed_size": m,
                     "seed_proof": {"method": "search", "order": list(out.order),
@@ -192,7 +211,8 @@ def _decide_r(
     """Is ig r-robust? Bounds first, then the exact ``method``."""
     if r > (ig.n + 1) // 2:
         return _Decision(False, pair=_half_pair(ig))
-    proof = _cheap_proof(ig, r, 1, seeds)
+    _check_method_size(method, ig.n)
+    proof = _cheap_proof(ig, r, 1, seeds, seed_search=True, deadline=deadline)
     if proof is not None:
         return _Decision(True, proof=proof)
     value, pair = known_pair if known_pair is not None else bd.upper_witness(ig)
@@ -260,8 +280,9 @@ def _race(ig: IndexedGraph, r: int, deadline: float | None,
 
 
 def _dp_min_cost(ig: IndexedGraph, r: int) -> tuple[int, bd.Pair | None]:
-    if ig.n > DP_MAX_NODES + 2:
-        raise InputError(f"method 'dp' handles n ≤ {DP_MAX_NODES + 2}; got n = {ig.n}")
+    """Exact min pair cost by the subset DP (O(n·2^n) time, ~10·2^n bytes; it cannot
+    be interrupted, so ``auto`` uses it only where it takes well under a second)."""
+    _check_method_size("dp", ig.n)
     from ._kernels import min_pair_cost  # numba: imported on first use
 
     inmask = np.array(ig.in_masks(), dtype=np.uint64)
@@ -316,30 +337,79 @@ def _s_star(
             break
     if lower >= upper:
         return _SStar(upper, upper, upper, proof, pair, "bounds")
+    _check_method_size(method, n)
     if method == "auto":
-        method = "dp" if n <= DP_MAX_NODES else "milp"
+        if n <= DP_AUTO_NODES and (deadline is None or _remaining(deadline) > 1.0):
+            method = "dp"
+        elif n <= MAX_SEARCH_NODES:
+            return _race_s(ig, r, lower, upper, proof, pair, deadline)
+        else:
+            method = "milp"
     if method == "dp":
         cost, dp_pair = _dp_min_cost(ig, r)
         if dp_pair is None:
             return _SStar(n, n, n, {"method": "dp"}, None, "dp")
         return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
-    while lower < upper:
-        out = milp_min_cost(ig, r, lower=lower, upper=upper, time_limit=_remaining(deadline))
-        if out.status == "infeasible":
-            proof = {"method": "milp", "solver": "highs",
-                     "info": {"seconds": round(out.seconds, 3)}}
-            return _SStar(upper, upper, upper, proof, pair, "milp")
-        if out.pair is None:
-            return _SStar(None, lower, upper, proof, pair, "milp")
+    if method == "search":
+        return _cost_search_result(ig, r, min_cost_pair(ig, r, upper, deadline=deadline),
+                                   lower, upper, proof, pair)
+    return _milp_s_result(ig, r, _milp_s(ig, r, lower, upper, deadline).outcome(), lower, upper,
+                          proof, pair)
+
+
+def _milp_s(ig: IndexedGraph, r: int, lower: int, upper: int,
+            deadline: float | None) -> RobustnessMilp:
+    return RobustnessMilp(ig, r, lower=lower, upper=upper, time_limit=_remaining(deadline))
+
+
+def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper: int,
+                   proof: Proof, pair: bd.Pair | None) -> _SStar:
+    """s*(r) from the MILP: infeasible below ``upper`` → s* = upper; optimal → its pair."""
+    milp_proof = {"method": "milp", "solver": "highs", "info": {"seconds": round(out.seconds, 3)}}
+    if out.status == "infeasible":
+        return _SStar(upper, upper, upper, milp_proof, pair, "milp")
+    if out.pair is None:
+        return _SStar(None, lower, upper, proof, pair, "milp")
+    found = bd.Pair(*out.pair)
+    cost = bd.pair_cost(ig, found, r)
+    if cost is None or cost >= upper:
+        raise SolverError("the robustness MILP returned a pair that is not cheaper than "
+                          f"the incumbent (cost {cost}, incumbent {upper})")
+    if out.status == "optimal":
+        return _SStar(cost, cost, cost, milp_proof, found, "milp")
+    return _SStar(None, lower, cost, proof, found, "milp")
+
+
+def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, upper: int,
+                        proof: Proof, pair: bd.Pair | None) -> _SStar:
+    """s*(r) from the charged-set branch and bound (see search.min_cost_pair)."""
+    if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
-        assert cost is not None and cost < upper, "MILP solution is not a cheaper pair"
+        assert cost is not None and cost <= out.best, "cost search returned a dearer pair"
         upper, pair = cost, found
-        if out.status == "optimal":
-            proof = {"method": "milp", "solver": "highs",
-                     "info": {"seconds": round(out.seconds, 3)}}
-            return _SStar(upper, upper, upper, proof, pair, "milp")
-    return _SStar(upper, upper, upper, proof, pair, "milp")
+    if out.status == "stopped":
+        return _SStar(None, lower, upper, proof, pair, "search")
+    search_proof = {"method": "cost_search", "order": list(out.order),
+                    "info": {"nodes": out.nodes}}
+    return _SStar(upper, upper, upper, search_proof, pair, "search")
+
+
+def _race_s(ig: IndexedGraph, r: int, lower: int, upper: int, proof: Proof,
+            pair: bd.Pair | None, deadline: float | None) -> _SStar:
+    """The s*(r) branch and bound and the MILP race, one core each."""
+    milp = _milp_s(ig, r, lower, upper, deadline)
+    milp.start()
+    try:
+        out = min_cost_pair(ig, r, upper, deadline=deadline,
+                            should_stop=lambda: not milp.running())
+    except BaseException:
+        milp.cancel()
+        raise
+    if out.status != "stopped" or (deadline is not None and time.perf_counter() > deadline):
+        milp.cancel()
+        return _cost_search_result(ig, r, out, lower, upper, proof, pair)
+    return _milp_s_result(ig, r, milp.outcome(), lower, upper, proof, pair)
 
 
 # --------------------------------------------------------------------------- #
@@ -544,7 +614,10 @@ def max_s(
     Raises
     ------
     InputError
-        Bad r, or the time limit stopped the search before s*(r) was settled.
+        Bad r, method or time limit.
+    TimeLimitReached
+        The time limit stopped the search before s*(r) was settled (the message
+        gives the proven bounds).
     """
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
@@ -554,13 +627,13 @@ def max_s(
     seeds = bd.greedy_cliques(ig)
     dec = _decide_r(ig, r, method, deadline, seeds)
     if dec.holds is None:
-        raise InputError(f"time limit reached before deciding whether G is {r}-robust")
+        raise TimeLimitReached(f"time limit reached before deciding whether G is {r}-robust")
     if not dec.holds:
         return 0
     _, up_pair = bd.upper_witness(ig)
     ss = _s_star(ig, r, method, deadline, seeds, dec.proof or {"method": "trivial"}, [up_pair])
     if ss.value is None:
-        raise InputError(f"time limit reached: {ss.lower} ≤ s*({r}) ≤ {ss.upper}")
+        raise TimeLimitReached(f"time limit reached: {ss.lower} ≤ s*({r}) ≤ {ss.upper}")
     return ss.value
 
 
