@@ -1,0 +1,107 @@
+"""The exact engines on their own: the r-decision branch and bound, the s*(r)
+charged-set branch and bound, the DP and the search/MILP races, against the
+independent LeBlanc enumeration of benchmarks/baselines.py."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import jsonschema
+import networkx as nx
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import rescon
+from benchmarks.baselines import leblanc_max_s, leblanc_rho
+from rescon.graphs import bounds as bd
+from rescon.graphs.indexed import index_graph
+from rescon.graphs.search import decide_r_robust, min_cost_pair
+
+SCHEMA = json.loads(
+    (Path(__file__).parents[1] / "certificates" / "schema" / "certificate.schema.json").read_text()
+)
+
+
+@st.composite
+def digraphs(draw, max_n: int = 9):
+    n = draw(st.integers(2, max_n))
+    pairs = [(u, v) for u in range(n) for v in range(n) if u != v]
+    edges = draw(st.lists(st.sampled_from(pairs), unique=True, max_size=len(pairs)))
+    G = nx.DiGraph()
+    G.add_nodes_from(range(n))
+    G.add_edges_from(edges)
+    return G
+
+
+@settings(max_examples=80, deadline=None)
+@given(digraphs())
+def test_decision_search_matches_enumeration(G):
+    ig = index_graph(G)
+    rho = leblanc_rho(G)
+    for r in range(1, (ig.n + 1) // 2 + 1):
+        out = decide_r_robust(ig, r)
+        assert (out.status == "robust") == (r <= rho)
+        if out.status == "not_robust":
+            pair = bd.Pair(*out.witness)
+            assert pair.S1 and pair.S2 and not pair.S1 & pair.S2
+            assert bd.violates(ig, pair, r, 1)
+
+
+@settings(max_examples=80, deadline=None)
+@given(digraphs())
+def test_cost_search_matches_enumeration(G):
+    ig = index_graph(G)
+    for r in range(1, (ig.n + 1) // 2 + 2):
+        expected = leblanc_max_s(G, r)  # 0 when G is not r-robust
+        out = min_cost_pair(ig, r, ig.n)
+        assert out.status == "done"
+        assert out.best == expected
+        if out.pair is not None:
+            cost = bd.pair_cost(ig, bd.Pair(*out.pair), r)
+            assert cost is not None and cost <= out.best
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_auto_race_agrees_with_dp_beyond_the_dp_threshold(seed):
+    """n = 23..25: auto takes the search/MILP race for s*, dp is forced; same answer."""
+    G = nx.gnp_random_graph(23 + seed % 3, 0.25, directed=True, seed=seed)
+    auto = rescon.robustness(G)
+    dp = rescon.robustness(G, method="dp")
+    assert (auto.r_max, auto.s_max) == (dp.r_max, dp.s_max)
+    assert rescon.check_certificate(auto.certificate).valid
+
+
+@pytest.mark.parametrize("n, p, seed", [(30, 0.5, 30000), (25, 0.5, 25000), (22, 0.3, 7)])
+def test_produced_certificates_match_the_schema(n, p, seed):
+    G = nx.gnp_random_graph(n, p, directed=True, seed=seed)
+    rep = rescon.robustness(G)
+    jsonschema.validate(rep.certificate, SCHEMA)
+    for r in (1, rep.r_max, rep.r_max + 1):
+        res = rescon.is_rs_robust(G, r, 2)
+        jsonschema.validate(res.certificate, SCHEMA)
+
+
+def test_search_tree_certificate_is_replayed_not_trusted():
+    G = nx.gnp_random_graph(25, 0.5, directed=True, seed=25000)  # ρ = 7, no clique seed
+    res = rescon.is_r_robust(G, 7, method="search")
+    assert res.holds and res.proof_method in ("search", "construction")
+    check = rescon.check_certificate(res.certificate)
+    assert check.valid and check.trusted == ()
+    tampered = json.loads(json.dumps(res.certificate))
+    proof = tampered["proof"]
+    tree = proof["tree"] if proof["method"] == "search" else proof["seed_proof"]["tree"]
+    leaf = next(k for k, t in enumerate(tree) if t < 0)
+    tree[leaf] = -2 if tree[leaf] != -2 else -1
+    assert not rescon.check_certificate(tampered).valid
+
+
+def test_race_uses_the_milp_on_dense_graphs_and_says_so():
+    """ER(40, 0.8): the MILP proves 17-robustness long before the search; the proof is
+    labelled milp and the checker reports it as accepted on trust."""
+    G = nx.gnp_random_graph(40, 0.8, directed=True, seed=40000)
+    res = rescon.is_r_robust(G, 17, time_limit=60)
+    assert res.holds
+    if res.proof_method == "milp":
+        assert rescon.check_certificate(res.certificate).trusted == ("milp",)
