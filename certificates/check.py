@@ -712,8 +712,8 @@ def _kind_robustness(c: dict, ctx: _Ctx) -> str:
     return f"{lo} <= rho(G) <= {hi} (n={g.n})"
 
 
-def _kind_not_sarymsakov(c: dict, ctx: _Ctx) -> str:
-    _obj(c, "certificate", _HEAD + ("n", "support", "witness"))
+def _support_rows(c: dict) -> tuple[int, list[int]]:
+    """(n, row) with row[i] = mask of the j with a_ij > 0, validated."""
     n = _int(c["n"], "n", 1, MAX_N)
     sup = _array(c["support"], "support")
     row = [0] * n  # row[i] = mask of the j with a_ij > 0
@@ -730,6 +730,12 @@ def _kind_not_sarymsakov(c: dict, ctx: _Ctx) -> str:
     for i in range(n):
         if not row[i]:
             raise Invalid(f"row {i} has no entry in support (a row-stochastic matrix has one)")
+    return n, row
+
+
+def _kind_not_sarymsakov(c: dict, ctx: _Ctx) -> str:
+    _obj(c, "certificate", _HEAD + ("n", "support", "witness"))
+    n, row = _support_rows(c)
     w = _obj(c["witness"], "witness", ("V1", "V2"))
     V1, V2 = _witness_pair(w, "witness", Graph(n, [], 0), "V1", "V2")
     I1 = I2 = 0
@@ -745,11 +751,115 @@ def _kind_not_sarymsakov(c: dict, ctx: _Ctx) -> str:
     return f"the {n}x{n} matrix is not Sarymsakov"
 
 
+def _source_components(n: int, pred: list[int]) -> int:
+    """Number of source strongly connected components of the digraph whose node i has
+    in-neighbour mask pred[i] (iterative Kosaraju on bitmasks)."""
+    succ = [0] * n
+    for i in range(n):
+        for u in _bits(pred[i]):
+            succ[u] |= 1 << i
+    seen, finish = 0, []
+    for v in range(n):
+        if seen >> v & 1:
+            continue
+        seen |= 1 << v
+        stack = [(v, succ[v])]
+        while stack:
+            u, rest = stack[-1]
+            rest &= ~seen
+            if rest:
+                w = (rest & -rest).bit_length() - 1
+                stack[-1] = (u, rest & ~(1 << w))
+                seen |= 1 << w
+                stack.append((w, succ[w]))
+            else:
+                stack.pop()
+                finish.append(u)
+    comp = [-1] * n
+    ncomp = 0
+    for v in reversed(finish):
+        if comp[v] >= 0:
+            continue
+        todo = [v]
+        comp[v] = ncomp
+        while todo:
+            u = todo.pop()
+            for w in _bits(pred[u]):
+                if comp[w] < 0:
+                    comp[w] = ncomp
+                    todo.append(w)
+        ncomp += 1
+    fed = [False] * ncomp
+    for i in range(n):
+        for u in _bits(pred[i]):
+            if comp[u] != comp[i]:
+                fed[comp[i]] = True
+    return fed.count(False)
+
+
+MAX_SARYMSAKOV_ENUM_N = 12
+
+
+def _kind_sarymsakov(c: dict, ctx: _Ctx) -> str:
+    """The matrix is Sarymsakov. Method ``matching``: a permutation sigma with
+    a_{u,sigma(u)} > 0; then I(V) ⊇ sigma(V), so a failing pair needs I(V_k) = sigma(V_k),
+    i.e. each V_k has no in-edge from outside in the digraph D (u -> i iff
+    a_{i,sigma(u)} > 0); two disjoint such sets exist iff D has two source components.
+    Method ``enumeration`` (n <= 12): all pairs. Method ``min_cut``: trusted."""
+    m = _method(c, "certificate")
+    if m == "matching":
+        _obj(c, "certificate", _HEAD + ("method", "n", "support", "matching"))
+        n, row = _support_rows(c)
+        sigma = _perm(c["matching"], "matching", n)
+        for u, j in enumerate(sigma):
+            if not row[u] >> j & 1:
+                raise Invalid(f"matching: a[{u}][{j}] is not in the support")
+        where = [0] * n
+        for u, j in enumerate(sigma):
+            where[j] = u  # where[j] = sigma^-1(j)
+        pred = [0] * n
+        for i in range(n):
+            for j in _bits(row[i]):
+                if where[j] != i:
+                    pred[i] |= 1 << where[j]
+        k = _source_components(n, pred)
+        if k != 1:
+            raise Invalid(f"the matching digraph has {k} source components: not Sarymsakov")
+        return f"the {n}x{n} matrix is Sarymsakov (matching)"
+    if m == "enumeration":
+        _obj(c, "certificate", _HEAD + ("method", "n", "support"))
+        n, row = _support_rows(c)
+        if n > MAX_SARYMSAKOV_ENUM_N:
+            raise Invalid(f"too large to enumerate (n={n}>{MAX_SARYMSAKOV_ENUM_N})")
+        infl = [0] * (1 << n)  # I(V) for every V
+        for V in range(1, 1 << n):
+            low = V & -V
+            infl[V] = infl[V ^ low] | row[low.bit_length() - 1]
+        full = (1 << n) - 1
+        for V1 in range(1, 1 << n):
+            rest = full & ~V1
+            V2 = rest
+            while V2:
+                if not infl[V1] & infl[V2] and \
+                        (infl[V1] | infl[V2]).bit_count() <= (V1 | V2).bit_count():
+                    raise Invalid(f"V1 = {_fmt(V1)}, V2 = {_fmt(V2)} fail the Sarymsakov "
+                                  "condition (found by enumeration)")
+                V2 = (V2 - 1) & rest
+        return f"the {n}x{n} matrix is Sarymsakov (enumeration)"
+    if m == "min_cut":
+        _obj(c, "certificate", _HEAD + ("method", "n", "support"))
+        _support_rows(c)
+        ctx.trust("min_cut")
+        return "Sarymsakov (min_cut: trusted)"
+    raise Invalid(f"certificate: unknown method '{m}' for kind 'sarymsakov'")
+
+
 KINDS: dict[str, Callable[[dict, _Ctx], str]] = {
     "not_rs_robust": _kind_not_rs_robust,
     "rs_robust": _kind_rs_robust,
     "robustness": _kind_robustness,
     "not_sarymsakov": _kind_not_sarymsakov,
+    "sarymsakov": _kind_sarymsakov,
 }
 
 

@@ -14,6 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import csr_matrix
 
+import rescon
 from rescon.errors import InputError
 from rescon.graphs.sarymsakov import SarymsakovResult, is_sarymsakov
 from rescon.io import read_graph
@@ -51,8 +52,10 @@ def _check_answer(S: np.ndarray, r: SarymsakovResult) -> None:
     assert r.exact
     if r.holds:
         assert r.witness is None
-        assert r.certificate == {"rescon_certificate": 1, "kind": "sarymsakov",
-                                 "method": "enumeration", "n": n, "support": support}
+        cert = r.certificate
+        assert cert["kind"] == "sarymsakov" and cert["support"] == support and cert["n"] == n
+        assert cert["method"] in ("matching", "enumeration")
+        assert rescon.check_certificate(cert).valid
     else:
         V1, V2 = r.witness
         assert V1 and V2 and not V1 & V2 and _fails(S, V1, V2)
@@ -198,3 +201,37 @@ def test_input_errors(A, pattern):
 def test_bad_time_limit(limit):
     with pytest.raises(InputError, match="time_limit must be a positive number of seconds"):
         is_sarymsakov(np.eye(2), time_limit=limit)
+
+
+def test_holds_certificates_are_checked_not_trusted():
+    """A Sarymsakov matrix gets a `sarymsakov` certificate the checker verifies
+    (matching: polynomial; enumeration: n ≤ 12); tampering with it is caught."""
+    import copy
+    import json
+    from pathlib import Path
+
+    import jsonschema
+
+    schema = json.loads((Path(__file__).parents[1] / "certificates" / "schema"
+                         / "certificate.schema.json").read_text())
+    A = np.full((4, 4), 0.25)
+    res = rescon.is_sarymsakov(A)
+    cert = res.certificate
+    assert res.holds and cert["kind"] == "sarymsakov" and cert["method"] == "matching"
+    jsonschema.validate(cert, schema)
+    check = rescon.check_certificate(cert)
+    assert check.valid and check.trusted == ()
+    # the identity support has n source components: a claimed matching proof must fail
+    bad = copy.deepcopy(cert)
+    bad["support"] = [[i, i] for i in range(4)]
+    bad["matching"] = [0, 1, 2, 3]
+    assert "source components" in rescon.check_certificate(bad).reason
+    bad = copy.deepcopy(cert)
+    bad["matching"] = [0, 0, 1, 2]
+    assert not rescon.check_certificate(bad).valid
+    # enumeration re-checks: the identity is not Sarymsakov
+    enum = {"rescon_certificate": 1, "kind": "sarymsakov", "method": "enumeration", "n": 3,
+            "support": [[0, 0], [1, 1], [2, 2]]}
+    assert not rescon.check_certificate(enum).valid
+    enum["support"] = [[i, j] for i in range(3) for j in range(3)]
+    assert rescon.check_certificate(enum).valid

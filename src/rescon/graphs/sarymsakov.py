@@ -50,8 +50,9 @@ class SarymsakovResult:
         :math:`|I(V_1)| + |I(V_2)| \\le |V_1| + |V_2|`. None iff ``holds``.
     certificate : dict or None
         JSON-ready (certificates/FORMAT.md): kind ``not_sarymsakov`` with the
-        witness, or kind ``sarymsakov`` (method ``enumeration``: the checker
-        re-enumerates). None when the search was cut by the time limit.
+        witness, or kind ``sarymsakov`` (method ``matching``: the perfect
+        matching, checked in polynomial time; ``enumeration`` for n ≤ 12; else
+        ``min_cut``, accepted on trust). None when the time limit cut the search.
     exact : bool
         False only if ``time_limit`` stopped the search before a decision.
     method : str
@@ -133,11 +134,11 @@ def is_sarymsakov(A: Any, *, time_limit: float | None = None) -> SarymsakovResul
         witness, exact, method = _source_components(S, sigma), True, "matching"
     else:
         witness, exact = _min_cut_search(S, deadline)
-        method = "min_cut"
+        method, sigma = "min_cut", None
     return SarymsakovResult(
         holds=witness is None,
         witness=witness,
-        certificate=_certificate(S, witness) if exact else None,
+        certificate=_certificate(S, witness, sigma) if exact else None,
         exact=exact,
         method=method,
     )
@@ -223,11 +224,19 @@ def _min_cut_search(S: np.ndarray, deadline: float | None) -> tuple[_Pair | None
     return None, True
 
 
-def _certificate(S: np.ndarray, witness: _Pair | None) -> dict[str, Any]:
+def _certificate(S: np.ndarray, witness: _Pair | None,
+                 sigma: np.ndarray | None) -> dict[str, Any]:
+    """``sarymsakov`` (method ``matching`` with the perfect matching, or
+    ``enumeration`` for n ≤ 12, else ``min_cut``, which the checker accepts on
+    trust) or ``not_sarymsakov`` with the failing pair."""
     n = S.shape[0]
     support = [[int(i), int(j)] for i, j in zip(*np.nonzero(S))]
     if witness is None:
-        return {"rescon_certificate": 1, "kind": "sarymsakov", "method": "enumeration",
-                "n": n, "support": support}
+        head = {"rescon_certificate": 1, "kind": "sarymsakov"}
+        if sigma is not None:
+            return {**head, "method": "matching", "n": n, "support": support,
+                    "matching": [int(j) for j in sigma]}
+        method = "enumeration" if n <= 12 else "min_cut"
+        return {**head, "method": method, "n": n, "support": support}
     return {"rescon_certificate": 1, "kind": "not_sarymsakov", "n": n, "support": support,
             "witness": {"V1": sorted(witness[0]), "V2": sorted(witness[1])}}
