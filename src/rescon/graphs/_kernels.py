@@ -129,6 +129,37 @@ def branch_node(cand: np.uint64, Q: np.uint64, inmask: np.ndarray, outmask: np.n
     return u
 
 
+@njit(cache=True, nogil=True)
+def prefix_mask(order: np.ndarray, k: int) -> np.uint64:
+    """The set {order[0], ..., order[k-1]}."""
+    B = ZERO
+    for j in range(k):
+        B |= U1 << np.uint64(order[j])
+    return B
+
+
+@njit(cache=True, nogil=True)
+def tightest_member(members: np.uint64, S: np.uint64, allowed: np.uint64,
+                    inmask: np.ndarray, r: int, n: int):
+    """Among ``members`` (⊆ S) with ≥ r in-neighbours outside S, the one whose
+    candidates (in-neighbours in ``allowed`` \\ S) exceed its need (|N(i) \\ S| − r + 1)
+    by the least. Returns (slack, candidates); (n + 1, 0) when there is none."""
+    best_slack = n + 1
+    best_cand = ZERO
+    m = members
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        outside = popcount(inmask[i] & ~S)
+        if outside >= r:
+            cand = inmask[i] & allowed & ~S
+            slack = popcount(cand) - (outside - r + 1)
+            if slack < best_slack:
+                best_slack = slack
+                best_cand = cand
+    return best_slack, best_cand
+
+
 # rows of the search stack
 SK_S, SK_X, SK_P, SK_Q, SK_DP, SK_DQ = 0, 1, 2, 3, 4, 5
 STACK_WIDTH = 6
@@ -181,9 +212,7 @@ def decide_step(
             if root >= n:
                 state[ST_STATUS] = UNSAT
                 break
-            B = ZERO
-            for j in range(root):
-                B |= U1 << np.uint64(order[j])
+            B = prefix_mask(order, root)
             ubuf[UB_B] = B
             S0 = U1 << np.uint64(order[root])
             stack[0, SK_S] = S0
@@ -219,19 +248,7 @@ def decide_step(
             ntok += 1
             progress[0] += 0.5 ** depth / n
             continue
-        best_slack = n + 1
-        best_cand = ZERO
-        m = S
-        while m:
-            i = low_index(m)
-            m &= ~(U1 << np.uint64(i))
-            out = popcount(inmask[i] & ~S)
-            if out >= r:
-                cand = inmask[i] & P & ~S
-                slack = popcount(cand) - (out - r + 1)
-                if slack < best_slack:
-                    best_slack = slack
-                    best_cand = cand
+        best_slack, best_cand = tightest_member(S, S, P, inmask, r, n)
         if best_cand == ZERO:
             ubuf[UB_W1] = S
             ubuf[UB_W2] = Q
@@ -435,9 +452,7 @@ def min_cost_step(
             if root >= n or state[CS_BEST] == 0:
                 state[CS_STATUS] = UNSAT
                 break
-            B = ZERO
-            for j in range(root):
-                B |= U1 << np.uint64(order[j])
+            B = prefix_mask(order, root)
             ubuf[CB_B] = B
             stack[0, CK_S] = U1 << np.uint64(order[root])
             stack[0, CK_X] = B
@@ -513,19 +528,7 @@ def min_cost_step(
             sp += 2
             continue
         # 2. a closed-to-be member short of inside in-neighbours: take one more
-        best_slack = n + 1
-        best_cand = ZERO
-        m = M
-        while m:
-            i = low_index(m)
-            m &= ~(U1 << np.uint64(i))
-            outside = popcount(inmask[i] & ~S)
-            if outside >= r:
-                cand = inmask[i] & ~S & ~X
-                slack = popcount(cand) - (outside - r + 1)
-                if slack < best_slack:
-                    best_slack = slack
-                    best_cand = cand
+        best_slack, best_cand = tightest_member(M, S, full & ~X, inmask, r, n)
         if best_slack < 0:
             progress[0] += 0.5 ** depth / n
             continue  # some member of M can no longer be closed

@@ -69,6 +69,15 @@ def _mask_array(ig: IndexedGraph) -> np.ndarray:
     return np.array(ig.in_masks(), dtype=np.uint64)
 
 
+def _out_mask_array(ig: IndexedGraph) -> np.ndarray:
+    """outmask[u] = the nodes that receive from u."""
+    out = np.zeros(ig.n, dtype=np.uint64)
+    for v, nbrs in enumerate(ig.in_nbrs):
+        for u in nbrs:
+            out[u] |= np.uint64(1) << np.uint64(v)
+    return out
+
+
 def _bits(mask: int) -> frozenset[int]:
     return frozenset(i for i in range(int(mask).bit_length()) if (int(mask) >> i) & 1)
 
@@ -102,10 +111,7 @@ def decide_r_robust(
         raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
     inmask = _mask_array(ig)
     order = search_order(ig)
-    outmask = np.zeros(n, dtype=np.uint64)
-    for v, nbrs in enumerate(ig.in_nbrs):
-        for u in nbrs:
-            outmask[u] |= np.uint64(1) << np.uint64(v)
+    outmask = _out_mask_array(ig)
     stack = np.zeros((2 * n + 2, K.STACK_WIDTH), dtype=np.uint64)
     stack_depth = np.zeros(2 * n + 2, dtype=np.int64)
     state = np.zeros(K.STATE_LEN, dtype=np.int64)
@@ -174,10 +180,7 @@ def min_cost_pair(
     if n > MAX_SEARCH_NODES:
         raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
     inmask = _mask_array(ig)
-    outmask = np.zeros(n, dtype=np.uint64)
-    for v, nbrs in enumerate(ig.in_nbrs):
-        for u in nbrs:
-            outmask[u] |= np.uint64(1) << np.uint64(v)
+    outmask = _out_mask_array(ig)
     order = search_order(ig)
     stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
     depth = np.zeros(3 * n + 3, dtype=np.int64)
