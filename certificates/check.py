@@ -20,6 +20,7 @@ JSON arrays may also be given as Python tuples when ``check`` is called directly
 from __future__ import annotations
 
 import json
+from fractions import Fraction
 import sys
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -558,6 +559,62 @@ def _proof_dp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
     return "dp (re-verified by enumeration)"
 
 
+MAX_SPECTRAL_N = 200
+
+
+def _positive_definite(M: list[list[Fraction]]) -> int:
+    """-1 when the symmetric rational matrix M is positive definite, else the index of
+    the first non-positive pivot of its exact LDLᵀ elimination."""
+    A = [row[:] for row in M]
+    n = len(A)
+    for k in range(n):
+        piv = A[k][k]
+        if piv <= 0:
+            return k
+        for i in range(k + 1, n):
+            f = A[i][k] / piv
+            if f:
+                Ai, Ak = A[i], A[k]
+                for j in range(k + 1, n):
+                    Ai[j] -= f * Ak[j]
+    return -1
+
+
+def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
+    """Undirected G: rho >= ceil(lambda2 / 2) (for |S| <= n/2 the edge boundary is
+    >= lambda2 |S| (n - |S|) / n >= lambda2 |S| / 2). Valid iff G is symmetric,
+    c >= 2(r - 1) and lambda2 > c, shown by L - c I + (c/n + 1) J positive definite
+    (J = all ones: the ones vector gets n > 0, its complement the eigenvalues of L
+    minus c)."""
+    _obj(p, where, ("method", "c"))
+    if s != 1:
+        raise Invalid(f"{where}: method 'spectral' proves r-robustness only (s = 1), got s = {s}")
+    n = g.n
+    if n > MAX_SPECTRAL_N:
+        raise Invalid(f"{where}: too large for the exact spectral check (n={n}>{MAX_SPECTRAL_N})")
+    if not isinstance(p["c"], str):
+        raise Invalid(f"{where}.c must be a rational as a string like \"13/4\", got {_tname(p['c'])}")
+    try:
+        c = Fraction(p["c"])
+    except (ValueError, ZeroDivisionError):
+        raise Invalid(f"{where}.c = {p['c']!r} is not a rational number") from None
+    if c < 2 * (r - 1):
+        raise Invalid(f"{where}: c = {c} < 2(r - 1) = {2 * (r - 1)}: lambda2 > c does not give r")
+    for i, mk in enumerate(g.inmask):
+        for j in _bits(mk):
+            if not g.inmask[j] >> i & 1:
+                raise Invalid(f"{where}: graph is not undirected: edge [{j}, {i}] has no reverse")
+    off = c / n + 1
+    M = [[off - (1 if g.inmask[i] >> j & 1 else 0) for j in range(n)] for i in range(n)]
+    for i in range(n):
+        M[i][i] = g.inmask[i].bit_count() - c + off
+    k = _positive_definite(M)
+    if k >= 0:
+        raise Invalid(f"{where}: lambda2 > c = {c} fails (L - cI + (c/n+1)J has a "
+                      f"non-positive pivot at {k})")
+    return "spectral"
+
+
 def _proof_cost_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
     _obj(p, where, ("method", "order"), ("info",))
     _perm(p["order"], f"{where}.order", g.n)
@@ -591,6 +648,7 @@ METHODS: dict[str, ProofFn] = {
     "implied": _proof_implied,
     "milp": _proof_milp,
     "cost_search": _proof_cost_search,
+    "spectral": _proof_spectral,
 }
 
 

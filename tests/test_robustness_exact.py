@@ -105,3 +105,28 @@ def test_race_uses_the_milp_on_dense_graphs_and_says_so():
     assert res.holds
     if res.proof_method == "milp":
         assert rescon.check_certificate(res.certificate).trusted == ("milp",)
+
+
+def test_spectral_bound_is_sound_and_checked_exactly():
+    """ρ ≥ ⌈λ2/2⌉ on undirected graphs: the bound holds against the exact ρ, the
+    checker verifies λ2 > c in exact arithmetic and rejects an inflated c."""
+    from rescon.graphs.bounds import spectral_r
+
+    for seed in range(4):
+        G = nx.random_regular_graph(4 + 2 * (seed % 2), 14, seed=seed)
+        ig = index_graph(G)
+        r, proof = spectral_r(ig)
+        assert r <= leblanc_rho(G)
+        if proof is None:
+            continue
+        cert = {"rescon_certificate": 1, "kind": "rs_robust", "graph": ig.graph_json(),
+                "r": r, "s": 1, "proof": proof}
+        jsonschema.validate(cert, SCHEMA)
+        assert rescon.check_certificate(cert).valid
+        lam2 = sorted(nx.laplacian_spectrum(G))[1]
+        bad = json.loads(json.dumps(cert))
+        bad["proof"]["c"] = str(int(lam2) + 1)  # above λ2: not positive definite
+        bad["r"] = max(r, (int(lam2) + 2) // 2)
+        assert not rescon.check_certificate(bad).valid
+    directed = nx.gnp_random_graph(12, 0.9, directed=True, seed=1)
+    assert spectral_r(index_graph(directed)) == (0, None)

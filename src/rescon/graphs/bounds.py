@@ -10,12 +10,14 @@ format of certificates/FORMAT.md:
   ≥ r + s − 1 in-neighbours among the earlier ones (adding such a node preserves
   (r, s)-robustness);
 * ``implied``: (r', s')-robust ⇒ (r, s)-robust when r' ≥ r and s' ≥ s, or when
-  r' ≥ r + s − 1 (for s' ≥ 1).
+  r' ≥ r + s − 1 (for s' ≥ 1);
+* ``spectral`` (undirected): ρ ≥ ⌈λ2/2⌉, with a rational c < λ2 checked exactly.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, Iterable
 
 import networkx as nx
@@ -37,6 +39,8 @@ __all__ = [
     "greedy_order",
     "s_candidates",
     "closure_order",
+    "is_undirected",
+    "spectral_r",
 ]
 
 Proof = dict[str, Any]
@@ -307,3 +311,44 @@ def construction_proof(
                 "seed_proof": {"method": "complete"},
             }
     return None
+
+
+SPECTRAL_MAX_NODES = 200  # the checker verifies the bound by exact elimination, O(n³)
+
+
+def is_undirected(ig: IndexedGraph) -> bool:
+    """True when every edge has its reverse (the in-neighbour relation is symmetric)."""
+    return all(v in ig.in_nbrs[u] for v, s in enumerate(ig.in_nbrs) for u in s)
+
+
+@lru_cache(maxsize=8)
+def spectral_r(ig: IndexedGraph) -> tuple[int, Proof | None]:
+    """ρ ≥ ⌈λ2/2⌉ for an undirected graph, with a ``spectral`` proof.
+
+    For |S| ≤ n/2 the edge boundary is ≥ λ2 |S| (n − |S|)/n ≥ λ2 |S|/2, so some member
+    of S has ≥ λ2/2 neighbours outside; the smaller set of any pair has ≤ n/2 nodes.
+    The proof gives a rational c with 2(r − 1) ≤ c < λ2 (half-way into the gap, so
+    float error cannot matter); the checker verifies λ2 > c exactly by showing
+    L − c·I + (c/n + 1)·J is positive definite. Returns (0, None) when the bound
+    gives nothing, the graph is directed, or n > ``SPECTRAL_MAX_NODES``.
+    """
+    from fractions import Fraction
+
+    n = ig.n
+    if n > SPECTRAL_MAX_NODES or not is_undirected(ig):
+        return 0, None
+    L = np.zeros((n, n))
+    for v, s in enumerate(ig.in_nbrs):
+        L[v, v] = len(s)
+        for u in s:
+            L[v, u] = -1.0
+    lam2 = float(np.linalg.eigvalsh(L)[1])
+    r = int(np.ceil(lam2 / 2 - 1e-9))
+    while r >= 1:
+        floor_c = 2 * (r - 1)
+        gap = lam2 - floor_c
+        if gap > 2e-3:
+            c = Fraction(floor_c) + Fraction(int(gap / 2 * 1000), 1000)
+            return r, {"method": "spectral", "c": str(c)}
+        r -= 1
+    return 0, None

@@ -160,7 +160,8 @@ def _half_pair(ig: IndexedGraph) -> bd.Pair:
 def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]], *,
                  seed_search: bool = False, deadline: float | None = None) -> Proof | None:
     """A proof of (r, s)-robustness from the bounds, if one gives it: trivial, degree,
-    complete, construction from a clique, or (s = 1, ``seed_search``) construction
+    complete, construction from a clique, spectral (undirected: ⌈λ2/2⌉ ≥ r + s − 1),
+    or (s = 1, ``seed_search``) construction
     from a small seed proven r-robust by a short search (≤ 1 s, and within
     ``deadline``)."""
     if r <= 0:
@@ -170,6 +171,10 @@ def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]], *,
     if bd.is_complete(ig):
         return {"method": "complete"} if ig.n >= 2 * r - 1 else None
     proof = bd.construction_proof(ig, r, s, seeds=seeds)
+    if proof is None:
+        r_spec, spec = bd.spectral_r(ig)
+        if spec is not None and r_spec >= r + s - 1:
+            proof = spec if s == 1 else {"method": "implied", "r": r_spec, "s": 1, "proof": spec}
     if proof is None and s == 1 and seed_search:
         proof = _searched_seed_construction(ig, r, deadline)
     return proof
