@@ -471,7 +471,12 @@ def robustness(
     >>> import networkx as nx, rescon
     >>> rep = rescon.robustness(nx.complete_graph(6))
     >>> rep.r_max, rep.s_max, rep.lower_proof
-    (3, 6, 'complete')
+    (3, 6, 'degree')
+    >>> rep = rescon.robustness(nx.cycle_graph(8))
+    >>> rep.r_max, rep.lower_proof, sorted(map(sorted, rep.witness))
+    (1, 'construction', [[0, 1], [2, 3, 4, 5, 6, 7]])
+    >>> rescon.check_certificate(rep.certificate).valid
+    True
     """
     t0 = time.perf_counter()
     deadline = _check_options(method, time_limit)
