@@ -447,6 +447,9 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
     n = g.n
     order = _perm(p["order"], f"{where}.order", n)
     if p["tree"] is None:
+        if n <= MAX_ENUM_N:
+            _enumerate_or_fail(where, g, r, s)
+            return "search (tree not recorded: re-verified by enumeration)"
         ctx.trust("search")
         return "search (tree not recorded: trusted)"
     tree = _array(p["tree"], f"{where}.tree")
@@ -592,8 +595,10 @@ def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) ->
     n = g.n
     if n > MAX_SPECTRAL_N:
         raise Invalid(f"{where}: too large for the exact spectral check (n={n}>{MAX_SPECTRAL_N})")
-    if not isinstance(p["c"], str):
-        raise Invalid(f"{where}.c must be a rational as a string like \"13/4\", got {_tname(p['c'])}")
+    if not isinstance(p["c"], str) or len(p["c"]) > 64 or \
+            not all(ch in "0123456789/" for ch in p["c"]):
+        raise Invalid(f"{where}.c must be a nonnegative rational string like \"13/4\" "
+                      f"(at most 64 characters), got {p['c']!r}")
     try:
         c = Fraction(p["c"])
     except (ValueError, ZeroDivisionError):
@@ -631,6 +636,9 @@ def _proof_milp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str
     if not isinstance(p["solver"], str) or not p["solver"]:
         raise Invalid(f"{where}.solver must be a nonempty string")
     _info(p, where)
+    if g.n <= MAX_ENUM_N:
+        _enumerate_or_fail(where, g, r, s)
+        return "milp (re-verified by enumeration)"
     ctx.trust("milp")
     return "milp (trusted)"
 

@@ -719,7 +719,7 @@ def test_robustness_half_and_lower_on_trust():
             "lower_s": {"method": "milp", "solver": "highs"},
             "upper_r": {"method": "half"}, "upper_s": None}
     res = check(cert)
-    assert res.valid and res.trusted == ("milp",)
+    assert res.valid and res.trusted == ()  # n <= 20: milp is re-verified by enumeration
     cert["lower"] = cert["lower_s"] = {"method": "complete"}
     res = check(cert)
     assert res.valid and res.trusted == ()
@@ -878,10 +878,16 @@ def test_labels_and_non_dict():
     for x in (None, [], "x", 3):
         res = check(x)
         assert not res.valid and "JSON object" in res.reason
+    # a milp proof on a small graph is re-verified by enumeration: a false claim fails
     res = check({"rescon_certificate": 1, "kind": "rs_robust", "graph": {"n": 3, "edges": []},
                  "r": 1, "s": 1, "proof": {"method": "milp", "solver": "highs",
                                           "info": {"anything": [1, 2]}}})
-    assert res.valid and res.trusted == ("milp",) and bool(res)
+    assert not res.valid and "enumeration" in res.reason and not bool(res)
+    res = check({"rescon_certificate": 1, "kind": "rs_robust",
+                 "graph": {"n": 3, "edges": complete_edges(3)},
+                 "r": 1, "s": 1, "proof": {"method": "milp", "solver": "highs",
+                                          "info": {"anything": [1, 2]}}})
+    assert res.valid and res.trusted == () and bool(res)
 
 
 def test_trusted_nested_dp_and_milp():
@@ -969,8 +975,7 @@ def test_cli_exit_codes(tmp_path):
     assert p.returncode == 0 and p.stdout.strip() == "valid", p.stderr
 
     trusted = tmp_path / "milp.json"
-    c = _base()
-    c["proof"] = {"method": "milp", "solver": "highs"}
+    c = rs_cert(21, complete_edges(21), 2, 1, {"method": "milp", "solver": "highs"})
     trusted.write_text(json.dumps(c))
     p = _run(trusted)
     assert p.returncode == 0

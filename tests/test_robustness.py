@@ -615,9 +615,9 @@ def test_tamper_misc():
     cert["upper_r"] = {"method": "half"}  # rho = 1 < ceil(6/2)
     assert not _checker_ok(cert)
     cert = copy.deepcopy(rep.certificate)
-    cert["lower"] = {"method": "milp", "solver": "highs"}  # trusted: still only for a true claim
+    cert["lower"] = {"method": "milp", "solver": "highs"}  # small n: re-verified, not trusted
     res = rescon.check_certificate(cert)
-    assert res.valid and res.trusted == ("milp",)
+    assert res.valid and res.trusted == ()
     cert["r_max"] = 2
     assert not _checker_ok(cert)  # upper_r witness does not violate 3
 

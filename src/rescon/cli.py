@@ -13,6 +13,7 @@ import sys
 from typing import Any, Callable, Sequence
 
 from .errors import RESCONError, TimeLimitReached
+from .graphs.robustness import METHODS
 
 __all__ = ["main"]
 
@@ -52,6 +53,9 @@ def _emit(result: dict[str, Any], as_json: bool, lines: list[str]) -> None:
         print("\n".join(lines))
 
 
+
+
+
 def _cmd_robustness(args: argparse.Namespace) -> int:
     from .graphs.robustness import is_rs_robust, max_s, robustness
     from .io import read_graph
@@ -85,9 +89,10 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         res = is_rs_robust(G, args.r, 1, **kw)
         _write_certificate(res.certificate, args.certificate)
         s_max: int | None = 0 if res.holds is False else None
-        if res.holds:
+        left = None if args.time_limit is None else args.time_limit - res.seconds
+        if res.holds and (left is None or left > 0):
             try:
-                s_max = max_s(G, args.r, **kw)
+                s_max = max_s(G, args.r, method=args.method, time_limit=left)
             except TimeLimitReached:
                 s_max = None
         out = {"r": args.r, "r_robust": res.holds, "s_max": s_max,
@@ -115,7 +120,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         return check_main([args.certificate])
     try:
         cert = load(args.certificate)
-    except (ValueError, OSError) as exc:  # what the checker calls unreadable
+    except (ValueError, OSError, RecursionError) as exc:  # what the checker calls unreadable
         print(json.dumps({"valid": False, "readable": False, "reason": str(exc)}))
         return 2
     res = check(cert)
@@ -162,7 +167,7 @@ def _parser() -> argparse.ArgumentParser:
     rob.add_argument("--undirected", action="store_true", help="treat edges as undirected")
     rob.add_argument("--time-limit", type=_positive_float, metavar="SEC",
                      help="stop and report proven bounds after SEC seconds")
-    rob.add_argument("--method", default="auto", choices=["auto", "search", "milp", "dp"],
+    rob.add_argument("--method", default="auto", choices=METHODS,
                      help="exact method when the bounds do not meet")
     rob.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
     rob.add_argument("--json", action="store_true", help="one JSON object on stdout")

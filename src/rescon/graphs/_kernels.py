@@ -296,7 +296,7 @@ def min_pair_cost(inmask: np.ndarray, r: int):
     big = np.int8(127)
     c = np.empty(N, dtype=np.int8)
     h = np.empty(N, dtype=np.int8)
-    arg = np.empty(N, dtype=np.int64)
+    arg = np.empty(N, dtype=np.int32)
     c[0] = 0
     h[0] = big
     arg[0] = 0
@@ -309,7 +309,7 @@ def min_pair_cost(inmask: np.ndarray, r: int):
                     cnt += 1
         c[S] = cnt
         h[S] = big if cnt == popcount(su) else cnt
-        arg[S] = S
+        arg[S] = np.int32(S)
     for b in range(n):
         bit = np.int64(1) << b
         for S in range(N):
@@ -353,19 +353,21 @@ def core_free(U: np.uint64, free: np.uint64, inmask: np.ndarray, r: int) -> np.u
 
 
 @njit(cache=True, nogil=True)
-def cheapest_side(U: np.uint64, budget: int, inmask: np.ndarray, r: int, out: np.ndarray) -> np.int64:
-    """Fewest charged nodes Q2 ⊆ U (at most ``budget``) such that some nonempty A2 ⊆ U \\ Q2
-    has every member with < r in-neighbours outside A2 ∪ Q2; -1 if none.
+def cheapest_side(U: np.uint64, least: int, budget: int, inmask: np.ndarray, r: int,
+                  out: np.ndarray) -> np.int64:
+    """Fewest charged nodes Q2 ⊆ U (between ``least``, already proven necessary, and
+    ``budget``) such that some nonempty A2 ⊆ U \\ Q2 has every member with < r
+    in-neighbours outside A2 ∪ Q2; -1 if none.
 
-    Then S2 = A2 ∪ Q2 has |reach_r(S2)| ≤ |Q2| and a closed member. Tries |Q2| = 0, 1, 2, ...
-    by enumerating subsets of U; writes (A2, Q2) into ``out``.
+    Then S2 = A2 ∪ Q2 has |reach_r(S2)| ≤ |Q2| and a closed member. Tries |Q2| = least,
+    least + 1, ... by enumerating subsets of U; writes (A2, Q2) into ``out``.
     """
-    n = inmask.shape[0]
-    A = core(U, inmask, r)
-    if A != ZERO:
-        out[0] = A
-        out[1] = ZERO
-        return 0
+    if least == 0:
+        A = core(U, inmask, r)
+        if A != ZERO:
+            out[0] = A
+            out[1] = ZERO
+            return 0
     members = np.empty(64, dtype=np.int64)
     k = 0
     m = U
@@ -375,7 +377,7 @@ def cheapest_side(U: np.uint64, budget: int, inmask: np.ndarray, r: int, out: np
         members[k] = i
         k += 1
     idx = np.empty(64, dtype=np.int64)
-    for size in range(1, min(budget, k) + 1):
+    for size in range(max(least, 1), min(budget, k) + 1):
         for t in range(size):
             idx[t] = t
         while True:
@@ -415,6 +417,7 @@ def min_cost_step(
     outmask: np.ndarray,
     order: np.ndarray,
     r: int,
+    lower: int,
     stack: np.ndarray,
     stack_depth: np.ndarray,
     state: np.ndarray,
@@ -429,11 +432,15 @@ def min_cost_step(
     for, unconstrained), |Q1| + |Q2| ≤ c, and every member of A_k ≠ ∅ with < r
     in-neighbours outside S_k. S1 is enumerated from root order[k] (the first node of
     S1 ∪ S2; B = order[:k] is outside both), state (S, X, C, M): S ⊆ S1, X ∩ S1 = ∅,
-    C ⊆ S charged, M ⊆ S must be closed. With budget b = best − 1 − |C| (``best`` is
-    the incumbent in state[CS_BEST]):
+    C ⊆ S charged, M ⊆ S must be closed. Unmarked members with r in-neighbours in X
+    can no longer be closed: they are charged too (F). The budget b = best − 1 − |C| −
+    |F| bounds the charges still to come (``best`` is the incumbent, state[CS_BEST]):
 
-    * S2's uncharged part is (r + b)-closed, so core_{r+b}(V \\ S \\ B) ≠ ∅ is needed;
-    * S1's uncharged part is (r + |C| + b)-closed and avoids X, so M ⊆ core(V \\ X);
+    * S2's uncharged part A2 has |N(i) \\ A2| ≤ r − 1 + |Q2| for its members, so it
+      lies in core_{r+k}(V \\ S \\ B) for k = |Q2|: the least k making that core
+      nonempty is a lower bound on |Q2|, and k > b prunes;
+    * S1's uncharged part avoids X and has |N(i) \\ (A1 ∪ C ∪ F)| ≤ r − 1 + (b − k), so
+      M ⊆ core at threshold r + b − k of V \\ X with C ∪ F counted inside;
     * a member of M with r in-neighbours in X cannot be closed.
 
     An unmarked member of S with ≥ r outside in-neighbours is charged or marked
@@ -449,7 +456,7 @@ def min_cost_step(
     side = np.zeros(2, dtype=np.uint64)
     while done < max_nodes:
         if sp == 0:
-            if root >= n or state[CS_BEST] == 0:
+            if root >= n or state[CS_BEST] <= lower:
                 state[CS_STATUS] = UNSAT
                 break
             B = prefix_mask(order, root)
@@ -471,14 +478,14 @@ def min_cost_step(
         done += 1
         nc = popcount(C)
         # unmarked members that can no longer be closed must be charged
-        forced = 0
+        F = ZERO
         m = S & ~C & ~M
         while m:
             i = low_index(m)
             m &= ~(U1 << np.uint64(i))
             if popcount(inmask[i] & X) >= r:
-                forced += 1
-        budget = state[CS_BEST] - 1 - nc - forced
+                F |= U1 << np.uint64(i)
+        budget = state[CS_BEST] - 1 - nc - popcount(F)
         prune = budget < 0
         if not prune:
             # S2 needs ≥ k charges when core_{r+k−1}(V \ S \ B) is empty
@@ -489,8 +496,10 @@ def min_cost_step(
             if k > budget:
                 prune = True
             else:
-                budget -= k
-                if M & ~core(full & ~X, inmask, r + nc + forced + k + budget):
+                # uncharged members i of S1 have |N(i) \\ (A1 ∪ C ∪ F)| ≤ r − 1 + (charges
+                # still to come on side 1) ≤ r − 1 + budget − k
+                free = C | F
+                if M & ~core_free(full & ~X & ~free, free, inmask, r + budget - k):
                     prune = True
         if not prune:
             m = M
@@ -554,7 +563,7 @@ def min_cost_step(
             sp += 2
             continue
         # 3. S1 = S is settled at cost |C|: the cheapest S2 outside S ∪ B
-        k2 = cheapest_side(full & ~S & ~B, state[CS_BEST] - 1 - nc, inmask, r, side)
+        k2 = cheapest_side(full & ~S & ~B, k, state[CS_BEST] - 1 - nc, inmask, r, side)
         if k2 >= 0:
             state[CS_BEST] = nc + k2
             ubuf[CB_W1] = S

@@ -16,6 +16,7 @@ omitted for r-robustness where every member must be closed).
 
 from __future__ import annotations
 
+import threading
 import time
 from dataclasses import dataclass
 
@@ -126,14 +127,17 @@ class RobustnessMilp:
         self._t0 = 0.0
 
     def start(self) -> None:
+        """Solve in a thread of our own (highspy's startSolve shares class-level locks
+        between instances, so two solves in one process would interfere)."""
         self._t0 = time.perf_counter()
-        self._thread = self.h.startSolve()
+        self._thread = threading.Thread(target=self.h.run, daemon=True)
+        self._thread.start()
 
     def running(self) -> bool:
-        return self.h.is_solver_running()
+        return self._thread is not None and self._thread.is_alive()
 
     def cancel(self) -> None:
-        """Stop a background solve and wait for its thread."""
+        """Stop a background solve (through HiGHS's interrupt callback) and wait."""
         if self._thread is not None:
             self.h.cancelSolve()
             self._thread.join()
@@ -143,14 +147,17 @@ class RobustnessMilp:
         """Wait for the solve and map HiGHS's status onto the shared status set."""
         if self._thread is None:
             self.start()
-        assert self._thread is not None
-        self._thread.join()
+        thread = self._thread
+        if thread is None:
+            raise SolverError("the robustness MILP did not start")
+        thread.join()
         self._thread = None
         seconds = time.perf_counter() - self._t0
         h = self.h
         S = self._highspy.HighsModelStatus
         status = h.getModelStatus()
-        if status == S.kInfeasible:
+        if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
+            # every variable is a bounded binary: the model cannot be unbounded
             return MilpOutcome("infeasible", None, None, seconds)
         if status not in (S.kOptimal, S.kTimeLimit, S.kInterrupt):
             raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} "

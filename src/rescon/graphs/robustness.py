@@ -8,8 +8,9 @@ r-robust).
 
 Strategy: polynomial bounds first (witness pairs above; degree, complete and
 construction proofs below); only when they do not meet, an exact method: the
-bitmask branch and bound (n ≤ 64, its search tree is the certificate) or the
-improved MILP for ρ; the subset DP (n ≤ 26) or the MILP for s*.
+bitmask branch and bound (n ≤ 64, its search tree is the certificate) raced against
+the improved MILP for ρ; for s*, the subset DP (n ≤ 22), else the charged-set branch
+and bound raced against the MILP (n ≤ 64), else the MILP.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from typing import Any, Callable, Hashable
 
 import numpy as np
 
-from ..errors import InputError, SolverError, TimeLimitReached
+from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
 from .indexed import IndexedGraph, index_graph
 from .milp import MilpOutcome, RobustnessMilp, milp_min_cost
@@ -62,7 +63,7 @@ class RobustnessReport:
         when r_max = ⌈n/2⌉ (no n-node graph is more robust).
     s_witness : (S1, S2) showing G is not (r_max, s_max + 1)-robust, None if s_max = n.
     lower_proof : how r_max was proven ("trivial", "degree", "complete",
-        "construction", "search", "milp", "dp").
+        "construction", "spectral", "implied", "search", "milp", "dp").
     certificate : JSON-ready ``robustness`` certificate (certificates/FORMAT.md).
     exact : False only when ``time_limit`` cut the search; then ρ ∈ [r_lower, r_upper].
     method : the exact method that ran ("bounds" when the bounds met).
@@ -235,8 +236,8 @@ def _decide_r(
             return _Decision(True, proof={"method": "dp"}, method="dp")
         assert pair is not None
         return _Decision(False, pair=pair, method="dp")
-    return _milp_decision(milp_min_cost(ig, r, upper=1, decision_only=True,
-                                        time_limit=_remaining(deadline)))
+    return _milp_decision(ig, r, milp_min_cost(ig, r, upper=1, decision_only=True,
+                                               time_limit=_remaining(deadline)))
 
 
 def _search_decision(out: SearchOutcome) -> _Decision:
@@ -250,13 +251,16 @@ def _search_decision(out: SearchOutcome) -> _Decision:
                                   "info": {"nodes": out.nodes}}, method="search")
 
 
-def _milp_decision(out: MilpOutcome) -> _Decision:
+def _milp_decision(ig: IndexedGraph, r: int, out: MilpOutcome) -> _Decision:
     if out.status == "infeasible":
         return _Decision(True, proof={"method": "milp", "solver": "highs",
                                       "info": {"seconds": round(out.seconds, 3)}}, method="milp")
     if out.pair is None:
         return _Decision(None, method="milp")
-    return _Decision(False, pair=bd.Pair(*out.pair), method="milp")
+    pair = bd.Pair(*out.pair)
+    if not (pair.S1 and pair.S2 and bd.violates(ig, pair, r, 1)):
+        raise SolverError(f"the robustness MILP returned a pair that does not violate {r}-robustness")
+    return _Decision(False, pair=pair, method="milp")
 
 
 def _race(ig: IndexedGraph, r: int, deadline: float | None,
@@ -281,7 +285,7 @@ def _race(ig: IndexedGraph, r: int, deadline: float | None,
     if deadline is not None and time.perf_counter() > deadline:
         milp.cancel()
         return _Decision(None, method="search+milp")
-    return _milp_decision(milp.outcome())
+    return _milp_decision(ig, r, milp.outcome())
 
 
 def _dp_min_cost(ig: IndexedGraph, r: int) -> tuple[int, bd.Pair | None]:
@@ -356,7 +360,7 @@ def _s_star(
             return _SStar(n, n, n, {"method": "dp"}, None, "dp")
         return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
     if method == "search":
-        return _cost_search_result(ig, r, min_cost_pair(ig, r, upper, deadline=deadline),
+        return _cost_search_result(ig, r, min_cost_pair(ig, r, upper, lower=lower, deadline=deadline),
                                    lower, upper, proof, pair)
     return _milp_s_result(ig, r, _milp_s(ig, r, lower, upper, deadline).outcome(), lower, upper,
                           proof, pair)
@@ -391,7 +395,9 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
     if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
-        assert cost is not None and cost <= out.best, "cost search returned a dearer pair"
+        if cost is None or cost > out.best:
+            raise RESCONError(f"internal error: the s* search returned a pair of cost {cost} "
+                              f"for a claimed {out.best}")
         upper, pair = cost, found
     if out.status == "stopped":
         return _SStar(None, lower, upper, proof, pair, "search")
@@ -406,7 +412,7 @@ def _race_s(ig: IndexedGraph, r: int, lower: int, upper: int, proof: Proof,
     milp = _milp_s(ig, r, lower, upper, deadline)
     milp.start()
     try:
-        out = min_cost_pair(ig, r, upper, deadline=deadline,
+        out = min_cost_pair(ig, r, upper, lower=lower, deadline=deadline,
                             should_stop=lambda: not milp.running())
     except BaseException:
         milp.cancel()
@@ -451,8 +457,9 @@ def robustness(
     Parameters
     ----------
     G : networkx.Graph or DiGraph; edge (u, v) means v receives u's state.
-    method : "auto" (bounds, then search for n ≤ 64 else MILP; s* by DP for n ≤ 26
-        else MILP), or force "search", "milp" or "dp" for the exact steps.
+    method : "auto" (bounds, then the search raced against the MILP for n ≤ 64, the
+        MILP beyond; s* by the DP for n ≤ 22, else the charged-set search raced
+        against the MILP), or force "search" (n ≤ 64), "milp" or "dp" (n ≤ 26).
     time_limit : seconds; when reached, returns proven bounds with ``exact=False``.
     undirected : treat the edges of a DiGraph as undirected.
     progress : show a progress bar (default: when stderr is a terminal).
@@ -481,6 +488,7 @@ def robustness(
     t0 = time.perf_counter()
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
+    _check_method_size(method, ig.n)
     n = ig.n
     seeds = bd.greedy_cliques(ig)
     up_value, up_pair = bd.upper_witness(ig)
@@ -565,6 +573,7 @@ def is_rs_robust(
     t0 = time.perf_counter()
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
+    _check_method_size(method, ig.n)
     r = _int_arg("r", r, 0)
     s = _int_arg("s", s, 1, ig.n)
     seeds = bd.greedy_cliques(ig)
@@ -631,6 +640,7 @@ def max_s(
     """
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
+    _check_method_size(method, ig.n)
     r = _int_arg("r", r, 0)
     if r == 0:
         return ig.n

@@ -124,11 +124,13 @@ def decide_r_robust(
                       tokens, record, _SLICE, progress)
         status = state[K.ST_STATUS]
         if status == K.NEED_ROOM:
-            if 2 * tokens.shape[0] > MAX_TREE_TOKENS:
+            if tokens.shape[0] >= MAX_TREE_TOKENS:
                 record = False
                 tokens = np.empty(1, dtype=np.int32)
             else:
-                tokens = np.concatenate([tokens, np.empty_like(tokens)])
+                grown = np.empty(min(2 * tokens.shape[0], MAX_TREE_TOKENS), dtype=np.int32)
+                grown[: tokens.shape[0]] = tokens
+                tokens = grown
             continue
         if on_progress is not None:
             on_progress(float(progress[0]))
@@ -165,11 +167,13 @@ def min_cost_pair(
     r: int,
     upper: int,
     *,
+    lower: int = 0,
     deadline: float | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> CostOutcome:
     """s*(r) = min |reach_r(S1)| + |reach_r(S2)| over pairs whose sets both keep an
-    r-closed member, searched below ``upper`` (a known pair's cost, or n).
+    r-closed member, searched below ``upper`` (a known pair's cost, or n); the search
+    ends early when it finds a pair of cost ``lower`` (a proven lower bound).
 
     Exact branch and bound over S1 with charged members (see
     ``_kernels.min_cost_step``); n ≤ 64.
@@ -190,7 +194,8 @@ def min_cost_pair(
     progress = np.zeros(1, dtype=np.float64)
     status = "done"
     while True:
-        K.min_cost_step(inmask, outmask, order, r, stack, depth, state, ubuf, _SLICE, progress)
+        K.min_cost_step(inmask, outmask, order, r, lower, stack, depth, state, ubuf, _SLICE,
+                        progress)
         if state[K.CS_STATUS] != K.RUNNING:
             break
         if (deadline is not None and time.perf_counter() > deadline) or (
