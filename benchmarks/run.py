@@ -287,12 +287,14 @@ def _row(inst: Instance, method: str, a: Answer | None, seconds: float | None,
     }
 
 
-def _warmup(cand_fn: Callable[[nx.Graph], Answer], insts: list[Instance], log: Any) -> None:
+def _warmup(cand_fn: Callable[..., Answer], insts: list[Instance], log: Any,
+            time_limit: float) -> None:
     """Compile numba kernels (baselines and candidate) before anything is timed.
 
     The candidate is run once on two tiny graphs and on the first instance of each
     family at the smallest size in the run (so size-dependent code paths are
-    compiled too). Failures here are not fatal: they show up as error rows later.
+    compiled too), each within the run's time limit. Failures here are not fatal:
+    they show up as error rows later.
     """
     t0 = time.perf_counter()
     B.leblanc_warmup()
@@ -305,7 +307,7 @@ def _warmup(cand_fn: Callable[[nx.Graph], Answer], insts: list[Instance], log: A
             seen.add(inst.name)
             small.append(inst.G)
     for G in small:
-        _guard(lambda G=G: cand_fn(G))()
+        _guard(lambda G=G: cand_fn(G, time_limit))()
     print(f"warm-up {time.perf_counter() - t0:.1f} s", file=log, flush=True)
 
 
@@ -319,7 +321,7 @@ def run_robustness(cfg: Config, log: Any = sys.stderr) -> int:
     cfg.out.mkdir(parents=True, exist_ok=True)
     csv_path = cfg.out / f"{cfg.stem}.csv"
     md_path = cfg.out / f"{cfg.stem}.md"
-    _warmup(cand_fn, insts, log)
+    _warmup(cand_fn, insts, log, cfg.time_limit)
 
     rows: list[dict[str, Any]] = []
     n_err = 0

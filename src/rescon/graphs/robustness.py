@@ -490,9 +490,15 @@ def robustness(
     ig = index_graph(G, undirected=undirected)
     _check_method_size(method, ig.n)
     n = ig.n
-    seeds = bd.greedy_cliques(ig)
-    up_value, up_pair = bd.upper_witness(ig)
     half = (n + 1) // 2
+    # no graph is more than ⌈n/2⌉-robust: when the degree bound (or K_n) reaches it,
+    # nothing else is needed
+    if _cheap_proof(ig, half, n, []) is not None:
+        seeds: list[list[int]] = []
+        up_value, up_pair = half, _half_pair(ig)
+    else:
+        seeds = bd.greedy_cliques(ig)
+        up_value, up_pair = bd.upper_witness(ig)
     r_upper, r_upper_pair = (half, None) if up_value >= half else (up_value, up_pair)
     # lower bound: the best cheap proof at or below r_upper
     r_lower, lower = 0, {"method": "trivial"}
