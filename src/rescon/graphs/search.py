@@ -65,6 +65,16 @@ def search_order(ig: IndexedGraph) -> np.ndarray:
     return np.lexsort((np.arange(ig.n), deg)).astype(np.int64)
 
 
+def _kernel_inputs(ig: IndexedGraph):
+    """(kernels module, in-masks, out-masks, root order) for a search on ig (n ≤ 64).
+    numba is imported here, on first use, not with rescon."""
+    from . import _kernels
+
+    if ig.n > MAX_SEARCH_NODES:
+        raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {ig.n}")
+    return _kernels, _mask_array(ig), _out_mask_array(ig), search_order(ig)
+
+
 def _mask_array(ig: IndexedGraph) -> np.ndarray:
     return np.array(ig.in_masks(), dtype=np.uint64)
 
@@ -104,14 +114,8 @@ def decide_r_robust(
     should_stop : polled between slices; True abandons the search ("stopped"),
         e.g. when a racing MILP has answered.
     """
-    from . import _kernels as K  # numba: imported on first use, not with rescon
-
+    K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
-    if n > MAX_SEARCH_NODES:
-        raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
-    inmask = _mask_array(ig)
-    order = search_order(ig)
-    outmask = _out_mask_array(ig)
     stack = np.zeros((2 * n + 2, K.STACK_WIDTH), dtype=np.uint64)
     stack_depth = np.zeros(2 * n + 2, dtype=np.int64)
     state = np.zeros(K.STATE_LEN, dtype=np.int64)
@@ -178,14 +182,8 @@ def min_cost_pair(
     Exact branch and bound over S1 with charged members (see
     ``_kernels.min_cost_step``); n ≤ 64.
     """
-    from . import _kernels as K
-
+    K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
-    if n > MAX_SEARCH_NODES:
-        raise ValueError(f"the bitmask search handles n ≤ {MAX_SEARCH_NODES}; got n = {n}")
-    inmask = _mask_array(ig)
-    outmask = _out_mask_array(ig)
-    order = search_order(ig)
     stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
     depth = np.zeros(3 * n + 3, dtype=np.int64)
     state = np.zeros(K.COST_STATE_LEN, dtype=np.int64)
