@@ -76,6 +76,9 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         if rep.exact:
             lines.append(f"rho(G) = {rep.r_max} (proof: {rep.lower_proof}); "
                          f"s*({rep.r_max}) = {rep.s_max}")
+        elif rep.r_lower == rep.r_upper:
+            lines.append(f"rho(G) = {rep.r_max} (proof: {rep.lower_proof}); "
+                         f"s*({rep.r_max}) not settled before the time limit")
         else:
             lines.append(f"time limit reached: {rep.r_lower} <= rho(G) <= {rep.r_upper}")
         if rep.witness is not None:
