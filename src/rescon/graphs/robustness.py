@@ -588,9 +588,8 @@ def is_rs_robust(
         if r == 0:
             dec = _Decision(True, proof={"method": "trivial"})
         else:
-            up_value, up_pair = bd.upper_witness(ig)
-            cands = [up_pair]
-            ss = _s_star(ig, r, method, deadline, seeds, dec.proof or {"method": "trivial"}, cands)
+            assert dec.proof is not None
+            ss = _s_star_of_robust(ig, r, method, deadline, seeds, dec.proof)
             if ss.value is None and ss.lower < s <= ss.upper:
                 dec = _Decision(None, method=ss.method)
             elif ss.lower >= s:
@@ -656,11 +655,19 @@ def max_s(
         raise TimeLimitReached(f"time limit reached before deciding whether G is {r}-robust")
     if not dec.holds:
         return 0
-    _, up_pair = bd.upper_witness(ig)
-    ss = _s_star(ig, r, method, deadline, seeds, dec.proof or {"method": "trivial"}, [up_pair])
+    assert dec.proof is not None
+    ss = _s_star_of_robust(ig, r, method, deadline, seeds, dec.proof)
     if ss.value is None:
         raise TimeLimitReached(f"time limit reached: {ss.lower} ≤ s*({r}) ≤ {ss.upper}")
     return ss.value
+
+
+def _s_star_of_robust(ig: IndexedGraph, r: int, method: str, deadline: float | None,
+                      seeds: list[list[int]], r_proof: Proof) -> _SStar:
+    """s*(r) of a graph proven r-robust by ``r_proof`` (r ≥ 1), seeding the upper
+    bound with the best witness heuristic."""
+    _, up_pair = bd.upper_witness(ig)
+    return _s_star(ig, r, method, deadline, seeds, r_proof, [up_pair])
 
 
 def _progress_bar(enabled: bool | None, n: int) -> Callable[[float | None], None] | None:
