@@ -729,6 +729,28 @@ def _upper(u: Any, where: str, g: Graph, r: int, s: int, allow_half: bool) -> st
                   + (" or 'half')" if allow_half else ")"))
 
 
+_S_KEYS = ("s_lower", "s_upper", "lower_s", "upper_s")
+
+
+def _s_bounds(c: dict, g: Graph, r: int, lo: int, hi: int, ctx: _Ctx) -> None:
+    """lower_s proves (r, lo)-robust (null iff lo = 1); upper_s violates (r, hi + 1)
+    (null iff hi = n)."""
+    if lo > hi:
+        raise Invalid(f"s lower bound {lo} > s upper bound {hi}")
+    if c["lower_s"] is None:
+        if lo != 1:
+            raise Invalid(f"lower_s is null but s = {lo} > 1 needs a proof")
+    else:
+        _proof(c["lower_s"], "lower_s", g, r, lo, ctx)
+    if hi == g.n:
+        if c["upper_s"] is not None:
+            raise Invalid(f"upper_s must be null when the s upper bound is n = {g.n}")
+    else:
+        if c["upper_s"] is None:
+            raise Invalid(f"upper_s is null but the s upper bound {hi} < n = {g.n}")
+        _upper(c["upper_s"], "upper_s", g, r, hi + 1, allow_half=False)
+
+
 def _kind_robustness(c: dict, ctx: _Ctx) -> str:
     if not isinstance(c.get("exact"), bool):
         if "exact" not in c:
@@ -747,21 +769,11 @@ def _kind_robustness(c: dict, ctx: _Ctx) -> str:
             if _method(c["lower"], "lower") != "trivial":
                 raise Invalid("r_max = 0 requires lower = {\"method\": \"trivial\"}")
         _proof(c["lower"], "lower", g, r, 1, ctx)
-        if c["lower_s"] is None:
-            if s != 1:
-                raise Invalid(f"lower_s is null but s_max = {s} > 1 needs a proof")
-        else:
-            _proof(c["lower_s"], "lower_s", g, r, s, ctx)
         _upper(c["upper_r"], "upper_r", g, r + 1, 1, allow_half=True)
-        if s == g.n:
-            if c["upper_s"] is not None:
-                raise Invalid(f"upper_s must be null when s_max = n = {g.n}")
-        else:
-            if c["upper_s"] is None:
-                raise Invalid(f"upper_s is null but s_max = {s} < n = {g.n}")
-            _upper(c["upper_s"], "upper_s", g, r, s + 1, allow_half=False)
+        _s_bounds(c, g, r, s, s, ctx)
         return f"rho(G) = {r} and s*({r}) = {s} (n={g.n})"
-    _obj(c, "certificate", _HEAD + ("graph", "exact", "r_lower", "r_upper", "lower", "upper_r"))
+    _obj(c, "certificate", _HEAD + ("graph", "exact", "r_lower", "r_upper", "lower", "upper_r"),
+         optional=_S_KEYS)
     g = _graph(c["graph"])
     lo = _int(c["r_lower"], "r_lower", 0)
     hi = _int(c["r_upper"], "r_upper", 0)
@@ -769,7 +781,19 @@ def _kind_robustness(c: dict, ctx: _Ctx) -> str:
         raise Invalid(f"r_lower = {lo} > r_upper = {hi}")
     _proof(c["lower"], "lower", g, lo, 1, ctx)
     _upper(c["upper_r"], "upper_r", g, hi + 1, 1, allow_half=True)
-    return f"{lo} <= rho(G) <= {hi} (n={g.n})"
+    present = [k for k in _S_KEYS if k in c]
+    if not present:
+        return f"{lo} <= rho(G) <= {hi} (n={g.n})"
+    if len(present) < len(_S_KEYS):
+        missing = next(k for k in _S_KEYS if k not in c)
+        raise Invalid(f"certificate: missing key '{missing}' (s bounds need all of "
+                      f"{', '.join(_S_KEYS)})")
+    if lo != hi or lo == 0:
+        raise Invalid("s bounds are allowed only when rho is settled (r_lower = r_upper >= 1)")
+    s_lo = _int(c["s_lower"], "s_lower", 1, g.n)
+    s_hi = _int(c["s_upper"], "s_upper", 1, g.n)
+    _s_bounds(c, g, lo, s_lo, s_hi, ctx)
+    return f"rho(G) = {lo} and {s_lo} <= s*({lo}) <= {s_hi} (n={g.n})"
 
 
 def _support_rows(c: dict) -> tuple[int, list[int]]:

@@ -371,11 +371,33 @@ def test_time_limit_reports_bounds(capsys, tmp_path):
     assert ROBUSTNESS_KEYS <= set(data)
     if data["exact"]:
         assert set(data) == ROBUSTNESS_KEYS
-    else:
+    elif data["r_lower"] < data["r_upper"]:
         assert set(data) == ROBUSTNESS_KEYS | {"r_lower", "r_upper"}
-        assert data["r_lower"] <= data["r_upper"]
+    else:
+        assert set(data) == ROBUSTNESS_KEYS | {"r_lower", "r_upper", "s_lower", "s_upper",
+                                               "s_witness"}
     cert = json.loads(cert_path.read_text())
     assert rescon.check_certificate(cert).valid
+
+
+def test_time_limit_reports_s_bounds(capsys, tmp_path):
+    """rho settled by construction, s* cut by the time limit: bounds on s* are printed."""
+    from rescon.graphs.generators import circulant
+
+    G = circulant(64, 6).to_directed()
+    path = write_edgelist(tmp_path / "circ.edgelist", G)
+    cert_path = tmp_path / "c.json"
+    data = run_json(["robustness", path, "--time-limit", "0.3", "--certificate", cert_path],
+                    capsys)
+    assert set(data) == ROBUSTNESS_KEYS | {"r_lower", "r_upper", "s_lower", "s_upper",
+                                           "s_witness"}
+    assert (data["r_lower"], data["r_upper"], data["exact"]) == (6, 6, False)
+    assert 1 <= data["s_lower"] <= data["s_upper"] < 64
+    w = data["s_witness"]
+    assert pair_violates(G, w["S1"], w["S2"], 6, data["s_upper"] + 1)
+    assert rescon.check_certificate(json.loads(cert_path.read_text())).valid
+    assert main(["robustness", str(path), "--time-limit", "0.3"]) == 0
+    assert "<= s*(6) <=" in capsys.readouterr().out
 
 
 # --------------------------------------------------------------------------- #

@@ -689,6 +689,65 @@ def test_undirected_circulant(n, k):
             assert rho == k and rep.s_max == ss[k]
     else:
         assert rep.s_max is None and rep.certificate["exact"] is False
+        _check_s_bounds(rep, G, k)
+
+
+def _check_s_bounds(rep, G, r):
+    """rho settled, s* not: proven bounds s_lower <= s*(r) <= s_upper, in the report and
+    in the certificate, the cheapest pair found as s_witness."""
+    n = G.number_of_nodes()
+    c = rep.certificate
+    assert 1 <= rep.s_lower <= rep.s_upper <= n
+    assert (c["s_lower"], c["s_upper"]) == (rep.s_lower, rep.s_upper)
+    if rep.s_upper < n:
+        assert pair_violates(G, *rep.s_witness, r, rep.s_upper + 1)
+    else:
+        assert rep.s_witness is None
+    assert (c["lower_s"] is None) == (rep.s_lower == 1)
+
+
+def test_s_bounds_when_only_s_star_times_out():
+    """circulant(64, 6): rho = 6 by construction, s*(6) not settled in 0.3 s."""
+    G = circulant(64, 6)
+    rep = rescon.robustness(G, time_limit=0.3)
+    assert rep.r_lower == rep.r_upper == 6 and not rep.exact
+    _check_s_bounds(rep, G, 6)
+    res = check_valid(rep.certificate, G)
+    assert "<= s*(6) <=" in res.reason
+    jsonschema = pytest.importorskip("jsonschema")
+    from pathlib import Path
+
+    schema = json.loads((Path(__file__).parent.parent / "certificates" / "schema"
+                         / "certificate.schema.json").read_text())
+    validator = jsonschema.Draft202012Validator(schema)
+    validator.validate(rep.certificate)
+    partial = {k: v for k, v in rep.certificate.items() if k != "upper_s"}
+    assert not validator.is_valid(partial)
+    cert = rep.certificate
+    # s_upper one below what the witness pair shows: rejected
+    bad = copy.deepcopy(cert)
+    bad["s_upper"] -= 1
+    assert not _checker_ok(bad)
+    # s_lower above what its proof proves
+    bad = copy.deepcopy(cert)
+    bad["s_lower"] = bad["s_upper"]
+    assert not _checker_ok(bad)
+    bad = copy.deepcopy(cert)
+    bad["s_lower"], bad["s_upper"] = bad["s_upper"], bad["s_lower"]
+    assert not _checker_ok(bad)
+    # all four keys or none
+    for key in ("s_lower", "s_upper", "lower_s", "upper_s"):
+        bad = copy.deepcopy(cert)
+        del bad[key]
+        assert not _checker_ok(bad)
+    # s bounds need rho settled
+    bad = copy.deepcopy(cert)
+    bad["r_lower"] -= 1
+    bad["lower"] = {"method": "implied", "r": 6, "s": 1, "proof": cert["lower"]}
+    assert not _checker_ok(bad)
+    trimmed = {k: v for k, v in cert.items() if k not in ("s_lower", "s_upper", "lower_s",
+                                                             "upper_s")}
+    assert _checker_ok(trimmed)
 
 
 def _dcirc_rho(n, k):

@@ -72,13 +72,16 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
                "seconds": round(rep.seconds, 6)}
         if not rep.exact:
             out.update(r_lower=rep.r_lower, r_upper=rep.r_upper)
+            if rep.s_lower is not None:
+                out.update(s_lower=rep.s_lower, s_upper=rep.s_upper,
+                           s_witness=_pair_json(rep.s_witness))
         lines = [f"n = {rep.n}"]
         if rep.exact:
             lines.append(f"rho(G) = {rep.r_max} (proof: {rep.lower_proof}); "
                          f"s*({rep.r_max}) = {rep.s_max}")
         elif rep.r_lower == rep.r_upper:
-            lines.append(f"rho(G) = {rep.r_max} (proof: {rep.lower_proof}); "
-                         f"s*({rep.r_max}) not settled before the time limit")
+            lines.append(f"rho(G) = {rep.r_max} (proof: {rep.lower_proof}); time limit "
+                         f"reached: {rep.s_lower} <= s*({rep.r_max}) <= {rep.s_upper}")
         else:
             lines.append(f"time limit reached: {rep.r_lower} <= rho(G) <= {rep.r_upper}")
         if rep.witness is not None:

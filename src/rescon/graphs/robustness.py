@@ -61,13 +61,17 @@ class RobustnessReport:
     s_max : s*(r_max), or None when the time limit stopped before it was settled.
     witness : (S1, S2) in node labels showing G is not (r_max + 1)-robust, or None
         when r_max = ⌈n/2⌉ (no n-node graph is more robust).
-    s_witness : (S1, S2) showing G is not (r_max, s_max + 1)-robust, None if s_max = n.
+    s_witness : (S1, S2) showing G is not (r_max, s_max + 1)-robust, None if s_max = n;
+        when only s* hit the time limit, the cheapest pair found (not (r_max, s_upper + 1)).
     lower_proof : how r_max was proven ("trivial", "degree", "complete",
         "construction", "spectral", "implied", "search", "milp", "dp").
     certificate : JSON-ready ``robustness`` certificate (certificates/FORMAT.md).
-    exact : False only when ``time_limit`` cut the search; then ρ ∈ [r_lower, r_upper].
+    exact : False only when ``time_limit`` cut the search; then ρ ∈ [r_lower, r_upper],
+        and when ρ was settled but s*(ρ) was not, s*(ρ) ∈ [s_lower, s_upper].
     method : the exact method that ran ("bounds" when the bounds met).
     seconds : wall time.
+    s_lower, s_upper : proven bounds on s*(r_max) (both equal s_max when exact; None
+        when ρ itself was not settled).
     """
 
     n: int
@@ -82,6 +86,8 @@ class RobustnessReport:
     r_upper: int
     method: str
     seconds: float
+    s_lower: int | None = None
+    s_upper: int | None = None
 
 
 @dataclass(frozen=True)
@@ -541,10 +547,13 @@ def robustness(
         ss = _s_star(ig, rho, method, deadline, seeds, lower, candidates)
     if ss.value is None:
         cert = {**_head("robustness", ig), "exact": False, "r_lower": rho, "r_upper": rho,
-                "lower": lower, "upper_r": _upper_json(r_upper_pair)}
-        return RobustnessReport(n, rho, None, _labels(ig, r_upper_pair), None,
+                "lower": lower, "upper_r": _upper_json(r_upper_pair),
+                "s_lower": ss.lower, "s_upper": ss.upper,
+                "lower_s": None if ss.lower == 1 else ss.proof,
+                "upper_s": None if ss.upper == n else _upper_json(ss.pair)}
+        return RobustnessReport(n, rho, None, _labels(ig, r_upper_pair), _labels(ig, ss.pair),
                                 lower["method"], cert, False, rho, rho, used,
-                                time.perf_counter() - t0)
+                                time.perf_counter() - t0, s_lower=ss.lower, s_upper=ss.upper)
     if ss.method != "bounds":
         used = ss.method if used == "bounds" else f"{used}+{ss.method}"
     cert = {**_head("robustness", ig), "exact": True, "r_max": rho, "s_max": ss.value,
@@ -553,7 +562,7 @@ def robustness(
             "upper_s": None if ss.value == n else _upper_json(ss.pair)}
     return RobustnessReport(n, rho, ss.value, _labels(ig, r_upper_pair), _labels(ig, ss.pair),
                             lower["method"], cert, True, rho, rho, used,
-                            time.perf_counter() - t0)
+                            time.perf_counter() - t0, s_lower=ss.value, s_upper=ss.value)
 
 
 def is_rs_robust(
