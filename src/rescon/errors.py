@@ -43,3 +43,7 @@ class CertificateError(RESCONError, ValueError):
 
 class TimeLimitReached(RESCONError, RuntimeError):
     """A time limit stopped a computation before it had an answer to return."""
+
+
+class EmptyKernel(RESCONError, ValueError):
+    """The safe kernel Ψ(X, F) is empty, so it has no point (F is too large for X)."""

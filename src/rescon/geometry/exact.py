@@ -1,0 +1,214 @@
+"""Exact arithmetic for point sets: integer coordinates, ranks, affine hulls.
+
+Every float is a dyadic rational m·2^e, so a point set X ∈ R^{n×d} of floats is
+exactly ``X_int / D`` for one power of two D and a Python-int matrix ``X_int``.
+All combinatorial decisions of the safe-kernel code (which side of a hyperplane a
+point lies on, affine dimensions) are taken on these integers, or on floats only
+when a rounding-error bound proves the float answer right.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from math import gcd
+
+import numpy as np
+
+__all__ = [
+    "ExactPoints",
+    "exact_points",
+    "bareiss_rank",
+    "AffineHull",
+    "affine_hull",
+    "solve_exact",
+    "nullspace_exact",
+    "int_vector",
+]
+
+
+@dataclass(frozen=True)
+class ExactPoints:
+    """X = ints / scale exactly, with ``ints`` a tuple of rows of Python ints."""
+
+    ints: tuple[tuple[int, ...], ...]
+    scale: int  # a power of two
+
+    @property
+    def n(self) -> int:
+        return len(self.ints)
+
+    def fraction(self, i: int) -> tuple[Fraction, ...]:
+        return tuple(Fraction(v, self.scale) for v in self.ints[i])
+
+
+def exact_points(X: np.ndarray) -> ExactPoints:
+    """The exact integer form of a finite float array (n, d)."""
+    ratios = [[float(v).as_integer_ratio() for v in row] for row in X.tolist()]
+    scale = max((den for row in ratios for _, den in row), default=1)
+    ints = tuple(tuple(num * (scale // den) for num, den in row) for row in ratios)
+    return ExactPoints(ints, scale)
+
+
+def bareiss_rank(rows: list[list[int]]) -> tuple[int, list[int], list[int]]:
+    """Rank of an integer matrix by fraction-free (Bareiss) elimination.
+
+    Returns (rank, pivot columns, pivot rows) — the pivot rows index ``rows``
+    and give a maximal independent subset of them.
+    """
+    if not rows:
+        return 0, [], []
+    m = [list(r) for r in rows]
+    order = list(range(len(m)))
+    ncols = len(m[0])
+    rank, prev = 0, 1
+    pivots: list[int] = []
+    for col in range(ncols):
+        pr = next((i for i in range(rank, len(m)) if m[i][col] != 0), None)
+        if pr is None:
+            continue
+        m[rank], m[pr] = m[pr], m[rank]
+        order[rank], order[pr] = order[pr], order[rank]
+        piv = m[rank][col]
+        for i in range(rank + 1, len(m)):
+            f = m[i][col]
+            row_i, row_r = m[i], m[rank]
+            for j in range(col, ncols):
+                row_i[j] = (row_i[j] * piv - f * row_r[j]) // prev
+        prev = piv
+        pivots.append(col)
+        rank += 1
+        if rank == len(m):
+            break
+    return rank, pivots, order[:rank]
+
+
+@dataclass(frozen=True)
+class AffineHull:
+    """aff(X) of an exact point set: dimension k, k+1 affinely independent points
+    ``basis`` (indices, basis[0] the origin), and k ``coords`` such that projecting
+    onto those coordinates is injective on aff(X)."""
+
+    dim: int
+    basis: tuple[int, ...]
+    coords: tuple[int, ...]
+
+    def lift(self, P: ExactPoints, y: tuple[Fraction, ...]) -> tuple[Fraction, ...]:
+        """The point of aff(X) whose ``coords`` are y (exact)."""
+        o = P.fraction(self.basis[0])
+        if self.dim == 0:
+            return o
+        if self.dim == len(o):  # full-dimensional: the coordinates are all of x
+            return tuple(y)
+        dirs = [[Fraction(P.ints[b][j] - P.ints[self.basis[0]][j], P.scale)
+                 for j in range(len(o))] for b in self.basis[1:]]
+        # y - o[coords] = Σ c_i dirs_i[coords]
+        M = [[dirs[i][c] for i in range(self.dim)] for c in self.coords]
+        rhs = [y[t] - o[c] for t, c in enumerate(self.coords)]
+        coef = solve_exact(M, rhs)
+        assert coef is not None, "projection onto the pivot coordinates is injective"
+        return tuple(o[j] + sum(coef[i] * dirs[i][j] for i in range(self.dim))
+                     for j in range(len(o)))
+
+    def equalities(self, P: ExactPoints) -> list[tuple[tuple[Fraction, ...], Fraction]]:
+        """d − k independent equalities a·x = b satisfied by every point of aff(X):
+        x_j = (the affine function of the pivot coordinates) for each other j."""
+        d = len(P.ints[0])
+        out = []
+        for j in range(d):
+            if j in self.coords:
+                continue
+            # x_j − Σ_t g_t x_{coords[t]} = h on aff(X): fit through the basis points
+            rows = [[Fraction(P.ints[b][c], P.scale) for c in self.coords] + [Fraction(1)]
+                    for b in self.basis]
+            rhs = [Fraction(P.ints[b][j], P.scale) for b in self.basis]
+            sol = solve_exact(rows, rhs)
+            assert sol is not None
+            a = [Fraction(0)] * d
+            a[j] = Fraction(1)
+            for t, c in enumerate(self.coords):
+                a[c] -= sol[t]
+            out.append((tuple(a), sol[-1]))
+        return out
+
+
+def affine_hull(P: ExactPoints) -> AffineHull:
+    """Exact affine hull of the points (Bareiss on the differences p_i − p_0)."""
+    p0 = P.ints[0]
+    diffs = [[a - b for a, b in zip(row, p0, strict=True)] for row in P.ints[1:]]
+    diffs_t = [list(col) for col in zip(*diffs, strict=True)] if diffs else []
+    # rank and pivot *rows* of the transposed matrix = pivot coordinates
+    k, _, coords = bareiss_rank(diffs_t)
+    if k == 0:
+        return AffineHull(0, (0,), ())
+    _, _, rows = bareiss_rank(diffs)
+    return AffineHull(k, (0, *(r + 1 for r in sorted(rows))), tuple(sorted(coords)))
+
+
+def solve_exact(M: list[list[Fraction]], rhs: list[Fraction]) -> list[Fraction] | None:
+    """The unique solution of M c = rhs (M with at least as many rows as columns), or
+    None when M has dependent columns or the system is inconsistent."""
+    n = len(M)
+    A = [list(map(Fraction, row)) + [Fraction(r)] for row, r in zip(M, rhs, strict=True)]
+    ncols = len(A[0]) - 1  # n ≥ ncols: an overdetermined system must be consistent
+    for col in range(ncols):
+        pr = next((i for i in range(col, n) if A[i][col] != 0), None)
+        if pr is None:
+            return None
+        A[col], A[pr] = A[pr], A[col]
+        piv = A[col][col]
+        A[col] = [v / piv for v in A[col]]
+        for i in range(n):
+            if i != col and A[i][col] != 0:
+                f = A[i][col]
+                A[i] = [vi - f * vc for vi, vc in zip(A[i], A[col], strict=True)]
+    for i in range(ncols, n):  # extra rows must be consistent
+        if A[i][-1] != 0:
+            return None
+    return [A[i][-1] for i in range(ncols)]
+
+
+def nullspace_exact(M: list[list[Fraction]]) -> list[list[Fraction]]:
+    """A basis of {c : M c = 0} (exact reduced row echelon form)."""
+    if not M:
+        return []
+    A = [list(map(Fraction, row)) for row in M]
+    rows, cols = len(A), len(A[0])
+    pivots: list[int] = []
+    r = 0
+    for col in range(cols):
+        pr = next((i for i in range(r, rows) if A[i][col] != 0), None)
+        if pr is None:
+            continue
+        A[r], A[pr] = A[pr], A[r]
+        piv = A[r][col]
+        A[r] = [v / piv for v in A[r]]
+        for i in range(rows):
+            if i != r and A[i][col] != 0:
+                f = A[i][col]
+                A[i] = [vi - f * vr for vi, vr in zip(A[i], A[r], strict=True)]
+        pivots.append(col)
+        r += 1
+        if r == rows:
+            break
+    free = [c for c in range(cols) if c not in pivots]
+    basis = []
+    for fc in free:
+        v = [Fraction(0)] * cols
+        v[fc] = Fraction(1)
+        for i, pc in enumerate(pivots):
+            v[pc] = -A[i][fc]
+        basis.append(v)
+    return basis
+
+
+def int_vector(v: list[Fraction]) -> tuple[int, ...]:
+    """The primitive integer vector with the direction of the rational vector v."""
+    den = 1
+    for x in v:
+        den = den * x.denominator // gcd(den, x.denominator)
+    ints = [int(x * den) for x in v]
+    g = 0
+    for x in ints:
+        g = gcd(g, x)
+    return tuple(x // g for x in ints) if g else tuple(ints)

@@ -1,0 +1,205 @@
+"""The valid halfspaces of Ψ(X, F): hyperplanes through k points with ≤ F outside.
+
+In coordinates where the points span R^k (see :mod:`.exact`), Tukey-depth theory
+gives
+
+    Ψ(X, F) = ⋂ { {y : a·y ≤ a·p_0} : a ⊥ a hyperplane through k affinely
+                  independent points p_0..p_{k−1}, #{q : a·q > a·p_0} ≤ F },
+
+O(n^k) candidates instead of C(n, F) subsets. Each candidate's side counts are
+decided by the float filter of :mod:`._candidates`; the undecided ones (points within
+the rounding-error bound of the hyperplane, or degenerate subsets) are re-decided in
+exact integer arithmetic, so the set returned never depends on a tolerance.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from math import comb, factorial, gcd
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["Halfspaces", "valid_halfspaces", "candidate_cost", "MAX_CANDIDATE_COST"]
+
+#: refuse inputs whose candidate enumeration needs more point tests than this
+MAX_CANDIDATE_COST = 4_000_000_000
+_EPS = 2.0**-53
+
+
+@dataclass
+class Halfspaces:
+    """Valid halfspaces, halfspace h being sign[h] · C_h · (y − p_0) ≤ 0 for the
+    hyperplane through the k points ``through[h]`` (indices into the unique points).
+
+    Floats (unscaled coordinates, for guidance): ``af[h]·y ≤ bf[h]`` with per-entry
+    error ≤ ``err[h]`` · (|y|_1 + 1)-weighted bound terms given by ``af_abs``
+    (see :func:`rescon.geometry.polytope.clip_to_fixpoint`). Exact (scaled integer
+    coordinates): :meth:`exact`.
+    """
+
+    Yi: list[tuple[int, ...]]
+    through: np.ndarray  # (h, k) int
+    sign: np.ndarray  # (h,) ±1
+    af: np.ndarray  # (h, k)
+    bf: np.ndarray  # (h,)
+    af_abs: np.ndarray  # (h, k) permanents bounding the error of af
+    b_abs: np.ndarray  # (h,) the same for bf
+    c_err: float
+    _cache: dict[int, tuple[tuple[int, ...], int]] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.sign)
+
+    def exact(self, h: int) -> tuple[tuple[int, ...], int]:
+        """(a, b), primitive integers: a·y ≤ b in the scaled integer coordinates."""
+        out = self._cache.get(h)
+        if out is None:
+            sub = self.through[h]
+            a = tuple(int(self.sign[h]) * c for c in exact_normal(self.Yi, sub))
+            b = sum(ai * pi for ai, pi in zip(a, self.Yi[sub[0]], strict=True))
+            out = self._cache[h] = _primitive(a, b)
+        return out
+
+
+def candidate_cost(n_unique: int, k: int) -> int:
+    """Point tests needed to classify all candidates: C(n, k) · (n − k)."""
+    return comb(n_unique, k) * max(n_unique - k, 0)
+
+
+def _permutations(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """All permutations of range(m) (rows) and their signs; one dummy row for m = 0."""
+    if m == 0:
+        return np.zeros((1, 1), dtype=np.int64), np.ones(1)
+    perms = list(itertools.permutations(range(m)))
+    signs = [-1.0 if sum(p[i] > p[j] for i in range(m) for j in range(i + 1, m)) % 2 else 1.0
+             for p in perms]
+    return np.array(perms, dtype=np.int64), np.array(signs)
+
+
+def _exact_float_bits(k: int) -> int:
+    """Integer coordinates below 2^B make the float orientation exact:
+    k! · (2^{B+1})^k < 2^53."""
+    return int((53 - np.log2(factorial(k))) // k) - 2
+
+
+def _int_det(rows: list[list[int]]) -> int:
+    m = len(rows)
+    if m == 0:
+        return 1
+    if m == 1:
+        return rows[0][0]
+    if m == 2:
+        return rows[0][0] * rows[1][1] - rows[0][1] * rows[1][0]
+    total = 0
+    for j in range(m):
+        if rows[0][j]:
+            minor = [r[:j] + r[j + 1:] for r in rows[1:]]
+            total += (-1) ** j * rows[0][j] * _int_det(minor)
+    return total
+
+
+def exact_normal(Yi: list[tuple[int, ...]], subset) -> tuple[int, ...]:
+    """Integer cofactor normal C of the hyperplane through the points ``subset``
+    (zero vector when they are affinely dependent): s(q) = C·(q − p_0)."""
+    k = len(Yi[0])
+    p0 = Yi[subset[0]]
+    D = [[Yi[i][j] - p0[j] for j in range(k)] for i in subset[1:]]
+    if k == 1:
+        return (1,)
+    out = []
+    for j in range(k):
+        minor = [row[:j] + row[j + 1:] for row in D]
+        out.append((-1) ** (k - 1 + j) * _int_det(minor))
+    return tuple(out)
+
+
+def _primitive(a: tuple[int, ...], b: int) -> tuple[tuple[int, ...], int]:
+    g = abs(b)
+    for v in a:
+        g = gcd(g, v)
+    return tuple(v // g for v in a), b // g
+
+
+def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F: int
+                     ) -> Halfspaces:
+    """All valid halfspaces of the unique points Y (float, (m, k)) with exact integer
+    coordinates Yi (Yi = Y · scale) and multiplicities W.
+
+    Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
+    """
+    from ._candidates import classify_subsets
+
+    m, k = Y.shape
+    count = comb(m, k)
+    cost = candidate_cost(m, k)
+    if cost > MAX_CANDIDATE_COST:
+        raise InputError(f"the safe kernel of {m} distinct points in dimension {k} needs "
+                         f"C({m},{k})·{m - k} ≈ {cost:.2e} point tests (limit "
+                         f"{MAX_CANDIDATE_COST:.0e}); reduce n or d")
+    perms, signs = _permutations(k - 1)
+    bits = max(abs(v) for row in Yi for v in row).bit_length()
+    exact_floats = k == 1 or bits <= _exact_float_bits(k)
+    c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
+    plus, minus, unc, degenerate, subsets, cof, cof_abs = classify_subsets(
+        np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), k, perms, signs,
+        c_err, count, F)
+    live = ~degenerate
+    sure_plus = live & (plus + unc <= F)
+    sure_minus = live & (minus + unc <= F)
+    rows: list[int] = []
+    sides: list[int] = []
+    for side, sure, cnt in ((1, sure_plus, plus), (-1, sure_minus, minus)):
+        ts = np.flatnonzero(sure)
+        rows += ts.tolist()
+        sides += [side] * len(ts)
+    maybe = live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus))
+    for t in np.flatnonzero(maybe):  # undecided by the filter: count exactly
+        n_plus, n_minus = _exact_counts(Yi, W, subsets[t])
+        if n_plus is None:
+            continue
+        if n_plus <= F and not sure_plus[t]:
+            rows.append(int(t))
+            sides.append(1)
+        if n_minus <= F and not sure_minus[t]:
+            rows.append(int(t))
+            sides.append(-1)
+    idx = np.array(rows, dtype=np.int64)
+    sign = np.array(sides, dtype=np.int64)
+    through = subsets[idx].astype(np.int64)
+    af = cof[idx] * sign[:, None]
+    p0 = Y[through[:, 0]] if len(idx) else np.zeros((0, k))
+    bf = np.einsum("ij,ij->i", af, p0)
+    af_abs = cof_abs[idx]
+    b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
+    hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, c_err)
+    # an affinely dependent subset has every other point within the rounding bound,
+    # so only subsets with no point surely off their hyperplane can be degenerate
+    suspect = [h for h in np.flatnonzero(plus[idx] + minus[idx] == 0) if not any(hs.exact(h)[0])]
+    if suspect:
+        keep = np.setdiff1d(np.arange(len(hs)), suspect)
+        hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
+                        b_abs[keep], c_err)
+    return hs
+
+
+def _exact_counts(Yi, W, subset) -> tuple[int | None, int]:
+    """Exact weighted numbers of points strictly on the + and − side of the
+    hyperplane through ``subset`` ((None, 0) if the subset is affinely dependent)."""
+    normal = exact_normal(Yi, subset)
+    if not any(normal):
+        return None, 0
+    p0 = Yi[subset[0]]
+    members = {int(i) for i in subset}
+    n_plus = n_minus = 0
+    for q, yq in enumerate(Yi):
+        if q in members:
+            continue
+        s = sum(c * (a - b) for c, a, b in zip(normal, yq, p0, strict=True))
+        if s > 0:
+            n_plus += int(W[q])
+        elif s < 0:
+            n_minus += int(W[q])
+    return n_plus, n_minus

@@ -1,0 +1,351 @@
+"""Safe kernels Ψ(X, F) = ⋂ {conv(S) : S ⊆ X, |S| = n − F}, exactly.
+
+Pipeline: exact integer form of X (:mod:`.exact`) → its affine hull aff(X) (dimension
+k, k pivot coordinates in which the projection is injective) → the valid halfspaces
+through k points with ≤ F points outside (:mod:`.halfspaces`) → exact clipping of the
+bounding box by them (:mod:`.polytope`) → vertices, facets, affine hull and a
+certificate (``safe_kernel``, or ``kernel_empty`` with Farkas multipliers).
+"""
+
+from __future__ import annotations
+
+import operator
+import time
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact
+from .halfspaces import valid_halfspaces
+from .polytope import ExactPolytope, clip_to_fixpoint
+
+__all__ = ["SafeKernel", "safe_kernel", "kernel_point", "kernel_points", "check_points", "check_F"]
+
+
+def check_points(X: Any, name: str = "X") -> np.ndarray:
+    """X as a finite float array (n, d), n ≥ 1, d ≥ 1, or InputError saying what came."""
+    try:
+        arr = np.array(X, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a finite (n, d) array of numbers; got "
+                         f"{type(X).__name__} that is not numeric ({exc})") from None
+    if arr.ndim != 2:
+        raise InputError(f"{name} must be a finite (n, d) array; got shape {arr.shape}")
+    n, d = arr.shape
+    if n == 0 or d == 0:
+        raise InputError(f"{name} must have n >= 1 points in d >= 1 dimensions; got shape "
+                         f"{arr.shape}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        nan = int(np.isnan(arr).sum())
+        raise InputError(f"{name} must be finite; got shape {arr.shape} with {nan} NaN and "
+                         f"{int(bad.sum()) - nan} infinite entries")
+    return arr
+
+
+def check_F(F: Any, n: int) -> int:
+    """F as an int with 0 ≤ F < n."""
+    if isinstance(F, bool) or not isinstance(F, (int, np.integer)):
+        raise InputError(f"F must be an integer 0 <= F < n = {n}; got {F!r}")
+    F = int(F)
+    if not 0 <= F < n:
+        raise InputError(f"F must satisfy 0 <= F < n = {n}; got F = {F}")
+    return F
+
+
+@dataclass(frozen=True)
+class _Exact:
+    """The exact data behind a SafeKernel (ambient coordinates, Fractions)."""
+
+    vertices: tuple[tuple[Fraction, ...], ...]
+    constraints: tuple[tuple[tuple[Fraction, ...], Fraction], ...]  # a·x ≤ b, tight somewhere
+    equalities: tuple[tuple[tuple[Fraction, ...], Fraction], ...]  # aff(X): a·x = b
+    facets: tuple[tuple[tuple[Fraction, ...], Fraction], ...] = ()  # relative to aff(Ψ)
+    kernel_eqs: tuple[tuple[tuple[Fraction, ...], Fraction], ...] = ()  # aff(Ψ): a·x = b
+
+    def contains(self, x: tuple[Fraction, ...]) -> bool:
+        if not self.vertices:
+            return False
+        dot = lambda a: sum(map(operator.mul, a, x))  # noqa: E731
+        return (all(dot(a) == b for a, b in self.equalities)
+                and all(dot(a) <= b for a, b in self.constraints))
+
+
+@dataclass(frozen=True)
+class SafeKernel:
+    """Ψ(X, F) as an exact polytope.
+
+    Attributes
+    ----------
+    points : the input X, (n, d).
+    F : the number of points that may be removed.
+    dim : affine dimension of Ψ (−1 when empty).
+    vertices : (m, d) floats of the exact vertices (``exact_vertices``: Fractions).
+    A, b : facets, Ψ = {x ∈ aff(Ψ) : A x ≤ b}, rows of unit norm; facets are taken
+        relative to aff(Ψ) (none when dim = 0).
+    affine_origin, affine_basis : aff(Ψ) = {origin + basisᵀ t}, basis (dim, d) with
+        orthonormal rows (origin None when empty).
+    Aeq, beq : aff(Ψ) = {x : Aeq x = beq} ((d − dim, d); empty when dim = d).
+    certificate : ``safe_kernel`` or ``kernel_empty`` certificate (certificates/FORMAT.md).
+    seconds : wall time.
+    """
+
+    points: np.ndarray = field(repr=False)
+    F: int
+    dim: int
+    vertices: np.ndarray
+    A: np.ndarray = field(repr=False)
+    b: np.ndarray = field(repr=False)
+    affine_origin: np.ndarray | None = field(repr=False)
+    affine_basis: np.ndarray = field(repr=False)
+    Aeq: np.ndarray = field(repr=False)
+    beq: np.ndarray = field(repr=False)
+    certificate: dict[str, Any] = field(repr=False)
+    seconds: float
+    exact_vertices: tuple[tuple[Fraction, ...], ...] = field(repr=False)
+    _exact: _Exact = field(repr=False, compare=False)
+
+    @property
+    def is_empty(self) -> bool:
+        return self.dim < 0
+
+    def contains(self, x: Any, tol: float = 0.0) -> bool:
+        """x ∈ Ψ. With ``tol = 0`` (default) decided exactly (x's floats are exact
+        rationals); with tol > 0, up to that distance in each constraint."""
+        xv = np.asarray(x, dtype=np.float64).reshape(-1)
+        if xv.shape != (self.points.shape[1],) or not np.isfinite(xv).all():
+            raise InputError(f"x must be a finite point of dimension {self.points.shape[1]}; "
+                             f"got shape {np.shape(x)}")
+        if self.is_empty:
+            return False
+        if tol == 0.0:
+            return self._exact.contains(tuple(Fraction(float(v)) for v in xv))
+        if tol < 0 or not np.isfinite(tol):
+            raise InputError(f"tol must be a finite number >= 0; got {tol}")
+        ok_eq = np.all(np.abs(self.Aeq @ xv - self.beq) <= tol) if len(self.beq) else True
+        ok_in = np.all(self.A @ xv - self.b <= tol) if len(self.b) else True
+        return bool(ok_eq and ok_in)
+
+    def point(self, method: str = "project", *, backend: str = "auto",
+              target: Any = None) -> tuple[np.ndarray, dict[str, Any]]:
+        """A canonical point of Ψ and its ``kernel_point`` certificate; see
+        :func:`rescon.kernel_point`."""
+        from .points import kernel_point_of
+
+        return kernel_point_of(self, method=method, backend=backend, target=target)
+
+    def plot(self, ax: Any = None, *, point: Any = None, path: Any = None) -> Any:
+        """Points, kernel and (optionally) a chosen point; d = 2 or 3 (matplotlib)."""
+        from ..plot.kernel import plot_kernel
+
+        return plot_kernel(self, ax=ax, point=point, path=path)
+
+
+def _q(x: Fraction) -> str:
+    return str(x)
+
+
+def _ambient(hull: AffineHull, d: int, a: tuple[int, ...], b: int, scale: int
+             ) -> tuple[tuple[Fraction, ...], Fraction]:
+    """a·y ≤ b on the pivot coordinates y = scale · x[coords] as an ambient halfspace."""
+    full = [Fraction(0)] * d
+    for t, c in enumerate(hull.coords):
+        full[c] = Fraction(a[t])
+    return tuple(full), Fraction(b, scale)
+
+
+def _unit_rows(rows: list[tuple[tuple[Fraction, ...], Fraction]], d: int
+               ) -> tuple[np.ndarray, np.ndarray]:
+    if not rows:
+        return np.zeros((0, d)), np.zeros(0)
+    A = np.array([[float(v) for v in a] for a, _ in rows])
+    b = np.array([float(v) for _, v in rows])
+    norm = np.linalg.norm(A, axis=1)
+    return A / norm[:, None], b / norm
+
+
+def safe_kernel(X: Any, F: Any) -> SafeKernel:
+    """Ψ(X, F) = ⋂ {conv(S) : S ⊆ X, |S| = n − F}, exactly, with a certificate.
+
+    Parameters
+    ----------
+    X : array (n, d) of finite floats (a multiset: duplicates count).
+    F : integer, 0 ≤ F < n.
+
+    Returns
+    -------
+    SafeKernel
+
+    Notes
+    -----
+    Ψ(X, F) is the Tukey-depth region of depth ≥ F + 1, the intersection of the
+    halfspaces bounded by hyperplanes through k affinely independent points of X with
+    at most F points strictly outside (k = dim aff X), so the work is O(n^{k+1})
+    side tests (numba, float-filtered, exact integers when undecided) plus an exact
+    clipping of the bounding box. Nonempty when n ≥ (d+1)F + 1 (Helly).
+
+    Examples
+    --------
+    >>> import rescon
+    >>> K = rescon.safe_kernel([[0, 0], [1, 0], [1, 1], [0, 1]], 1)
+    >>> K.dim, K.vertices.tolist()
+    (0, [[0.5, 0.5]])
+    >>> rescon.safe_kernel([[0, 0], [1, 0], [0, 1]], 1).is_empty
+    True
+    """
+    t0 = time.perf_counter()
+    Xa = check_points(X)
+    n, d = Xa.shape
+    F = check_F(F, n)
+    P = exact_points(Xa)
+    hull = affine_hull(P)
+    eqs = tuple(hull.equalities(P))
+    if hull.dim == 0:
+        poly = None
+        verts = (P.fraction(0),)
+        constraints: tuple = ()
+    else:
+        poly = _clip(P, hull, F)
+        verts = tuple(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
+                      for y in poly.fraction_vertices())
+        used = [h for h in range(len(poly.a)) if poly.tight_vertices(h)]
+        constraints = tuple(_ambient(hull, d, poly.a[h], poly.b[h], P.scale) for h in used)
+    if not verts:
+        exact = _Exact(verts, constraints, eqs)
+        cert = _empty_certificate(Xa, F, hull, poly, P.scale, d)
+        return SafeKernel(Xa, F, -1, np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), None,
+                          np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), cert,
+                          time.perf_counter() - t0, (), exact)
+    dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d)
+    facets = _relative_facets(poly, hull, P.scale, d, dim) if poly is not None else []
+    A, b = _unit_rows(facets, d)
+    exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
+    cert = {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(), "F": F,
+            "dim": dim, "vertices": [[_q(v) for v in x] for x in verts],
+            "equalities": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in eqs],
+            "facets": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in constraints],
+            "proof": {"method": "halfspaces"}}
+    V = np.array([[float(v) for v in x] for x in verts])
+    return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq, cert,
+                      time.perf_counter() - t0, verts, exact)
+
+
+def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
+    """Ψ in the pivot coordinates (scaled integers): the bounding box clipped by
+    every valid halfspace."""
+    index: dict[tuple[int, ...], int] = {}
+    weights: list[int] = []
+    rows: list[tuple[int, ...]] = []
+    first: list[int] = []
+    for i, row in enumerate(P.ints):
+        y = tuple(row[c] for c in hull.coords)
+        j = index.setdefault(y, len(rows))
+        if j == len(rows):
+            rows.append(y)
+            weights.append(0)
+            first.append(i)
+        weights[j] += 1
+    Yf = np.array([[float(r) / P.scale for r in y] for y in rows], dtype=np.float64)
+    H = valid_halfspaces(Yf, rows, np.array(weights), F)
+    lo = [min(y[j] for y in rows) for j in range(hull.dim)]
+    hi = [max(y[j] for y in rows) for j in range(hull.dim)]
+    poly = ExactPolytope.box(lo, hi)
+    clip_to_fixpoint(poly, H, P.scale)
+    return poly
+
+
+def _affine_of(verts, d: int):
+    """dim, origin, orthonormal basis and equalities (floats, and exact) of
+    aff(vertices)."""
+    v0 = verts[0]
+    diffs = [[vi - v0i for vi, v0i in zip(v, v0, strict=True)] for v in verts[1:]]
+    ns = nullspace_exact(diffs) if diffs else [
+        [Fraction(int(i == j)) for i in range(d)] for j in range(d)]
+    dim = d - len(ns)
+    origin = np.array([float(v) for v in v0])
+    if dim == 0:
+        basis = np.zeros((0, d))
+    else:
+        D = np.array([[float(v) for v in row] for row in diffs])
+        _, _, vt = np.linalg.svd(D, full_matrices=False)
+        basis = vt[:dim]
+    kernel_eqs = tuple((tuple(row), sum(r * v for r, v in zip(row, v0, strict=True)))
+                       for row in ns)
+    if ns:
+        Aeq = np.array([[float(v) for v in row] for row in ns])
+        Aeq /= np.linalg.norm(Aeq, axis=1)[:, None]
+        beq = Aeq @ origin
+    else:
+        Aeq, beq = np.zeros((0, d)), np.zeros(0)
+    return dim, origin, basis, Aeq, beq, kernel_eqs
+
+
+def _relative_facets(poly: ExactPolytope, hull: AffineHull, scale: int, d: int, dim: int):
+    """Constraints whose tight vertices span a (dim − 1)-face: the facets of Ψ relative
+    to its affine hull (implicit equalities, tight everywhere, are left out)."""
+    if dim == 0:
+        return []
+    nv = len(poly.verts)
+    out = []
+    for h in range(len(poly.a)):
+        members = poly.tight_vertices(h)
+        if 0 < len(members) < nv and poly.face_dim(members) == dim - 1:
+            out.append(_ambient(hull, d, poly.a[h], poly.b[h], scale))
+    return out
+
+
+def _empty_certificate(Xa, F, hull, poly, scale, d) -> dict[str, Any]:
+    far = poly.farkas
+    assert far is not None
+    hs = [_ambient(hull, d, poly.a[i], poly.b[i], scale) for i in far.ids]
+    return {"rescon_certificate": 1, "kind": "kernel_empty", "points": Xa.tolist(), "F": F,
+            "halfspaces": [{"a": [_q(v) for v in a], "b": _q(b)} for a, b in hs],
+            "multipliers": [_q(x) for x in far.multipliers],
+            "equalities": [], "eq_multipliers": []}
+
+
+def kernel_point(X: Any, F: Any, *, method: str = "project", backend: str = "auto",
+                 target: Any = None) -> tuple[np.ndarray, dict[str, Any]]:
+    """A canonical point of Ψ(X, F) and its ``kernel_point`` certificate.
+
+    Parameters
+    ----------
+    X, F : as for :func:`safe_kernel`.
+    method : ``"project"`` — the unique point of Ψ closest to ``target`` (default the
+        mean of X), argmin ‖x − target‖² over Ψ; ``"chebyshev"`` — the centre of the
+        largest ball in Ψ within its affine hull (not unique in general);
+        ``"vertex-mean"`` — the mean of Ψ's vertices.
+    backend : QP/LP backend that guides the exact computation ("auto": clarabel for
+        the QP, HiGHS for the LP; or any name of
+        :func:`rescon.models.kernel_models.qp_backends`). The returned point is exact
+        (KKT conditions checked in rationals), so it does not depend on the backend.
+    target : a point of R^d for ``"project"``.
+
+    Returns
+    -------
+    (x, certificate) : x as floats (rounded from the exact rational point that the
+        certificate states).
+
+    Raises
+    ------
+    EmptyKernel
+        Ψ(X, F) = ∅ (the kernel's ``kernel_empty`` certificate proves it).
+
+    Examples
+    --------
+    >>> import rescon
+    >>> x, cert = rescon.kernel_point([[0, 0], [4, 0], [0, 4], [1, 1]], 1)
+    >>> x.tolist(), cert["kind"]
+    ([1.0, 1.0], 'kernel_point')
+    """
+    return safe_kernel(X, F).point(method, backend=backend, target=target)
+
+
+def kernel_points(batch: Any, F: Any, *, method: str = "project", backend: str = "auto"
+                  ) -> np.ndarray:
+    """:func:`kernel_point` for many point sets at once: ``batch`` is (B, n, d) or a
+    list of (n_i, d) arrays; returns the (B, d) points (certificates are dropped)."""
+    return np.array([kernel_point(X, F, method=method, backend=backend)[0] for X in batch])

@@ -1,0 +1,172 @@
+"""Canonical points of a safe kernel, exact, with ``kernel_point`` certificates.
+
+* ``"project"``: the unique point of Ψ closest to a target (default: the mean of X),
+  argmin ‖x − m‖² over Ψ. A backend (:mod:`rescon.models.kernel_models`) solves the QP
+  in floats; its active facets then fix the exact answer: x = m − Eᵀν − A_Sᵀμ with
+  E x = f (aff Ψ) and A_S x = b_S, solved in rationals and accepted only if μ ≥ 0 and
+  x ∈ Ψ exactly (KKT). If the guess fails, active sets are enumerated exactly.
+  The answer is therefore the same for every backend.
+* ``"chebyshev"``: the centre of the largest ball in Ψ within aff Ψ (LP, floats), moved
+  exactly onto aff Ψ and certified inside.
+* ``"vertex-mean"``: the exact mean of Ψ's vertices.
+"""
+
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import EmptyKernel, InputError, SolverError
+from .exact import solve_exact
+
+if TYPE_CHECKING:
+    from .kernel import SafeKernel
+
+__all__ = ["kernel_point_of", "METHODS", "point_certificate"]
+
+METHODS = ("project", "chebyshev", "vertex-mean")
+MAX_ACTIVE_SETS = 200_000
+
+Vec = tuple[Fraction, ...]
+
+
+def _dot(a, x) -> Fraction:
+    return sum((ai * xi for ai, xi in zip(a, x, strict=True)), Fraction(0))
+
+
+def point_certificate(K: SafeKernel, x: Vec) -> dict[str, Any]:
+    return {"rescon_certificate": 1, "kind": "kernel_point", "points": K.points.tolist(),
+            "F": K.F, "x": [str(v) for v in x], "proof": {"method": "halfspaces"}}
+
+
+def kernel_point_of(K: SafeKernel, *, method: str, backend: str, target: Any
+                    ) -> tuple[np.ndarray, dict[str, Any]]:
+    if method not in METHODS:
+        raise InputError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
+    if K.is_empty:
+        raise EmptyKernel(f"the safe kernel is empty (n = {len(K.points)}, "
+                          f"F = {K.F}): no point to return; see the kernel's certificate")
+    if method == "vertex-mean":
+        if target is not None:
+            raise InputError("target is only used by method='project'")
+        x = _vertex_mean(K)
+    elif method == "project":
+        x = _project(K, _target(K, target), backend)
+    else:
+        if target is not None:
+            raise InputError("target is only used by method='project'")
+        x = _chebyshev(K, backend)
+    return np.array([float(v) for v in x]), point_certificate(K, x)
+
+
+def _vertex_mean(K: SafeKernel) -> Vec:
+    V = K.exact_vertices
+    return tuple(sum(col, Fraction(0)) / len(V) for col in zip(*V, strict=True))
+
+
+def _target(K: SafeKernel, target: Any) -> Vec:
+    d = K.points.shape[1]
+    if target is None:
+        n = len(K.points)
+        cols = zip(*K.points.tolist(), strict=True)
+        return tuple(sum(map(Fraction, col), Fraction(0)) / n for col in cols)
+    t = np.asarray(target, dtype=np.float64).reshape(-1)
+    if t.shape != (d,) or not np.isfinite(t).all():
+        raise InputError(f"target must be a finite point of dimension {d}; got {target!r}")
+    return tuple(Fraction(float(v)) for v in t)
+
+
+def _float_guide(K: SafeKernel, m: Vec, backend: str) -> np.ndarray:
+    from ..models.kernel_models import project
+
+    name = "clarabel" if backend in ("auto", "exact") else backend
+    return project(K.A, K.b, K.affine_origin, K.affine_basis,
+                   np.array([float(v) for v in m]), backend=name)
+
+
+def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:
+    ex = K._exact
+    if K.dim == 0:
+        return ex.vertices[0]
+    facets = list(ex.facets)
+    guess = _float_guide(K, m, backend)
+    A = K.A
+    slack = K.b - A @ guess
+    scale = 1e-7 * (1.0 + np.abs(K.b) + np.abs(A) @ np.abs(guess))
+    active = tuple(int(i) for i in np.flatnonzero(slack <= scale))
+    tried = set()
+    for S in itertools.chain([active], _active_sets(len(facets), K.dim)):
+        if S in tried or len(S) > K.dim:
+            continue
+        tried.add(S)
+        x = _kkt(ex.kernel_eqs, facets, S, m)
+        if x is not None:
+            return x
+    raise SolverError("no exact KKT point found for the projection (internal error)")
+
+
+def _active_sets(m: int, dim: int):
+    count = 0
+    for size in range(dim + 1):
+        for S in itertools.combinations(range(m), size):
+            count += 1
+            if count > MAX_ACTIVE_SETS:
+                raise SolverError(f"the exact projection needs more than {MAX_ACTIVE_SETS} "
+                                  f"active sets ({m} facets, dim {dim})")
+            yield S
+
+
+def _kkt(eqs, facets, S, m: Vec) -> Vec | None:
+    """The KKT point for active set S, if it is optimal: x = m − Σ_rows c_r g_r with
+    g_r the equality rows and the facet normals in S, G x = h; μ ≥ 0 on S, x ∈ Ψ."""
+    rows = [a for a, _ in eqs] + [facets[i][0] for i in S]
+    rhs = [b for _, b in eqs] + [facets[i][1] for i in S]
+    if rows:
+        gram = [[_dot(g, h) for h in rows] for g in rows]
+        c = solve_exact(gram, [_dot(g, m) - r for g, r in zip(rows, rhs, strict=True)])
+        if c is None:
+            return None
+        x = tuple(mi - sum(cr * g[j] for cr, g in zip(c, rows, strict=True))
+                  for j, mi in enumerate(m))
+        if any(cr < 0 for cr in c[len(eqs):]):
+            return None
+    else:
+        x = m
+    if all(_dot(a, x) <= b for a, b in facets):
+        return x
+    return None
+
+
+def _chebyshev(K: SafeKernel, backend: str) -> Vec:
+    from ..models.kernel_models import chebyshev
+
+    ex = K._exact
+    if K.dim == 0:
+        return ex.vertices[0]
+    name = "highs" if backend in ("auto", "exact") else backend
+    centre, _ = chebyshev(K.A, K.b, K.affine_origin, K.affine_basis, backend=name)
+    x = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre))
+    if ex.contains(x):
+        return x
+    # a centre on the boundary up to rounding: pull it towards the vertex mean
+    vm = _vertex_mean(K)
+    for t in (Fraction(1, 10**12), Fraction(1, 10**6), Fraction(1, 1000), Fraction(1, 2)):
+        y = tuple((1 - t) * a + t * b for a, b in zip(x, vm, strict=True))
+        if ex.contains(y):
+            return y
+    raise SolverError("the Chebyshev centre returned by the backend is not in the kernel")
+
+
+def _onto_hull(eqs, x: Vec) -> Vec:
+    """Orthogonal projection of x onto {y : a·y = b for (a, b) in eqs}, exactly."""
+    if not eqs:
+        return x
+    rows = [a for a, _ in eqs]
+    gram = [[_dot(g, h) for h in rows] for g in rows]
+    c = solve_exact(gram, [_dot(a, x) - b for a, b in eqs])
+    assert c is not None
+    return tuple(xi - sum(cr * g[j] for cr, g in zip(c, rows, strict=True))
+                 for j, xi in enumerate(x))
