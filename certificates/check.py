@@ -947,6 +947,26 @@ KINDS: dict[str, Callable[[dict, _Ctx], str]] = {
 }
 
 
+def _kernel_kinds() -> dict[str, Callable[[dict, _Ctx], str]]:
+    """The safe-kernel kinds of the sibling module kernels.py (stdlib only), bound to the
+    helpers above: ``from .kernels`` inside the package, otherwise (script, or this file
+    loaded by path) kernels.py is loaded from this file's directory."""
+    if __package__:
+        from . import kernels
+    else:
+        import importlib.util
+        import os
+        path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "kernels.py")
+        spec = importlib.util.spec_from_file_location(f"{__name__}_kernels", path)
+        kernels = importlib.util.module_from_spec(spec)
+        sys.modules[spec.name] = kernels
+        spec.loader.exec_module(kernels)
+    return kernels.install(Invalid, _obj, _int, _array, _tname)
+
+
+KINDS.update(_kernel_kinds())
+
+
 def check(cert: Any) -> CheckResult:
     """Check a certificate (the parsed JSON object).  Never raises on bad input."""
     ctx = _Ctx()

@@ -565,3 +565,43 @@ def test_search_method_beyond_64_nodes_cli(capsys, tmp_path):
     assert proc.returncode in (0, 2)
     if proc.returncode == 2:
         assert_clean_error(proc.returncode, proc.stdout, proc.stderr)
+
+
+# --------------------------------------------------------------------------- #
+# rescon kernel
+# --------------------------------------------------------------------------- #
+
+KERNEL_KEYS = {"n", "d", "F", "empty", "dim", "vertices", "A", "b", "point", "seconds"}
+
+
+def test_kernel_command(capsys, tmp_path):
+    pts = tmp_path / "square.csv"
+    pts.write_text("x,y\n0,0\n1,0\n1,1\n0,1\n")
+    cert_path = tmp_path / "k.json"
+    png = tmp_path / "k.png"
+    data = run_json(["kernel", pts, "--F", "1", "--certificate", cert_path, "--plot", png],
+                    capsys)
+    assert set(data) == KERNEL_KEYS
+    assert (data["n"], data["d"], data["F"], data["empty"], data["dim"]) == (4, 2, 1, False, 0)
+    assert data["vertices"] == [[0.5, 0.5]] and data["point"] == [0.5, 0.5]
+    assert rescon.check_certificate(json.loads(cert_path.read_text())).valid
+    assert png.stat().st_size > 1000
+    assert main(["check", str(cert_path)]) == 0
+
+
+def test_kernel_command_empty_and_errors(capsys, tmp_path):
+    pts = tmp_path / "tri.csv"
+    pts.write_text("0,0\n1,0\n0,1\n")
+    data = run_json(["kernel", pts, "--F", "1"], capsys)
+    assert data["empty"] is True and data["dim"] == -1 and data["point"] is None
+    bad = tmp_path / "bad.csv"
+    bad.write_text("0,0\n1\n")
+    for argv in (["kernel", str(bad), "--F", "0"], ["kernel", str(pts), "--F", "3"],
+                 ["kernel", str(tmp_path / "missing.csv"), "--F", "0"]):
+        capsys.readouterr()
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Traceback" not in err
+    with pytest.raises(SystemExit) as exc:
+        main(["kernel", str(pts)])  # --F is required
+    assert exc.value.code == 2

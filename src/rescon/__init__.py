@@ -10,6 +10,7 @@ from __future__ import annotations
 from .certify import CheckResult, check_certificate
 from .errors import (
     CertificateError,
+    EmptyKernel,
     GraphFormatError,
     InputError,
     RESCONError,
@@ -26,6 +27,8 @@ from .graphs.robustness import (
     max_s,
     robustness,
 )
+from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kernel
+from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.sarymsakov import is_sarymsakov
 
 __version__ = "0.1.0"
@@ -33,20 +36,27 @@ __version__ = "0.1.0"
 __all__ = [
     "CertificateError",
     "CheckResult",
+    "EmptyKernel",
     "GraphFormatError",
     "InputError",
     "RESCONError",
     "RobustnessCheck",
     "RobustnessReport",
+    "SafeKernel",
     "SolverError",
     "SolverNotFound",
     "TimeLimitReached",
+    "TverbergPartition",
     "check_assumption2",
     "check_attack_model",
     "check_certificate",
     "is_r_robust",
     "is_rs_robust",
     "is_sarymsakov",
+    "kernel_point",
+    "kernel_points",
     "max_s",
     "robustness",
+    "safe_kernel",
+    "tverberg_partition",
 ]

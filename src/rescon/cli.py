@@ -119,6 +119,35 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_kernel(args: argparse.Namespace) -> int:
+    from .geometry.kernel import safe_kernel
+    from .io import read_points
+
+    X = read_points(args.points)
+    K = safe_kernel(X, args.F)
+    point = None if K.is_empty else K.point("project")[0]
+    cert = K.certificate
+    _write_certificate(cert, args.certificate)
+    if args.plot:
+        if X.shape[1] not in (2, 3):
+            raise RESCONError(f"--plot draws d = 2 or 3 only; the points have d = {X.shape[1]}")
+        K.plot(point=point, path=args.plot)
+    out = {"n": int(X.shape[0]), "d": int(X.shape[1]), "F": K.F, "empty": K.is_empty,
+           "dim": K.dim, "vertices": K.vertices.tolist(), "A": K.A.tolist(),
+           "b": K.b.tolist(), "point": None if point is None else point.tolist(),
+           "seconds": round(K.seconds, 6)}
+    if K.is_empty:
+        lines = [f"n = {X.shape[0]}, d = {X.shape[1]}, F = {K.F}: the safe kernel is EMPTY "
+                 "(Farkas certificate)"]
+    else:
+        lines = [f"n = {X.shape[0]}, d = {X.shape[1]}, F = {K.F}: safe kernel of dimension "
+                 f"{K.dim} with {len(K.vertices)} vertices, {len(K.b)} facets",
+                 f"point (closest to the mean of the points): {point.tolist()}"]
+    lines.append(f"{K.seconds:.4f} s")
+    _emit(out, args.json, lines)
+    return 0
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     from rescon_certificates.check import check, load, main as check_main
 
@@ -178,6 +207,14 @@ def _parser() -> argparse.ArgumentParser:
     rob.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
     rob.add_argument("--json", action="store_true", help="one JSON object on stdout")
     rob.set_defaults(func=_cmd_robustness)
+
+    ker = sub.add_parser("kernel", help="the safe kernel of a point set (exact polytope)")
+    ker.add_argument("points", help="CSV (n rows of d numbers, optional header) or .npy")
+    ker.add_argument("--F", type=_nonneg_int, required=True, help="points that may be removed")
+    ker.add_argument("--plot", metavar="PNG", help="draw points, kernel and point (d = 2, 3)")
+    ker.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
+    ker.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    ker.set_defaults(func=_cmd_kernel)
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")

@@ -113,8 +113,10 @@ class SafeKernel:
         return self.dim < 0
 
     def contains(self, x: Any, tol: float = 0.0) -> bool:
-        """x ∈ Ψ. With ``tol = 0`` (default) decided exactly (x's floats are exact
-        rationals); with tol > 0, up to that distance in each constraint."""
+        """x ∈ Ψ. With ``tol = 0`` (default) decided exactly for the floats given (their
+        exact binary values) — so a float rounded from an exact boundary point, such as
+        the ``x`` of :meth:`point`, may test False; with tol > 0, up to that distance in
+        each (unit-normal) constraint."""
         xv = np.asarray(x, dtype=np.float64).reshape(-1)
         if xv.shape != (self.points.shape[1],) or not np.isfinite(xv).all():
             raise InputError(f"x must be a finite point of dimension {self.points.shape[1]}; "

@@ -35,7 +35,7 @@ class Backend:
 BACKENDS: dict[str, Backend] = {
     b.name: b
     for b in (
-        Backend("highs", "highspy", frozenset({"LP", "MILP"}), "pip install highspy"),
+        Backend("highs", "highspy", frozenset({"LP", "QP", "MILP"}), "pip install highspy"),
         Backend("clarabel", "clarabel", frozenset({"LP", "QP", "SOCP"}), "pip install clarabel"),
         Backend("proxsuite", "proxsuite", frozenset({"QP", "batch"}), "pip install proxsuite"),
         Backend("cvxpy", "cvxpy", frozenset({"LP", "QP", "SOCP", "model"}), "pip install cvxpy"),

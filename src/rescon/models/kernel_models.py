@@ -1,0 +1,681 @@
+"""Optimisation models that turn a polytope (a safe kernel) into one canonical point.
+
+The polytope is given in float form as
+
+.. math::  K = \\{x \\in \\mathbb R^d : x = o + B^\\top t,\\ A x \\le b\\},
+
+with ``origin`` :math:`o \\in \\mathbb R^d`, ``basis`` :math:`B \\in \\mathbb R^{k\\times d}`
+(orthonormal rows, :math:`k` = affine dimension, :math:`0 \\le k \\le d`), ``A``
+:math:`\\in \\mathbb R^{m\\times d}`, ``b`` :math:`\\in \\mathbb R^m`. Every model works in
+the hull coordinates :math:`t \\in \\mathbb R^k`:
+
+.. math::  G t \\le h, \\qquad G_i = \\frac{A_i B^\\top}{\\|A_i B^\\top\\|},\\quad
+           h_i = \\frac{b_i - A_i o}{\\|A_i B^\\top\\|}
+
+(rows scaled to unit normals). A row whose hull part :math:`A_i B^\\top` vanishes (up to
+rounding, :math:`\\|A_i B^\\top\\| \\le 10^{-12}\\|A_i\\|`) describes the hull itself,
+:math:`0 \\le b_i - A_i o`, which the caller guarantees; it is skipped.
+
+Two models:
+
+* :func:`project` — the QP :math:`\\min_t \\tfrac12\\|t - B(y - o)\\|^2` s.t. :math:`Gt \\le h`:
+  the unique point of :math:`K` closest to a target :math:`y` (``project_batch`` for many);
+* :func:`chebyshev` — the LP :math:`\\max_{t,\\rho} \\rho` s.t. :math:`Gt + \\rho \\le h,\\
+  \\rho \\ge 0`: the largest ball inside :math:`K` within its affine hull.
+
+Backends come from :mod:`rescon.models.backends` (never a silent fallback). Matrix
+backends (``clarabel``, ``proxsuite``, ``highs``) take the standard form
+:math:`\\min \\tfrac12 z^\\top P z + q^\\top z` s.t. :math:`Gz \\le h`; the symbolic backends
+(``cvxpy``, ``casadi``) write each model with their own modelling language and take the
+underlying solver as ``solver=`` or as ``backend="name:solver"`` (e.g. ``"casadi:osqp"``);
+:func:`qp_backends` / :func:`lp_backends` list every usable spelling.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import io
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from ..errors import InputError, SolverError, SolverNotFound
+from .backends import available_backends, require_backend
+
+__all__ = ["chebyshev", "lp_backends", "project", "project_batch", "qp_backends"]
+
+#: Tolerance asked of every solver (absolute / relative gap and feasibility).
+TOL = 1e-9
+#: A row with ``‖A_i Bᵀ‖ ≤ _HULL_NORMAL ‖A_i‖`` is normal to the hull (see module doc).
+_HULL_NORMAL = 1e-12
+#: Orthonormality the ``basis`` rows must have: ``max |B Bᵀ − I| ≤ _ORTHONORMAL``.
+_ORTHONORMAL = 1e-8
+
+#: CVXPY solvers with known tight-tolerance settings → (capabilities, options).
+_CVXPY_SOLVERS: dict[str, tuple[frozenset[str], dict]] = {
+    "CLARABEL": (
+        frozenset({"LP", "QP"}),
+        {"tol_gap_abs": TOL, "tol_gap_rel": TOL, "tol_feas": TOL},
+    ),
+    "OSQP": (
+        frozenset({"LP", "QP"}),
+        {"eps_abs": TOL, "eps_rel": TOL, "polishing": True, "max_iter": 200_000},
+    ),
+    "HIGHS": (
+        frozenset({"LP", "QP"}),
+        {"primal_feasibility_tolerance": TOL, "dual_feasibility_tolerance": TOL,
+         "qp_regularization_value": 0.0},
+    ),
+    "SCS": (frozenset({"LP", "QP"}), {"eps_abs": TOL, "eps_rel": TOL, "max_iters": 200_000}),
+    "SCIPY": (frozenset({"LP"}), {}),
+}
+#: CasADi conic plugins, in order of preference → (capabilities, options).
+_CASADI_PLUGINS: dict[str, tuple[frozenset[str], dict]] = {
+    "qpoases": (frozenset({"LP", "QP"}), {"printLevel": "none"}),
+    # no polishing: CasADi's OSQP then prints on C-level stdout (accuracy is eps's)
+    "osqp": (
+        frozenset({"LP", "QP"}),
+        {"osqp": {"eps_abs": TOL, "eps_rel": TOL, "polish": False, "verbose": False,
+                  "max_iter": 200_000}},
+    ),
+    # CasADi's proxqp takes no duality-gap check (residuals 1e-9 leave errors ~1e-5;
+    # 1e-12 leaves ~1e-9), its default sparse backend ignores eps_abs, and it reports
+    # PROXQP_PRIMAL_INFEASIBLE on some feasible LPs: dense, 1e-12, QP only.
+    "proxqp": (
+        frozenset({"QP"}),
+        {"proxqp": {"eps_abs": 1e-12, "eps_rel": 0.0, "verbose": False, "backend": "dense"}},
+    ),
+}
+#: "backend:solver" pairs that exist but are not offered → why.
+_REFUSED = {
+    "casadi:highs": "CasADi's bundled HiGHS and highspy cannot share a process (segfault "
+    "or ImportError, depending on which loads first); use backend='highs'",
+    "cvxpy:PROXQP": "CVXPY's interface sets no duality-gap check (errors ~1e-5) and "
+    "reports 'infeasible' on some feasible problems; use backend='proxsuite'",
+}
+
+
+class _Hull(NamedTuple):
+    """A validated polytope reduced to hull coordinates: ``K = {o + Bᵀt : G t ≤ h}``."""
+
+    origin: np.ndarray  # (d,)
+    basis: np.ndarray  # (k, d)
+    G: np.ndarray  # (m', k), unit rows
+    h: np.ndarray  # (m',)
+
+    @property
+    def k(self) -> int:
+        return self.basis.shape[0]
+
+    def lift(self, t: np.ndarray) -> np.ndarray:
+        """x = o + Bᵀ t."""
+        return self.origin + self.basis.T @ t
+
+
+class _Standard(NamedTuple):
+    """min ½ zᵀPz + qᵀz  s.t.  G z ≤ h  (P symmetric PSD, dense)."""
+
+    P: np.ndarray
+    q: np.ndarray
+    G: np.ndarray
+    h: np.ndarray
+
+
+# --------------------------------------------------------------------------- #
+# public API
+# --------------------------------------------------------------------------- #
+
+
+def project(A, b, origin, basis, target, *, backend="clarabel", solver=None) -> np.ndarray:
+    """The point of ``K`` closest to ``target`` (Euclidean projection).
+
+    Solves the strictly convex QP
+
+    .. math::  \\min_{t\\in\\mathbb R^k} \\tfrac12 \\|t - B(y - o)\\|^2
+               \\quad\\text{s.t.}\\quad G t \\le h
+
+    and returns :math:`x^* = o + B^\\top t^*`. Since :math:`B` has orthonormal rows,
+    :math:`\\|x - y\\|^2 = \\|t - B(y-o)\\|^2 + \\|(I - B^\\top B)(y - o)\\|^2`, so
+    :math:`x^*` is the unique minimiser of :math:`\\|x - y\\|` over ``K``.
+
+    Parameters
+    ----------
+    A : array_like, shape (m, d)
+    b : array_like, shape (m,)
+        Inequalities ``A x ≤ b`` of ``K``.
+    origin : array_like, shape (d,)
+        A point of the affine hull of ``K``.
+    basis : array_like, shape (k, d)
+        Orthonormal rows spanning the hull directions (``k = 0``: ``K = {origin}``).
+    target : array_like, shape (d,)
+        The point ``y`` to project.
+    backend : str
+        A name from :func:`qp_backends`: ``"clarabel"``, ``"proxsuite"``, ``"highs"``,
+        ``"cvxpy"``/``"cvxpy:SOLVER"``, ``"casadi"``/``"casadi:plugin"``.
+    solver : str, optional
+        The solver behind a symbolic backend: a CVXPY solver name (default
+        ``"CLARABEL"``; also OSQP, HIGHS, SCS, and SCIPY for LPs) or a CasADi conic
+        plugin (default ``"qpoases"``; also ``"osqp"``, and ``"proxqp"`` for QPs).
+        ``_REFUSED`` says why ``cvxpy:PROXQP`` and ``casadi:highs`` are not offered.
+        Not accepted by the matrix backends.
+
+    Returns
+    -------
+    numpy.ndarray, shape (d,)
+
+    Raises
+    ------
+    InputError
+        Malformed or non-finite input, or a ``solver=`` the backend does not take.
+    SolverNotFound
+        Unknown or missing backend / solver / plugin (names the available ones).
+    SolverError
+        The solver did not report an optimal solution (e.g. ``K`` empty); the message
+        carries the solver's status.
+
+    Notes
+    -----
+    One QP in ``k ≤ d`` variables with ``m`` constraints; ``k = 0`` calls no solver.
+
+    Examples
+    --------
+    >>> A = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]]  # the square [-1, 1]²
+    >>> x = project(A, [1, 1, 1, 1], [0, 0], np.eye(2), [3.0, 0.5])
+    >>> np.round(x, 6).tolist()
+    [1.0, 0.5]
+    """
+    name, solver = _resolve(backend, solver, "QP")
+    hull = _validate(A, b, origin, basis)
+    y = _vector(target, "target", hull.origin.size)
+    if hull.k == 0:
+        return hull.origin.copy()
+    return hull.lift(_SOLVE_QP[name](hull, _target_t(hull, y), solver))
+
+
+def chebyshev(A, b, origin, basis, *, backend="highs", solver=None) -> tuple[np.ndarray, float]:
+    """Centre and radius of the largest ball inside ``K`` within its affine hull.
+
+    Solves the LP (rows of ``G`` are unit vectors)
+
+    .. math::  \\max_{t, \\rho} \\rho \\quad\\text{s.t.}\\quad G t + \\rho \\mathbf 1 \\le h,
+               \\quad \\rho \\ge 0,
+
+    and returns :math:`(o + B^\\top t^*, \\rho^*)`: the ball of radius :math:`\\rho^*`
+    around the centre, intersected with the hull, lies in ``K``.
+
+    Parameters are those of :func:`project` (without ``target``); ``backend`` is a name
+    from :func:`lp_backends`.
+
+    Returns
+    -------
+    centre : numpy.ndarray, shape (d,)
+    radius : float
+        Unique; ``0.0`` when ``k = 0`` (centre = ``origin``, no solver called).
+
+    Raises
+    ------
+    InputError, SolverNotFound, SolverError
+        As for :func:`project`; an unbounded ``K`` gives a SolverError.
+
+    Notes
+    -----
+    The maximiser need not be unique (a 2×1 rectangle has a segment of centres); each
+    backend returns one of them, so only the radius is backend-independent. Use
+    :func:`project` when a canonical point is needed.
+
+    Examples
+    --------
+    >>> A = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]]
+    >>> c, r = chebyshev(A, [1, 1, 1, 1], [0, 0], np.eye(2))
+    >>> np.round(c, 6).tolist(), round(r, 6)
+    ([0.0, 0.0], 1.0)
+    """
+    name, solver = _resolve(backend, solver, "LP")
+    hull = _validate(A, b, origin, basis)
+    if hull.k == 0:
+        return hull.origin.copy(), 0.0
+    t, rho = _SOLVE_LP[name](hull, solver)
+    return hull.lift(t), float(rho)
+
+
+def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None) -> np.ndarray:
+    """:func:`project` for many polytopes at once.
+
+    Parameters
+    ----------
+    problems : sequence of (A, b, origin, basis, target)
+        Arguments of :func:`project`; all must share ``d``, while ``m`` and ``k`` may vary.
+    backend, solver
+        As for :func:`project`. A backend with the ``"batch"`` capability (proxsuite)
+        solves all QPs in one parallel call (``proxqp.dense.solve_in_parallel`` over a
+        ``BatchQP`` of QPs of their own sizes); any other backend solves them in a loop.
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(problems), d)
+        Row ``i`` is ``project(*problems[i])``.
+
+    Raises
+    ------
+    InputError
+        A malformed problem (the message names its index) or different ``d``.
+    SolverNotFound, SolverError
+        As for :func:`project`; a failure names the problem's index.
+    """
+    name, solver = _resolve(backend, solver, "QP")
+    hulls, targets = _validate_batch(problems)
+    out = np.zeros((len(hulls), hulls[0].origin.size if hulls else 0))
+    for i, hull in enumerate(hulls):
+        out[i] = hull.origin
+    todo = [i for i, h in enumerate(hulls) if h.k > 0]
+    cs = [_target_t(hulls[i], targets[i]) for i in todo]
+    if name in _BATCH_QP:
+        ts = _BATCH_QP[name]([hulls[i] for i in todo], cs, todo)
+    else:
+        ts = [_indexed(i, _SOLVE_QP[name], hulls[i], c, solver) for i, c in zip(todo, cs)]
+    for i, t in zip(todo, ts):
+        out[i] = hulls[i].lift(t)
+    return out
+
+
+def qp_backends() -> list[str]:
+    """Every usable ``backend=`` spelling for :func:`project`, e.g. ``"casadi:osqp"``."""
+    return _variants("QP")
+
+
+def lp_backends() -> list[str]:
+    """Every usable ``backend=`` spelling for :func:`chebyshev`."""
+    return _variants("LP")
+
+
+# --------------------------------------------------------------------------- #
+# validation and reduction to hull coordinates
+# --------------------------------------------------------------------------- #
+
+
+def _array(x, name: str, ndim: int, expected: str) -> np.ndarray:
+    """``x`` as a finite float array of ``ndim`` dimensions, else InputError."""
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a finite {expected} float array; got {x!r:.60}") from exc
+    if arr.ndim != ndim:
+        raise InputError(f"{name} must be a finite {expected} array; got shape {arr.shape}")
+    bad = int(np.count_nonzero(~np.isfinite(arr)))
+    if bad:
+        raise InputError(f"{name} must be a finite {expected} array; got {bad} NaN/inf entries")
+    return arr
+
+
+def _vector(x, name: str, d: int) -> np.ndarray:
+    arr = _array(x, name, 1, f"({d},)")
+    if arr.shape != (d,):
+        raise InputError(f"{name} must be a finite ({d},) array; got shape {arr.shape}")
+    return arr
+
+
+def _validate(A, b, origin, basis) -> _Hull:
+    """Check shapes, finiteness and orthonormality; reduce to hull coordinates."""
+    o = _array(origin, "origin", 1, "(d,)")
+    d = o.size
+    if d == 0:
+        raise InputError("origin must be a finite (d,) array with d >= 1; got shape (0,)")
+    A = _array(A, "A", 2, f"(m, {d})")
+    B = _array(basis, "basis", 2, f"(k, {d})")
+    if A.shape[1] != d:
+        raise InputError(f"A must be a finite (m, {d}) array; got shape {A.shape}")
+    b = _vector(b, "b", A.shape[0])
+    if B.shape[1] != d or B.shape[0] > d:
+        raise InputError(f"basis must be a finite (k, {d}) array, k <= {d}; got shape {B.shape}")
+    err = float(np.max(np.abs(B @ B.T - np.eye(B.shape[0])), initial=0.0))
+    if err > _ORTHONORMAL:
+        raise InputError(f"basis rows must be orthonormal; got max |B Bᵀ − I| = {err:.3g}")
+    return _reduce(A, b, o, B)
+
+
+def _reduce(A: np.ndarray, b: np.ndarray, o: np.ndarray, B: np.ndarray) -> _Hull:
+    """G = A Bᵀ, h = b − A o, rows normal to the hull dropped, the rest unit-scaled."""
+    At = A @ B.T
+    norm = np.linalg.norm(At, axis=1)
+    keep = norm > _HULL_NORMAL * np.linalg.norm(A, axis=1)
+    G = At[keep] / norm[keep, None]
+    h = (b - A @ o)[keep] / norm[keep]
+    return _Hull(o, B, G, h)
+
+
+def _target_t(hull: _Hull, y: np.ndarray) -> np.ndarray:
+    """The target in hull coordinates, c = B (y − o)."""
+    return hull.basis @ (y - hull.origin)
+
+
+def _validate_batch(problems) -> tuple[list[_Hull], list[np.ndarray]]:
+    hulls, targets = [], []
+    for i, prob in enumerate(problems):
+        try:
+            if len(prob) != 5:
+                raise InputError(f"expected (A, b, origin, basis, target); got {len(prob)} items")
+            hull = _validate(*prob[:4])
+            targets.append(_vector(prob[4], "target", hull.origin.size))
+        except (InputError, TypeError) as exc:
+            raise InputError(f"problems[{i}]: {exc}") from exc
+        if hulls and hull.origin.size != hulls[0].origin.size:
+            raise InputError(
+                f"problems[{i}]: all problems must share d = {hulls[0].origin.size}; "
+                f"got d = {hull.origin.size}"
+            )
+        hulls.append(hull)
+    return hulls, targets
+
+
+# --------------------------------------------------------------------------- #
+# backend resolution
+# --------------------------------------------------------------------------- #
+
+
+def _resolve(backend: str, solver: str | None, capability: str) -> tuple[str, str | None]:
+    """(backend name, solver) from ``backend`` ("name" or "name:solver") and ``solver``."""
+    if not isinstance(backend, str) or not isinstance(solver, (str, type(None))):
+        raise InputError(f"backend and solver must be strings; got {backend!r}, {solver!r}")
+    return _resolve_cached(backend, solver, capability)
+
+
+@functools.lru_cache(maxsize=64)
+def _resolve_cached(backend: str, solver: str | None, capability: str) -> tuple[str, str | None]:
+    """:func:`_resolve` after the type checks, cached: looking a backend up in the
+    registry costs ~0.3 ms (``find_spec`` of every backend), more than a small QP."""
+    name, _, inline = backend.partition(":")
+    if inline and solver is not None:
+        raise InputError(f"give the solver once: backend={backend!r} and solver={solver!r}")
+    solver = inline or solver
+    require_backend(name, capability)
+    if name == "cvxpy":
+        solver = "CLARABEL" if solver is None else solver.upper()
+        return name, _pick(name, solver, _cvxpy_solvers(capability), capability)
+    if name == "casadi":
+        return name, _pick(name, solver, _casadi_plugins(capability), capability)
+    if solver is not None:
+        raise InputError(f"backend {name!r} takes no solver=; got {solver!r}")
+    return name, None
+
+
+def _cvxpy_solvers(capability: str) -> list[str]:
+    """Installed CVXPY solvers that have ``capability`` and known tolerance settings."""
+    import cvxpy as cp
+
+    installed = set(cp.installed_solvers())
+    return [s for s, (caps, _) in _CVXPY_SOLVERS.items() if capability in caps and s in installed]
+
+
+def _casadi_plugins(capability: str) -> list[str]:
+    """CasADi conic plugins with ``capability`` that can be loaded.
+
+    ``casadi.has_conic`` is asked first because CasADi may abort the process when a
+    missing plugin is instantiated.
+    """
+    import casadi
+
+    return [p for p, (caps, _) in _CASADI_PLUGINS.items()
+            if capability in caps and casadi.has_conic(p)]
+
+
+def _pick(name: str, solver: str | None, ok: list[str], capability: str) -> str:
+    """``solver`` (default: the first of ``ok``) if it is in ``ok``, else SolverNotFound."""
+    if solver is None and ok:
+        return ok[0]
+    why = _REFUSED.get(f"{name}:{solver}", f"not available for {capability}")
+    if solver not in ok:
+        raise SolverNotFound(f"{name} solver {solver!r}: {why}; available: {ok}")
+    return solver
+
+
+def _variants(capability: str) -> list[str]:
+    out = []
+    for name in available_backends(capability):
+        if name == "cvxpy":
+            out += [f"cvxpy:{s}" for s in _cvxpy_solvers(capability)]
+        elif name == "casadi":
+            out += [f"casadi:{p}" for p in _casadi_plugins(capability)]
+        else:
+            out.append(name)
+    return out
+
+
+def _indexed(i: int, fn, *args):
+    """``fn(*args)``, with a SolverError naming the batch index ``i``."""
+    try:
+        return fn(*args)
+    except SolverNotFound:
+        raise
+    except SolverError as exc:
+        raise SolverError(f"problems[{i}]: {exc}") from exc
+
+
+def _fail(backend: str, status) -> SolverError:
+    return SolverError(f"{backend}: solver status {str(status)!r} is not optimal")
+
+
+# --------------------------------------------------------------------------- #
+# standard forms for the matrix backends
+# --------------------------------------------------------------------------- #
+
+
+def _qp_form(hull: _Hull, c: np.ndarray) -> _Standard:
+    """min ½ tᵀt − cᵀt  s.t.  G t ≤ h."""
+    return _Standard(np.eye(hull.k), -c, hull.G, hull.h)
+
+
+def _lp_form(hull: _Hull) -> _Standard:
+    """z = (t, ρ): min −ρ  s.t.  [G 1; 0 −1] z ≤ [h; 0]."""
+    k, m = hull.k, hull.h.size
+    G = np.zeros((m + 1, k + 1))
+    G[:m, :k] = hull.G
+    G[:m, k] = 1.0
+    G[m, k] = -1.0
+    q = np.zeros(k + 1)
+    q[k] = -1.0
+    return _Standard(np.zeros((k + 1, k + 1)), q, G, np.append(hull.h, 0.0))
+
+
+def _clarabel(s: _Standard) -> np.ndarray:
+    """Clarabel's native API: P upper triangle and G as CSC, G z + slack = h, slack ≥ 0."""
+    import clarabel
+    import scipy.sparse as sps
+
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = TOL
+    cones = [clarabel.NonnegativeConeT(s.h.size)] if s.h.size else []
+    P = sps.triu(sps.csc_matrix(s.P), format="csc")
+    sol = clarabel.DefaultSolver(P, s.q, sps.csc_matrix(s.G), s.h, cones, settings).solve()
+    if str(sol.status) != "Solved":
+        raise _fail("clarabel", sol.status)
+    return np.array(sol.x)
+
+
+def _proxsuite_setup(qp, s: _Standard) -> None:
+    """Settings and data of a proxqp dense QP: min ½ zᵀPz + qᵀz, G z ≤ h (no l)."""
+    qp.settings.eps_abs = qp.settings.eps_duality_gap_abs = TOL
+    qp.settings.eps_rel = qp.settings.eps_duality_gap_rel = 0.0
+    qp.settings.check_duality_gap = True  # small residuals alone leave errors ~1e-5
+    qp.settings.verbose = False
+    if s.h.size:
+        qp.init(s.P, s.q, None, None, s.G, None, s.h)
+    else:
+        qp.init(s.P, s.q, None, None, None, None, None)
+
+
+def _proxsuite_result(qp) -> np.ndarray:
+    import proxsuite
+
+    status = qp.results.info.status
+    if status != proxsuite.proxqp.PROXQP_SOLVED:
+        raise _fail("proxsuite", status)
+    return np.array(qp.results.x)
+
+
+def _proxsuite(s: _Standard) -> np.ndarray:
+    import proxsuite
+
+    qp = proxsuite.proxqp.dense.QP(s.q.size, 0, s.h.size)
+    _proxsuite_setup(qp, s)
+    qp.solve()
+    return _proxsuite_result(qp)
+
+
+def _proxsuite_batch(hulls: list[_Hull], cs: list[np.ndarray], index: list[int]) -> list:
+    """All QPs in one ``BatchQP`` (each with its own n, n_in), solved in parallel."""
+    import proxsuite
+
+    dense = proxsuite.proxqp.dense
+    batch = dense.BatchQP(len(hulls))
+    for hull, c in zip(hulls, cs):
+        _proxsuite_setup(batch.init_qp_in_place(hull.k, 0, hull.h.size), _qp_form(hull, c))
+    dense.solve_in_parallel(batch)
+    return [_indexed(i, _proxsuite_result, batch.get(j)) for j, i in enumerate(index)]
+
+
+def _highs(s: _Standard) -> np.ndarray:
+    """highspy: columns z free, rows −∞ ≤ G z ≤ h, Hessian P (lower triangle, CSC)."""
+    import highspy
+    import scipy.sparse as sps
+
+    n, m = s.q.size, s.h.size
+    h = highspy.Highs()
+    for option, value in (("output_flag", False), ("primal_feasibility_tolerance", TOL),
+                          ("dual_feasibility_tolerance", TOL), ("qp_regularization_value", 0.0)):
+        h.setOptionValue(option, value)
+    h.addVars(n, np.full(n, -highspy.kHighsInf), np.full(n, highspy.kHighsInf))
+    h.changeColsCost(n, np.arange(n, dtype=np.int32), s.q)
+    if m:
+        G = sps.csr_matrix(s.G)
+        h.addRows(m, np.full(m, -highspy.kHighsInf), s.h, G.nnz,
+                  G.indptr[:-1].astype(np.int32), G.indices.astype(np.int32), G.data)
+    if np.any(s.P):
+        P = sps.tril(sps.csc_matrix(s.P), format="csc")
+        hess = highspy.HighsHessian()
+        hess.dim_ = n
+        hess.format_ = highspy.HessianFormat.kTriangular
+        hess.start_, hess.index_, hess.value_ = P.indptr, P.indices, P.data
+        h.passHessian(hess)
+    h.run()
+    status = h.getModelStatus()
+    if status != highspy.HighsModelStatus.kOptimal:
+        raise _fail("highs", h.modelStatusToString(status))
+    return np.array(h.getSolution().col_value)
+
+
+_MATRIX = {"clarabel": _clarabel, "proxsuite": _proxsuite, "highs": _highs}
+
+
+# --------------------------------------------------------------------------- #
+# symbolic models
+# --------------------------------------------------------------------------- #
+
+
+def _cvxpy_solve(problem, solver: str) -> None:
+    import cvxpy as cp
+
+    try:
+        problem.solve(solver=solver, **_CVXPY_SOLVERS[solver][1])
+    except cp.error.SolverError as exc:
+        raise SolverError(f"cvxpy:{solver}: {exc}") from exc
+    if problem.status != cp.OPTIMAL:
+        raise _fail(f"cvxpy:{solver}", problem.status)
+
+
+def _cvxpy_qp(hull: _Hull, c: np.ndarray, solver: str) -> np.ndarray:
+    """CVXPY: minimize ½‖t − c‖² subject to G t ≤ h."""
+    import cvxpy as cp
+
+    t = cp.Variable(hull.k)
+    cons = [hull.G @ t <= hull.h] if hull.h.size else []
+    _cvxpy_solve(cp.Problem(cp.Minimize(0.5 * cp.sum_squares(t - c)), cons), solver)
+    return np.asarray(t.value)
+
+
+def _cvxpy_lp(hull: _Hull, solver: str) -> tuple[np.ndarray, float]:
+    """CVXPY: maximize ρ subject to G t + ρ ≤ h, ρ ≥ 0."""
+    import cvxpy as cp
+
+    t, rho = cp.Variable(hull.k), cp.Variable()
+    cons = [hull.G @ t + rho <= hull.h, rho >= 0] if hull.h.size else [rho >= 0]
+    _cvxpy_solve(cp.Problem(cp.Maximize(rho), cons), solver)
+    return np.asarray(t.value), float(rho.value)
+
+
+def _casadi_solve(opti, plugin: str):
+    """Solve an ``Opti('conic')`` model with ``plugin``; SolverError unless it succeeds.
+
+    Plugins print through CasADi's Python ``sys.stdout`` whatever their options say
+    (qpOASES its licence banner on every solve); that is discarded so that stdout
+    stays clean for ``--json`` output.
+    """
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            opti.solver(plugin, {"print_time": False, "error_on_fail": False,
+                                 **_CASADI_PLUGINS[plugin][1]})
+            return opti.solve()
+    except RuntimeError as exc:
+        raise _fail(f"casadi:{plugin}", opti.stats().get("return_status", exc)) from exc
+
+
+def _casadi_qp(hull: _Hull, c: np.ndarray, plugin: str) -> np.ndarray:
+    """CasADi Opti: minimize ½‖t − c‖² subject to G t ≤ h."""
+    import casadi
+
+    opti = casadi.Opti("conic")
+    t = opti.variable(hull.k)
+    opti.minimize(0.5 * casadi.sumsqr(t - c))
+    if hull.h.size:
+        opti.subject_to(casadi.mtimes(casadi.DM(hull.G), t) <= hull.h)
+    sol = _casadi_solve(opti, plugin)
+    return np.atleast_1d(np.asarray(sol.value(t), dtype=float)).ravel()
+
+
+def _casadi_lp(hull: _Hull, plugin: str) -> tuple[np.ndarray, float]:
+    """CasADi Opti: maximize ρ subject to G t + ρ ≤ h, ρ ≥ 0."""
+    import casadi
+
+    opti = casadi.Opti("conic")
+    t, rho = opti.variable(hull.k), opti.variable()
+    opti.minimize(-rho)
+    if hull.h.size:
+        opti.subject_to(casadi.mtimes(casadi.DM(hull.G), t) + rho <= hull.h)
+    opti.subject_to(rho >= 0)
+    sol = _casadi_solve(opti, plugin)
+    return np.atleast_1d(np.asarray(sol.value(t), dtype=float)).ravel(), float(sol.value(rho))
+
+
+# --------------------------------------------------------------------------- #
+# dispatch: backend name → (hull, c, solver) -> t  /  (hull, solver) -> (t, ρ)
+# --------------------------------------------------------------------------- #
+
+
+def _matrix_qp(name: str):
+    return lambda hull, c, solver: _MATRIX[name](_qp_form(hull, c))
+
+
+def _matrix_lp(name: str):
+    def solve(hull: _Hull, solver) -> tuple[np.ndarray, float]:
+        z = _MATRIX[name](_lp_form(hull))
+        return z[:-1], z[-1]
+
+    return solve
+
+
+_SOLVE_QP = {
+    "clarabel": _matrix_qp("clarabel"),
+    "proxsuite": _matrix_qp("proxsuite"),
+    "highs": _matrix_qp("highs"),
+    "cvxpy": _cvxpy_qp,
+    "casadi": _casadi_qp,
+}
+_SOLVE_LP = {
+    "clarabel": _matrix_lp("clarabel"),
+    "highs": _matrix_lp("highs"),
+    "cvxpy": _cvxpy_lp,
+    "casadi": _casadi_lp,
+}
+_BATCH_QP = {"proxsuite": _proxsuite_batch}

@@ -1,0 +1,272 @@
+"""Safe kernels against brute-force oracles.
+
+Oracle: x ∈ Ψ(X, F) iff x ∈ conv(S) for every S ⊆ X with |S| = n − F, decided by an
+LP per subset (scipy linprog). Vertices of the computed kernel must pass it, points
+pushed out of a facet must fail it, and random points must be classified the same way
+by ``SafeKernel.contains`` (exact) unless they sit within 1e-7 of the boundary.
+Every certificate is checked by the standalone checker.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.optimize import linprog
+
+import rescon
+from rescon.errors import EmptyKernel, InputError
+
+
+def in_hull(x: np.ndarray, S: np.ndarray, tol: float = 1e-9) -> bool:
+    """x ∈ conv(S) up to tol (LP feasibility: λ ≥ 0, Σλ = 1, Sᵀλ = x)."""
+    m = len(S)
+    A = np.vstack([S.T, np.ones((1, m))])
+    b = np.concatenate([x, [1.0]])
+    res = linprog(np.zeros(m), A_eq=A, b_eq=b, bounds=(0, None), method="highs",
+                  options={"primal_feasibility_tolerance": tol})
+    return res.status == 0
+
+
+def in_kernel_oracle(x, X, F, tol=1e-9) -> bool:
+    n = len(X)
+    return all(in_hull(np.asarray(x, float), X[list(S)], tol)
+               for S in itertools.combinations(range(n), n - F))
+
+
+def check_kernel(X: np.ndarray, F: int, rng=None) -> rescon.SafeKernel:
+    X = np.asarray(X, dtype=float)
+    K = rescon.safe_kernel(X, F)
+    res = rescon.check_certificate(K.certificate)
+    assert res.valid, res.reason
+    if K.is_empty:
+        # the oracle agrees: some point of a candidate set is outside some hull — test
+        # the centroid and the coordinate-wise median at least
+        for x in (X.mean(axis=0), np.median(X, axis=0)):
+            assert not in_kernel_oracle(x, X, F, tol=1e-10)
+        assert K.dim == -1 and len(K.vertices) == 0
+        return K
+    for v in K.vertices:
+        assert in_kernel_oracle(v, X, F, tol=1e-7), v
+        assert K.contains(v, tol=1e-9)
+    # push each vertex outwards along each facet normal it is tight on
+    for a, b in zip(K.A, K.b, strict=True):
+        tight = [v for v in K.vertices if abs(a @ v - b) < 1e-9]
+        for v in tight:
+            y = v + 1e-5 * a
+            assert not in_kernel_oracle(y, X, F, tol=1e-10)
+            assert not K.contains(y)
+    # out of the affine hull
+    for a in K.Aeq:
+        y = K.vertices[0] + 1e-5 * a
+        assert not in_kernel_oracle(y, X, F, tol=1e-10)
+        assert not K.contains(y)
+    if rng is not None:
+        lo, hi = X.min(axis=0), X.max(axis=0)
+        for y in rng.uniform(lo, hi, size=(15, X.shape[1])):
+            margin = min([b - a @ y for a, b in zip(K.A, K.b, strict=True)]
+                         + [-abs(a @ y - b) for a, b in zip(K.Aeq, K.beq, strict=True)]
+                         + [np.inf])
+            if abs(margin) < 1e-7:
+                continue
+            assert K.contains(y) == in_kernel_oracle(y, X, F), (y, margin)
+    assert K.dim == (np.linalg.matrix_rank(K.vertices - K.vertices[0])
+                     if len(K.vertices) > 1 else 0)
+    return K
+
+
+# --------------------------------------------------------------------------- #
+# known answers
+# --------------------------------------------------------------------------- #
+
+
+def test_square_diagonals_cross():
+    K = check_kernel([[0, 0], [1, 0], [1, 1], [0, 1]], 1)
+    assert K.dim == 0 and K.vertices.tolist() == [[0.5, 0.5]]
+    assert K.exact_vertices[0] == (0.5, 0.5)
+
+
+def test_f_zero_is_the_hull():
+    X = np.array([[0, 0], [2, 0], [0, 2], [1, 0.5], [2, 2]])
+    K = check_kernel(X, 0)
+    assert sorted(map(tuple, K.vertices)) == [(0, 0), (0, 2), (2, 0), (2, 2)]
+
+
+def test_triangle_f1_empty_with_farkas():
+    K = check_kernel([[0, 0], [1, 0], [0, 1]], 1)
+    assert K.is_empty and K.certificate["kind"] == "kernel_empty"
+    with pytest.raises(EmptyKernel):
+        K.point()
+
+
+def test_collinear_points_give_the_median_segment():
+    X = np.array([[0, 0], [1, 1], [2, 2], [3, 3], [4, 4]])
+    K = check_kernel(X, 1)
+    assert K.dim == 1
+    assert sorted(map(tuple, K.vertices)) == [(1, 1), (3, 3)]
+    K = check_kernel(X, 2)
+    assert K.dim == 0 and K.vertices.tolist() == [[2, 2]]
+
+
+def test_duplicates_count():
+    X = np.array([[0, 0]] * 3 + [[1, 0], [0, 1]])
+    K = check_kernel(X, 2)
+    assert K.vertices.tolist() == [[0, 0]]
+
+
+def test_one_dimensional_and_one_point():
+    K = check_kernel(np.array([[3.0], [1.0], [2.0], [5.0]]), 1)
+    assert sorted(K.vertices[:, 0]) == [2.0, 3.0]
+    K = check_kernel(np.array([[1.5, 2.5]]), 0)
+    assert K.vertices.tolist() == [[1.5, 2.5]]
+
+
+def test_points_on_a_plane_in_3d():
+    rng = np.random.default_rng(3)
+    uv = rng.integers(-5, 6, size=(9, 2)).astype(float)
+    X = np.column_stack([uv[:, 0], uv[:, 1], 2 * uv[:, 0] - uv[:, 1] + 1])
+    K = check_kernel(X, 2, rng)
+    assert K.dim <= 2 and len(K.Aeq) >= 1
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_random_gaussian_2d(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 11))
+    F = int(rng.integers(0, (n - 1) // 3 + 2))
+    check_kernel(rng.normal(size=(n, 2)), F, rng)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_integer_grid_ties(seed):
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(6, 11))
+    X = rng.integers(0, 4, size=(n, 2)).astype(float)
+    F = int(rng.integers(0, (n - 1) // 3 + 2))
+    check_kernel(X, F, rng)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_random_3d(seed):
+    rng = np.random.default_rng(200 + seed)
+    n = int(rng.integers(6, 10))
+    X = rng.normal(size=(n, 3)) if seed else rng.integers(0, 3, size=(n, 3)).astype(float)
+    check_kernel(X, int(rng.integers(0, 3)), rng)
+
+
+def test_converged_cloud_is_exact():
+    """Benign points within 1e-7 plus far outliers: no tolerance artefacts."""
+    rng = np.random.default_rng(7)
+    X = np.vstack([1.0 + 1e-7 * rng.normal(size=(8, 2)), [[50.0, 50.0], [-40.0, 60.0]]])
+    K = check_kernel(X, 2)
+    assert K.dim == 2
+    assert np.all(np.abs(K.vertices - 1.0) < 1e-6)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(4, 8).flatmap(lambda n: st.tuples(
+    st.lists(st.tuples(st.integers(-3, 3), st.integers(-3, 3)), min_size=n, max_size=n),
+    st.integers(0, 3))))
+def test_hypothesis_small_integer_clouds(data):
+    pts, F = data
+    X = np.array(pts, dtype=float)
+    F = min(F, len(X) - 1)
+    check_kernel(X, F)
+
+
+# --------------------------------------------------------------------------- #
+# kernel points
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("method", ["project", "chebyshev", "vertex-mean"])
+def test_kernel_point_methods(method):
+    rng = np.random.default_rng(11)
+    for X, F in [(rng.normal(size=(12, 2)), 2), ([[0, 0], [1, 0], [1, 1], [0, 1]], 1),
+                 ([[0, 0], [1, 1], [2, 2], [3, 3], [4, 4]], 1), (rng.normal(size=(9, 3)), 1)]:
+        K = rescon.safe_kernel(X, F)
+        x, cert = K.point(method)
+        assert K.contains(x, tol=1e-10)
+        res = rescon.check_certificate(cert)
+        assert res.valid, res.reason
+
+
+def test_project_is_the_closest_point():
+    rng = np.random.default_rng(5)
+    X = rng.normal(size=(15, 2))
+    K = rescon.safe_kernel(X, 3)
+    target = np.array([3.0, -2.0])
+    x, _ = K.point("project", target=target)
+    # no vertex and no point on an edge is closer
+    best = min(np.linalg.norm(v - target) for v in K.vertices)
+    assert np.linalg.norm(x - target) <= best + 1e-12
+    for t in np.linspace(0, 1, 50):
+        for i in range(len(K.vertices)):
+            for j in range(len(K.vertices)):
+                p = (1 - t) * K.vertices[i] + t * K.vertices[j]
+                assert np.linalg.norm(x - target) <= np.linalg.norm(p - target) + 1e-12
+    # inside target: itself
+    inside = K.vertices.mean(axis=0)
+    x2, _ = K.point("project", target=inside)
+    assert np.allclose(x2, inside, atol=1e-15)
+
+
+def test_project_same_for_every_backend():
+    from rescon.models.kernel_models import qp_backends
+
+    X = np.random.default_rng(9).normal(size=(14, 2))
+    K = rescon.safe_kernel(X, 3)
+    target = np.array([5.0, 5.0])
+    answers = {b: K.point("project", backend=b, target=target)[0] for b in qp_backends()}
+    ref = next(iter(answers.values()))
+    for b, x in answers.items():
+        assert np.array_equal(x, ref), b
+
+
+def test_kernel_points_batch():
+    rng = np.random.default_rng(2)
+    batch = rng.normal(size=(5, 10, 2))
+    out = rescon.kernel_points(batch, 2)
+    assert out.shape == (5, 2)
+    for X, x in zip(batch, out, strict=True):
+        assert rescon.safe_kernel(X, 2).contains(x)
+
+
+# --------------------------------------------------------------------------- #
+# bad input
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("X,F,match", [
+    ([[0, np.nan], [1, 1]], 0, "NaN"),
+    ([[0, np.inf], [1, 1]], 0, "infinite"),
+    ([1, 2, 3], 0, "shape"),
+    (np.zeros((0, 2)), 0, "n >= 1"),
+    ([[0, 0], [1, 1]], -1, "F must"),
+    ([[0, 0], [1, 1]], 2, "F must"),
+    ([[0, 0], [1, 1]], 1.5, "integer"),
+    ([[0, 0], [1, 1]], True, "integer"),
+    ([["a", 0], [1, 1]], 0, "numbers"),
+])
+def test_bad_input(X, F, match):
+    with pytest.raises(InputError, match=match):
+        rescon.safe_kernel(X, F)
+
+
+def test_bad_point_method_and_target():
+    K = rescon.safe_kernel([[0, 0], [2, 0], [0, 2], [2, 2], [1, 1]], 1)
+    with pytest.raises(InputError, match="method"):
+        K.point("centroid")
+    with pytest.raises(InputError, match="target"):
+        K.point("project", target=[1, 2, 3])
+    with pytest.raises(InputError, match="x must"):
+        K.contains([1.0])
+
+
+def test_huge_input_refused_with_estimate():
+    X = np.random.default_rng(0).normal(size=(400, 5))
+    with pytest.raises(InputError, match="point tests"):
+        rescon.safe_kernel(X, 10)
