@@ -48,6 +48,9 @@ __all__ = ["chebyshev", "lp_backends", "project", "project_batch", "qp_backends"
 
 #: Tolerance asked of every solver (absolute / relative gap and feasibility).
 TOL = 1e-9
+#: Gap tolerance of the interior-point solver (Clarabel): its error grows like
+#: √gap when a constraint is weakly active, and 1e-9 left errors of 1e-6.
+IPM_TOL = 1e-12
 #: A row with ``‖A_i Bᵀ‖ ≤ _HULL_NORMAL ‖A_i‖`` is normal to the hull (see module doc).
 _HULL_NORMAL = 1e-12
 #: Orthonormality the ``basis`` rows must have: ``max |B Bᵀ − I| ≤ _ORTHONORMAL``.
@@ -57,10 +60,11 @@ _ORTHONORMAL = 1e-8
 _CVXPY_SOLVERS: dict[str, tuple[frozenset[str], dict]] = {
     "CLARABEL": (
         frozenset({"LP", "QP"}),
-        {"tol_gap_abs": TOL, "tol_gap_rel": TOL, "tol_feas": TOL},
+        {"tol_gap_abs": IPM_TOL, "tol_gap_rel": IPM_TOL, "tol_feas": IPM_TOL},
     ),
+    # OSQP (ADMM) hits its iteration limit on some LPs at 1e-9: QP only
     "OSQP": (
-        frozenset({"LP", "QP"}),
+        frozenset({"QP"}),
         {"eps_abs": TOL, "eps_rel": TOL, "polishing": True, "max_iter": 200_000},
     ),
     "HIGHS": (
@@ -74,26 +78,23 @@ _CVXPY_SOLVERS: dict[str, tuple[frozenset[str], dict]] = {
 #: CasADi conic plugins, in order of preference → (capabilities, options).
 _CASADI_PLUGINS: dict[str, tuple[frozenset[str], dict]] = {
     "qpoases": (frozenset({"LP", "QP"}), {"printLevel": "none"}),
-    # no polishing: CasADi's OSQP then prints on C-level stdout (accuracy is eps's)
+    # no polishing: CasADi's OSQP then prints on C-level stdout; QP only as for CVXPY
     "osqp": (
-        frozenset({"LP", "QP"}),
+        frozenset({"QP"}),
         {"osqp": {"eps_abs": TOL, "eps_rel": TOL, "polish": False, "verbose": False,
                   "max_iter": 200_000}},
-    ),
-    # CasADi's proxqp takes no duality-gap check (residuals 1e-9 leave errors ~1e-5;
-    # 1e-12 leaves ~1e-9), its default sparse backend ignores eps_abs, and it reports
-    # PROXQP_PRIMAL_INFEASIBLE on some feasible LPs: dense, 1e-12, QP only.
-    "proxqp": (
-        frozenset({"QP"}),
-        {"proxqp": {"eps_abs": 1e-12, "eps_rel": 0.0, "verbose": False, "backend": "dense"}},
     ),
 }
 #: "backend:solver" pairs that exist but are not offered → why.
 _REFUSED = {
     "casadi:highs": "CasADi's bundled HiGHS and highspy cannot share a process (segfault "
     "or ImportError, depending on which loads first); use backend='highs'",
-    "cvxpy:PROXQP": "CVXPY's interface sets no duality-gap check (errors ~1e-5) and "
-    "reports 'infeasible' on some feasible problems; use backend='proxsuite'",
+    "casadi:proxqp": "CasADi's interface exposes neither proxqp's duality-gap check (errors "
+    "~1e-5) nor its infeasibility tolerance (spurious PRIMAL_INFEASIBLE on feasible "
+    "problems); use backend='proxsuite'",
+    "cvxpy:PROXQP": "CVXPY's interface exposes neither proxqp's duality-gap check (errors "
+    "~1e-5) nor its infeasibility tolerance (spurious 'infeasible'); use "
+    "backend='proxsuite'",
 }
 
 
@@ -156,9 +157,10 @@ def project(A, b, origin, basis, target, *, backend="clarabel", solver=None) -> 
         ``"cvxpy"``/``"cvxpy:SOLVER"``, ``"casadi"``/``"casadi:plugin"``.
     solver : str, optional
         The solver behind a symbolic backend: a CVXPY solver name (default
-        ``"CLARABEL"``; also OSQP, HIGHS, SCS, and SCIPY for LPs) or a CasADi conic
-        plugin (default ``"qpoases"``; also ``"osqp"``, and ``"proxqp"`` for QPs).
-        ``_REFUSED`` says why ``cvxpy:PROXQP`` and ``casadi:highs`` are not offered.
+        ``"CLARABEL"``; also HIGHS, SCS, OSQP for QPs, SCIPY for LPs) or a CasADi
+        conic plugin (``"qpoases"``, the default, or ``"osqp"`` for QPs).
+        ``_REFUSED`` says why ``cvxpy:PROXQP``, ``casadi:proxqp`` and ``casadi:highs``
+        are not offered.
         Not accepted by the matrix backends.
 
     Returns
@@ -485,7 +487,7 @@ def _clarabel(s: _Standard) -> np.ndarray:
 
     settings = clarabel.DefaultSettings()
     settings.verbose = False
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = TOL
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = IPM_TOL
     cones = [clarabel.NonnegativeConeT(s.h.size)] if s.h.size else []
     P = sps.triu(sps.csc_matrix(s.P), format="csc")
     sol = clarabel.DefaultSolver(P, s.q, sps.csc_matrix(s.G), s.h, cones, settings).solve()
@@ -499,6 +501,8 @@ def _proxsuite_setup(qp, s: _Standard) -> None:
     qp.settings.eps_abs = qp.settings.eps_duality_gap_abs = TOL
     qp.settings.eps_rel = qp.settings.eps_duality_gap_rel = 0.0
     qp.settings.check_duality_gap = True  # small residuals alone leave errors ~1e-5
+    # the default 1e-4 certifies infeasibility of some feasible QPs
+    qp.settings.eps_primal_inf = qp.settings.eps_dual_inf = 1e-12
     qp.settings.verbose = False
     if s.h.size:
         qp.init(s.P, s.q, None, None, s.G, None, s.h)
