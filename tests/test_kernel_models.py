@@ -190,6 +190,18 @@ def test_batch_stress(d):
 
 
 @pytest.mark.parametrize("backend", QP_BACKENDS)
+def test_project_degenerate(backend):
+    """Weakly active constraints (zero multipliers): targets on a facet, at a vertex,
+    or projecting onto a vertex along a facet; interior-point errors are ~√gap here.
+    The square [-1, 1]² with the redundant cut x + y ≤ 2 through its corner."""
+    A = np.vstack([SQUARE[0], [1.0, 1.0]])
+    b = np.append(SQUARE[1], 2.0)
+    for y in ([2.0, 1.0], [1.0, 1.0], [1.0, 0.5], [2.0, -1.0], [0.5, 1.0], [3.0, 3.0]):
+        x = project(A, b, [0.0, 0.0], np.eye(2), y, backend=backend)
+        np.testing.assert_allclose(x, np.clip(y, -1, 1), atol=1e-6, err_msg=f"target {y}")
+
+
+@pytest.mark.parametrize("backend", QP_BACKENDS)
 def test_infeasible_qp_raises(backend):
     A, b = np.array([[1.0], [-1.0]]), np.array([-1.0, -1.0])  # x ≤ −1 and x ≥ 1
     with pytest.raises(SolverError, match="status"):
@@ -242,7 +254,7 @@ def test_batch_equals_loop(backend):
         pytest.skip(f"{backend} not installed")
     problems = batch_problems(30)
     X = project_batch(problems, backend=backend)
-    loop = np.array([project(*p, backend="clarabel") for p in problems])
+    loop = np.array([project(*p, backend=backend) for p in problems])
     assert X.shape == (30, 2)
     np.testing.assert_allclose(X, loop, atol=1e-7)
 
