@@ -16,7 +16,7 @@ float arithmetic is exact (small integers), and s = 0 means "on the hyperplane".
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True)
@@ -52,69 +52,13 @@ def _cofactors(Y, idx, k, perms, psigns, C, Cabs):
 
 
 @njit(cache=True)
-def classify_subsets(Y, W, k, perms, psigns, c_err, count, F):
-    """For the first ``count`` k-subsets of range(len(Y)) in lexicographic order:
-    the weighted numbers of points surely on the + side, surely on the − side and
-    uncertain, the subset, its cofactors C and their permanents |C|, and whether C is
-    surely zero (degenerate subset; only decided when c_err = 0).
-
-    The scan of a subset stops once both sides surely hold more than F points (it
-    can then bound no valid halfspace), so counts above F are not exact."""
-    n = Y.shape[0]
-    plus = np.zeros(count, dtype=np.int64)
-    minus = np.zeros(count, dtype=np.int64)
-    unc = np.zeros(count, dtype=np.int64)
-    degenerate = np.zeros(count, dtype=np.bool_)
+def k_subsets(n, k, count):
+    """The first ``count`` k-subsets of range(n) in lexicographic order, (count, k)."""
     subsets = np.empty((count, k), dtype=np.int32)
-    cof = np.empty((count, k))
-    cof_abs = np.empty((count, k))
     idx = np.arange(k)
-    C = np.empty(k)
-    Cabs = np.empty(k)
-    member = np.zeros(n, dtype=np.bool_)
     for t in range(count):
         for i in range(k):
             subsets[t, i] = idx[i]
-            member[idx[i]] = True
-        if k == 1:
-            C[0] = 1.0
-            Cabs[0] = 1.0
-        else:
-            _cofactors(Y, idx, k, perms, psigns, C, Cabs)
-        zero = True
-        for j in range(k):
-            if C[j] != 0.0:
-                zero = False
-        if zero and c_err == 0.0:
-            degenerate[t] = True
-        else:
-            p0 = idx[0]
-            for q in range(n):
-                if member[q]:
-                    continue
-                s = 0.0
-                bound = 0.0
-                for j in range(k):
-                    diff = Y[q, j] - Y[p0, j]
-                    s += diff * C[j]
-                    bound += abs(diff) * Cabs[j]
-                bound *= c_err
-                if s > bound:
-                    plus[t] += W[q]
-                    if plus[t] > F and minus[t] > F:
-                        break
-                elif s < -bound:
-                    minus[t] += W[q]
-                    if plus[t] > F and minus[t] > F:
-                        break
-                elif c_err != 0.0:
-                    unc[t] += W[q]
-        for j in range(k):
-            cof[t, j] = C[j]
-            cof_abs[t, j] = Cabs[j]
-        for i in range(k):
-            member[idx[i]] = False
-        # next combination
         i = k - 1
         while i >= 0 and idx[i] == n - k + i:
             i -= 1
@@ -123,4 +67,83 @@ def classify_subsets(Y, W, k, perms, psigns, c_err, count, F):
         idx[i] += 1
         for j in range(i + 1, k):
             idx[j] = idx[j - 1] + 1
-    return plus, minus, unc, degenerate, subsets, cof, cof_abs
+    return subsets
+
+
+@njit(cache=True, parallel=True)
+def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
+    """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
+    on the + side, surely on the − side and uncertain, its cofactors C and their
+    permanents |C|, and whether C is surely zero (degenerate subset; only decided
+    when c_err = 0).
+
+    A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
+    (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
+    the precise one. The scan of a subset stops once both sides surely hold more than
+    F points (it can then bound no valid halfspace), so counts above F are not exact."""
+    n, k = Y.shape
+    count = subsets.shape[0]
+    plus = np.zeros(count, dtype=np.int64)
+    minus = np.zeros(count, dtype=np.int64)
+    unc = np.zeros(count, dtype=np.int64)
+    degenerate = np.zeros(count, dtype=np.bool_)
+    cof = np.empty((count, k))
+    cof_abs = np.empty((count, k))
+    M = 0.0
+    for q in range(n):
+        for j in range(k):
+            M = max(M, abs(Y[q, j]))
+    for t in prange(count):
+        idx = subsets[t]
+        C = np.empty(k)
+        Cabs = np.empty(k)
+        if k == 1:
+            C[0] = 1.0
+            Cabs[0] = 1.0
+        else:
+            _cofactors(Y, idx, k, perms, psigns, C, Cabs)
+        zero = True
+        coarse = 0.0
+        for j in range(k):
+            cof[t, j] = C[j]
+            cof_abs[t, j] = Cabs[j]
+            coarse += Cabs[j]
+            if C[j] != 0.0:
+                zero = False
+        coarse *= c_err * 2.0 * M
+        if zero and c_err == 0.0:
+            degenerate[t] = True
+            continue
+        p0 = idx[0]
+        np_, nm, nu = 0, 0, 0
+        for q in range(n):
+            is_member = False
+            for i in range(k):
+                if idx[i] == q:
+                    is_member = True
+            if is_member:
+                continue
+            s = 0.0
+            for j in range(k):
+                s += (Y[q, j] - Y[p0, j]) * C[j]
+            if abs(s) <= coarse:
+                bound = 0.0
+                for j in range(k):
+                    bound += abs(Y[q, j] - Y[p0, j]) * Cabs[j]
+                bound *= c_err
+            else:
+                bound = coarse
+            if s > bound:
+                np_ += W[q]
+                if np_ > F and nm > F:
+                    break
+            elif s < -bound:
+                nm += W[q]
+                if np_ > F and nm > F:
+                    break
+            elif c_err != 0.0:
+                nu += W[q]
+        plus[t] = np_
+        minus[t] = nm
+        unc[t] = nu
+    return plus, minus, unc, degenerate, cof, cof_abs

@@ -47,6 +47,7 @@ class Halfspaces:
     bf: np.ndarray  # (h,)
     af_abs: np.ndarray  # (h, k) permanents bounding the error of af
     b_abs: np.ndarray  # (h,) the same for bf
+    outside: np.ndarray  # (h,) points surely strictly outside (at most F)
     c_err: float
     _cache: dict[int, tuple[tuple[int, ...], int]] = field(default_factory=dict)
 
@@ -130,7 +131,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
-    from ._candidates import classify_subsets
+    from ._candidates import classify_subsets, k_subsets
 
     m, k = Y.shape
     count = comb(m, k)
@@ -143,18 +144,21 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     exact_floats = k == 1 or bits <= _exact_float_bits(k)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
-    plus, minus, unc, degenerate, subsets, cof, cof_abs = classify_subsets(
-        np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), k, perms, signs,
-        c_err, count, F)
+    subsets = k_subsets(m, k, count)
+    plus, minus, unc, degenerate, cof, cof_abs = classify_subsets(
+        np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms, signs,
+        c_err, F)
     live = ~degenerate
     sure_plus = live & (plus + unc <= F)
     sure_minus = live & (minus + unc <= F)
     rows: list[int] = []
     sides: list[int] = []
+    outside: list[int] = []
     for side, sure, cnt in ((1, sure_plus, plus), (-1, sure_minus, minus)):
         ts = np.flatnonzero(sure)
         rows += ts.tolist()
         sides += [side] * len(ts)
+        outside += cnt[ts].tolist()
     maybe = live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus))
     for t in np.flatnonzero(maybe):  # undecided by the filter: count exactly
         n_plus, n_minus = _exact_counts(Yi, W, subsets[t])
@@ -163,9 +167,11 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         if n_plus <= F and not sure_plus[t]:
             rows.append(int(t))
             sides.append(1)
+            outside.append(n_plus)
         if n_minus <= F and not sure_minus[t]:
             rows.append(int(t))
             sides.append(-1)
+            outside.append(n_minus)
     idx = np.array(rows, dtype=np.int64)
     sign = np.array(sides, dtype=np.int64)
     through = subsets[idx].astype(np.int64)
@@ -174,14 +180,15 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     bf = np.einsum("ij,ij->i", af, p0)
     af_abs = cof_abs[idx]
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
-    hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, c_err)
+    out = np.array(outside, dtype=np.int64)
+    hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err)
     # an affinely dependent subset has every other point within the rounding bound,
     # so only subsets with no point surely off their hyperplane can be degenerate
     suspect = [h for h in np.flatnonzero(plus[idx] + minus[idx] == 0) if not any(hs.exact(h)[0])]
     if suspect:
         keep = np.setdiff1d(np.arange(len(hs)), suspect)
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
-                        b_abs[keep], c_err)
+                        b_abs[keep], out[keep], c_err)
     return hs
 
 

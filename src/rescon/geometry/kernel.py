@@ -13,7 +13,7 @@ import operator
 import time
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -103,10 +103,19 @@ class SafeKernel:
     affine_basis: np.ndarray = field(repr=False)
     Aeq: np.ndarray = field(repr=False)
     beq: np.ndarray = field(repr=False)
-    certificate: dict[str, Any] = field(repr=False)
     seconds: float
     exact_vertices: tuple[tuple[Fraction, ...], ...] = field(repr=False)
     _exact: _Exact = field(repr=False, compare=False)
+    _make_certificate: Callable[[], dict[str, Any]] = field(repr=False, compare=False)
+    _cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def certificate(self) -> dict[str, Any]:
+        """The ``safe_kernel`` / ``kernel_empty`` certificate (built on first use: the
+        exact rationals are written out as "p/q" strings)."""
+        if "certificate" not in self._cache:
+            self._cache["certificate"] = self._make_certificate()
+        return self._cache["certificate"]
 
     @property
     def is_empty(self) -> bool:
@@ -213,26 +222,30 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         poly = _clip(P, hull, F)
         verts = tuple(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
                       for y in poly.fraction_vertices())
-        used = [h for h in range(len(poly.a)) if poly.tight_vertices(h)]
+        used = sorted(poly.incidence())
         constraints = tuple(_ambient(hull, d, poly.a[h], poly.b[h], P.scale) for h in used)
     if not verts:
         exact = _Exact(verts, constraints, eqs)
-        cert = _empty_certificate(Xa, F, hull, poly, P.scale, d)
         return SafeKernel(Xa, F, -1, np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), None,
-                          np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), cert,
-                          time.perf_counter() - t0, (), exact)
-    dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d)
+                          np.zeros((0, d)), np.zeros((0, d)), np.zeros(0),
+                          time.perf_counter() - t0, (), exact,
+                          lambda: _empty_certificate(Xa, F, hull, poly, P.scale, d))
+    full = poly is not None and hull.dim == d and poly.dim() == d
+    dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d, full)
     facets = _relative_facets(poly, hull, P.scale, d, dim) if poly is not None else []
     A, b = _unit_rows(facets, d)
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
-    cert = {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(), "F": F,
-            "dim": dim, "vertices": [[_q(v) for v in x] for x in verts],
-            "equalities": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in eqs],
-            "facets": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in constraints],
-            "proof": {"method": "halfspaces"}}
+
+    def certificate() -> dict[str, Any]:
+        return {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(),
+                "F": F, "dim": dim, "vertices": [[_q(v) for v in x] for x in verts],
+                "equalities": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in eqs],
+                "facets": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in constraints],
+                "proof": {"method": "halfspaces"}}
+
     V = np.array([[float(v) for v in x] for x in verts])
-    return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq, cert,
-                      time.perf_counter() - t0, verts, exact)
+    return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq,
+                      time.perf_counter() - t0, verts, exact, certificate)
 
 
 def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
@@ -255,14 +268,17 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     lo = [min(y[j] for y in rows) for j in range(hull.dim)]
     hi = [max(y[j] for y in rows) for j in range(hull.dim)]
     poly = ExactPolytope.box(lo, hi)
-    clip_to_fixpoint(poly, H, P.scale)
+    clip_to_fixpoint(poly, H, P.scale, first=np.flatnonzero(H.outside == F))
     return poly
 
 
-def _affine_of(verts, d: int):
+def _affine_of(verts, d: int, full: bool):
     """dim, origin, orthonormal basis and equalities (floats, and exact) of
-    aff(vertices)."""
+    aff(vertices); ``full``: already known to be d-dimensional."""
     v0 = verts[0]
+    if full:
+        origin = np.array([float(v) for v in v0])
+        return d, origin, np.eye(d), np.zeros((0, d)), np.zeros(0), ()
     diffs = [[vi - v0i for vi, v0i in zip(v, v0, strict=True)] for v in verts[1:]]
     ns = nullspace_exact(diffs) if diffs else [
         [Fraction(int(i == j)) for i in range(d)] for j in range(d)]
@@ -292,9 +308,8 @@ def _relative_facets(poly: ExactPolytope, hull: AffineHull, scale: int, d: int, 
         return []
     nv = len(poly.verts)
     out = []
-    for h in range(len(poly.a)):
-        members = poly.tight_vertices(h)
-        if 0 < len(members) < nv and poly.face_dim(members) == dim - 1:
+    for h, members in sorted(poly.incidence().items()):
+        if len(members) >= dim and len(members) < nv and poly.face_dim(members) == dim - 1:
             out.append(_ambient(hull, d, poly.a[h], poly.b[h], scale))
     return out
 

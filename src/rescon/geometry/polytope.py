@@ -33,6 +33,26 @@ class Farkas:
     multipliers: tuple[Fraction, ...]
 
 
+def _bits(t: int):
+    """Indices of the set bits of t."""
+    while t:
+        low = t & -t
+        yield low.bit_length() - 1
+        t ^= low
+
+
+class _Members(dict):
+    """constraint → the vertices tight on it, computed on first use."""
+
+    def __init__(self, tight: list[int]) -> None:
+        super().__init__()
+        self.tight = tight
+
+    def __missing__(self, h: int) -> list[int]:
+        out = self[h] = [i for i, t in enumerate(self.tight) if t >> h & 1]
+        return out
+
+
 def _normalise(h: tuple[int, ...]) -> tuple[int, ...]:
     g = 0
     for v in h:
@@ -50,6 +70,7 @@ class ExactPolytope:
     verts: list[tuple[int, ...]] = field(default_factory=list)  # (w, y_1..y_k)
     tight: list[int] = field(default_factory=list)
     farkas: Farkas | None = None  # set when a clip empties the polytope
+    _fv: np.ndarray | None = field(default=None, repr=False)  # float vertices (cache)
 
     @classmethod
     def box(cls, lo: list[int], hi: list[int]) -> ExactPolytope:
@@ -81,47 +102,92 @@ class ExactPolytope:
 
     def slack(self, a: tuple[int, ...], b: int) -> list[int]:
         """s_v = a·y_v − b·w_v for every vertex (the sign of a·x − b at x = y/w)."""
-        return [sum(ai * yi for ai, yi in zip(a, v[1:], strict=True)) - b * v[0]
-                for v in self.verts]
+        return [self._slack_at(a, b, i) for i in range(len(self.verts))]
+
+    def _slack_at(self, a: tuple[int, ...], b: int, i: int) -> int:
+        v = self.verts[i]
+        return sum(ai * yi for ai, yi in zip(a, v[1:], strict=True)) - b * v[0]
+
+    def _signs(self, a: tuple[int, ...], b: int) -> tuple[np.ndarray, dict[int, int]]:
+        """sign(a·x_v − b) for every vertex: floats beyond a rounding bound (the float
+        vertices are correctly rounded, a and b rounded once), exact integers inside it.
+        Also the exact slacks computed on the way."""
+        fv = self._float_array()
+        af = np.array([float(x) for x in a])
+        bf = float(b)
+        sf = fv @ af - bf
+        bound = 2.0 * (self.k + 3) * _EPS * (np.abs(fv) @ np.abs(af) + abs(bf))
+        sign = np.where(sf > bound, 1, np.where(sf < -bound, -1, 0))
+        exact: dict[int, int] = {}
+        for i in np.flatnonzero(sign == 0):
+            x = exact[int(i)] = self._slack_at(a, b, int(i))
+            sign[i] = (x > 0) - (x < 0)
+        return sign, exact
+
+    def _float_array(self) -> np.ndarray:
+        if self._fv is None or len(self._fv) != len(self.verts):
+            self._fv = np.array([[yi / v[0] for yi in v[1:]] for v in self.verts],
+                                dtype=np.float64).reshape(len(self.verts), self.k)
+        return self._fv
 
     def clip(self, a: tuple[int, ...], b: int) -> bool:
         """Intersect with a·y ≤ b; False (and nothing recorded) if it cuts nothing."""
-        s = self.slack(a, b)
-        if all(x <= 0 for x in s):
+        sign, exact = self._signs(a, b)
+        if not (sign > 0).any():
             return False
         hid = len(self.a)
         bit = 1 << hid
-        if all(x > 0 for x in s):
-            self.farkas = self._farkas(a, b, s)
+        if (sign > 0).all():
+            self.farkas = self._farkas(a, b, self.slack(a, b))
             self.a.append(a)
             self.b.append(b)
-            self.verts, self.tight = [], []
+            self.verts, self.tight, self._fv = [], [], None
             return True
+
+        def s_of(i: int) -> int:
+            x = exact.get(i)
+            if x is None:
+                x = exact[i] = self._slack_at(a, b, i)
+            return x
+
+        members = _Members(self.tight)
         need = self.k - 1
-        ins = [i for i, x in enumerate(s) if x < 0]
-        outs = [i for i, x in enumerate(s) if x > 0]
-        new_v, new_t = [], []
-        for v in outs:
+        new_v, new_t, new_f = [], [], []
+        for v in np.flatnonzero(sign > 0).tolist():
             tv = self.tight[v]
-            for u in ins:
-                z = self.tight[u] & tv
-                if z.bit_count() < need or not self._edge(u, v, z):
+            shared: dict[int, int] = {}
+            if need == 0:  # k = 1: every pair of a segment's ends is an edge
+                shared = dict.fromkeys(range(len(self.verts)), 0)
+            for h in _bits(tv):
+                for u in members[h]:
+                    shared[u] = shared.get(u, 0) + 1
+            for u, cnt in shared.items():
+                if cnt < need or sign[u] >= 0:
                     continue
-                su, sv = s[u], s[v]
-                p = tuple(sv * cu - su * cv for cu, cv in zip(self.verts[u], self.verts[v],
-                                                                strict=True))
-                new_v.append(_normalise(p))
+                z = self.tight[u] & tv
+                if not self._edge(u, v, z, members):
+                    continue
+                su, sv = s_of(u), s_of(v)
+                p = _normalise(tuple(sv * cu - su * cv for cu, cv in
+                                     zip(self.verts[u], self.verts[v], strict=True)))
+                new_v.append(p)
                 new_t.append(z | bit)
-        keep = [i for i, x in enumerate(s) if x <= 0]
+                new_f.append([yi / p[0] for yi in p[1:]])
+        keep = np.flatnonzero(sign <= 0).tolist()
+        fv = self._float_array()
         self.verts = [self.verts[i] for i in keep] + new_v
-        self.tight = [self.tight[i] | (bit if s[i] == 0 else 0) for i in keep] + new_t
+        self.tight = [self.tight[i] | (bit if sign[i] == 0 else 0) for i in keep] + new_t
+        self._fv = np.vstack([fv[keep], np.array(new_f, dtype=np.float64).reshape(-1, self.k)])
         self.a.append(a)
         self.b.append(b)
         return True
 
-    def _edge(self, u: int, v: int, z: int) -> bool:
+    def _edge(self, u: int, v: int, z: int, members: _Members) -> bool:
         """u, v span an edge: no other vertex is tight on all of z."""
-        return not any((t & z) == z for i, t in enumerate(self.tight) if i != u and i != v)
+        if not z:
+            return len(self.verts) == 2
+        smallest = min((members[h] for h in _bits(z)), key=len)
+        return not any((self.tight[w] & z) == z for w in smallest if w != u and w != v)
 
     def _farkas(self, a: tuple[int, ...], b: int, s: list[int]) -> Farkas:
         """All vertices violate a·y ≤ b. At the vertex v* minimising a·y over the
@@ -154,8 +220,8 @@ class ExactPolytope:
     # ------------------------------------------------------------------ #
 
     def float_vertices(self) -> np.ndarray:
-        return np.array([[yi / v[0] for yi in v[1:]] for v in self.verts], dtype=np.float64
-                        ).reshape(len(self.verts), self.k)
+        """The vertices as correctly rounded floats."""
+        return self._float_array().copy()
 
     def fraction_vertices(self) -> list[tuple[Fraction, ...]]:
         return [tuple(Fraction(yi, v[0]) for yi in v[1:]) for v in self.verts]
@@ -172,16 +238,37 @@ class ExactPolytope:
     def tight_vertices(self, h: int) -> list[int]:
         return [i for i, t in enumerate(self.tight) if t >> h & 1]
 
+    def incidence(self) -> dict[int, list[int]]:
+        """constraint → the vertices tight on it (only constraints tight somewhere)."""
+        out: dict[int, list[int]] = {}
+        for i, t in enumerate(self.tight):
+            for h in _bits(t):
+                out.setdefault(h, []).append(i)
+        return out
+
     def face_dim(self, members: list[int]) -> int:
+        """Affine dimension of the vertices ``members``. Full rank is read off the float
+        SVD when the smallest singular value exceeds the rounding perturbation
+        (Weyl: the exact matrix differs by ‖E‖₂ ≤ √(size) · 4ε · max|x|, plus the
+        SVD's own error); anything else is decided by exact elimination."""
         if not members:
             return -1
+        if len(members) == 1:
+            return 0
+        fv = self._float_array()[members]
+        D = fv[1:] - fv[0]
+        sv = np.linalg.svd(D, compute_uv=False)
+        perturb = np.sqrt(D.size) * 8.0 * _EPS * (np.abs(fv).max() + sv[0])
+        if sv[-1] > 16.0 * perturb and len(sv) == min(D.shape):
+            return len(sv)
         w0, *y0 = self.verts[members[0]]
         rows = [[yi * w0 - y0i * self.verts[m][0]
                  for yi, y0i in zip(self.verts[m][1:], y0, strict=True)] for m in members[1:]]
-        return bareiss_rank(rows)[0] if rows else 0
+        return bareiss_rank(rows)[0]
 
 
-def clip_to_fixpoint(P: ExactPolytope, H, scale: int) -> None:
+def clip_to_fixpoint(P: ExactPolytope, H, scale: int, first: np.ndarray | None = None
+                     ) -> None:
     """Clip P (scaled integer coordinates y = scale · x) by every valid halfspace of
     ``H`` (:class:`rescon.geometry.halfspaces.Halfspaces`) that a vertex violates,
     until none is.
@@ -191,32 +278,62 @@ def clip_to_fixpoint(P: ExactPolytope, H, scale: int) -> None:
     float normals' own error (c_err · permanents) and the evaluation — and in exact
     integers for the pairs the bound leaves undecided. P only shrinks, so a halfspace
     satisfied at every vertex is satisfied for good and leaves the working set.
+    ``first``: indices of H to clip by before the others (the likely facets).
     """
-    ids = np.arange(len(H))
-    Af, bf, Aabs, babs = H.af, H.bf, H.af_abs, H.b_abs
+    if first is not None and 0 < len(first) < len(H):
+        _clip_rounds(P, H, scale, np.asarray(first, dtype=np.int64))
+    _clip_rounds(P, H, scale, np.arange(len(H)))
+
+
+def _clip_rounds(P: ExactPolytope, H, scale: int, ids: np.ndarray) -> None:
+    """clip_to_fixpoint on the halfspaces ``ids`` of H.
+
+    Each round evaluates every (halfspace, vertex) pair in floats. A per-row bound
+    (valid for every vertex, as |v_j| ≤ M) splits the pairs into surely violated,
+    surely satisfied and near; rows with near pairs get the per-pair bound, and the
+    pairs still undecided are decided exactly. A row satisfied at every vertex is
+    done for good (P only shrinks); surely violated rows are clipped by the most
+    violated per vertex, exactly violated ones all."""
+    Af, bf, Aabs, babs = H.af[ids], H.bf[ids], H.af_abs[ids], H.b_abs[ids]
+    norms = np.linalg.norm(Af, axis=1)
     c = 2.0 * (P.k + 4) * _EPS
     while not P.is_empty and len(ids):
         V = P.float_vertices() / scale
-        absV = np.abs(V).T
+        M = np.abs(V).max()
+        row_bound = (H.c_err * (Aabs.sum(axis=1) * M + babs)
+                     + c * (np.abs(Af).sum(axis=1) * M + np.abs(bf)))
         S = Af @ V.T - bf[:, None]
-        bound = (H.c_err * (Aabs @ absV + babs[:, None])
-                 + c * (np.abs(Af) @ absV + np.abs(bf)[:, None]))
-        sure = S > bound
-        unsure = np.abs(S) <= bound
-        if sure.any():
-            score = np.where(sure, S / np.linalg.norm(Af, axis=1)[:, None], -np.inf)
-            for h in np.unique(score.argmax(axis=0)[sure.any(axis=0)]):
-                P.clip(*H.exact(int(ids[h])))
-                if P.is_empty:
-                    return
-        else:
-            for h in np.flatnonzero(unsure.any(axis=1)):
+        sure = S > row_bound[:, None]
+        violated = sure.any(axis=1)
+        near_rows = np.flatnonzero(~violated & (S.max(axis=1) >= -row_bound))
+        done = ~violated
+        done[near_rows] = False
+        exact_cuts = []
+        if len(near_rows):
+            absV = np.abs(V).T
+            Sn = S[near_rows]
+            bound = (H.c_err * (Aabs[near_rows] @ absV + babs[near_rows, None])
+                     + c * (np.abs(Af[near_rows]) @ absV + np.abs(bf[near_rows])[:, None]))
+            for r, h in enumerate(near_rows):
+                if (Sn[r] > bound[r]).any():
+                    exact_cuts.append(int(ids[h]))
+                    continue
                 a, b = H.exact(int(ids[h]))
                 if any(sum(ai * yi for ai, yi in zip(a, P.verts[v][1:], strict=True))
-                       - b * P.verts[v][0] > 0 for v in np.flatnonzero(unsure[h])):
-                    P.clip(a, b)
-                    break
-            else:
+                       - b * P.verts[v][0] > 0 for v in np.flatnonzero(Sn[r] >= -bound[r])):
+                    exact_cuts.append(int(ids[h]))
+                else:
+                    done[h] = True
+        if not violated.any() and not exact_cuts:
+            return
+        picks = []
+        if violated.any():
+            score = np.where(sure, S / norms[:, None], -np.inf)
+            picks = [int(ids[h]) for h in np.unique(score.argmax(axis=0)[sure.any(axis=0)])]
+        for g in picks + exact_cuts:
+            P.clip(*H.exact(g))
+            if P.is_empty:
                 return
-        keep = (sure | unsure).any(axis=1)  # the others hold at every vertex: for good
-        ids, Af, bf, Aabs, babs = ids[keep], Af[keep], bf[keep], Aabs[keep], babs[keep]
+        keep = ~done  # the others hold at every vertex, and P only shrinks: for good
+        ids, Af, bf, Aabs, babs, norms = (ids[keep], Af[keep], bf[keep], Aabs[keep],
+                                          babs[keep], norms[keep])
