@@ -20,15 +20,30 @@ from numba import njit, prange
 
 
 @njit(cache=True)
-def _cofactors(Y, idx, k, perms, psigns, C, Cabs):
+def _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols):
     """Cofactors of the last row of [p_1 − p_0; ...; p_{k−1} − p_0; ·] and their
-    absolute-value permanents, into C and Cabs (length k)."""
-    D = np.empty((max(k - 1, 1), k))
+    absolute-value permanents, into C and Cabs (length k); D ((k−1, k)) and cols
+    (k − 1) are scratch. Closed forms for k = 2, 3."""
     p0 = idx[0]
     for i in range(k - 1):
         for j in range(k):
             D[i, j] = Y[idx[i + 1], j] - Y[p0, j]
-    cols = np.empty(max(k - 1, 1), dtype=np.int64)
+    if k == 2:
+        C[0] = -D[0, 1]
+        C[1] = D[0, 0]
+        Cabs[0] = abs(D[0, 1])
+        Cabs[1] = abs(D[0, 0])
+        return
+    if k == 3:
+        a0, a1, a2 = D[0, 0], D[0, 1], D[0, 2]
+        b0, b1, b2 = D[1, 0], D[1, 1], D[1, 2]
+        C[0] = a1 * b2 - a2 * b1
+        C[1] = a2 * b0 - a0 * b2
+        C[2] = a0 * b1 - a1 * b0
+        Cabs[0] = abs(a1 * b2) + abs(a2 * b1)
+        Cabs[1] = abs(a2 * b0) + abs(a0 * b2)
+        Cabs[2] = abs(a0 * b1) + abs(a1 * b0)
+        return
     for j in range(k):
         c = 0
         for t in range(k):
@@ -51,6 +66,23 @@ def _cofactors(Y, idx, k, perms, psigns, C, Cabs):
         Cabs[j] = per
 
 
+#: below this many subsets the scan runs on one thread (thread start-up dominates)
+PARALLEL_MIN_SUBSETS = 20_000
+
+
+def classify(Y, W, subsets, perms, psigns, c_err, F):
+    """:func:`classify_subsets`, on one thread for small inputs."""
+    count, k = subsets.shape
+    if count >= PARALLEL_MIN_SUBSETS:
+        return classify_subsets(Y, W, subsets, perms, psigns, c_err, F)
+    out = (np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64),
+           np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_),
+           np.empty((count, k)), np.empty((count, k)))
+    M = float(np.abs(Y).max()) if Y.size else 0.0
+    _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, 0, count, *out)
+    return out
+
+
 @njit(cache=True)
 def k_subsets(n, k, count):
     """The first ``count`` k-subsets of range(n) in lexicographic order, (count, k)."""
@@ -70,38 +102,22 @@ def k_subsets(n, k, count):
     return subsets
 
 
-@njit(cache=True, parallel=True)
-def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
-    """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
-    on the + side, surely on the − side and uncertain, its cofactors C and their
-    permanents |C|, and whether C is surely zero (degenerate subset; only decided
-    when c_err = 0).
-
-    A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
-    (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
-    the precise one. The scan of a subset stops once both sides surely hold more than
-    F points (it can then bound no valid halfspace), so counts above F are not exact."""
+@njit(cache=True, nogil=True)
+def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
+                    plus, minus, unc, degenerate, cof, cof_abs):
+    """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays)."""
     n, k = Y.shape
-    count = subsets.shape[0]
-    plus = np.zeros(count, dtype=np.int64)
-    minus = np.zeros(count, dtype=np.int64)
-    unc = np.zeros(count, dtype=np.int64)
-    degenerate = np.zeros(count, dtype=np.bool_)
-    cof = np.empty((count, k))
-    cof_abs = np.empty((count, k))
-    M = 0.0
-    for q in range(n):
-        for j in range(k):
-            M = max(M, abs(Y[q, j]))
-    for t in prange(count):
+    C = np.empty(k)
+    Cabs = np.empty(k)
+    D = np.empty((max(k - 1, 1), k))
+    cols = np.empty(max(k - 1, 1), dtype=np.int64)
+    for t in range(t0, t1):
         idx = subsets[t]
-        C = np.empty(k)
-        Cabs = np.empty(k)
         if k == 1:
             C[0] = 1.0
             Cabs[0] = 1.0
         else:
-            _cofactors(Y, idx, k, perms, psigns, C, Cabs)
+            _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols)
         zero = True
         coarse = 0.0
         for j in range(k):
@@ -146,4 +162,34 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
         plus[t] = np_
         minus[t] = nm
         unc[t] = nu
+
+
+@njit(cache=True, parallel=True)
+def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
+    """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
+    on the + side, surely on the − side and uncertain, its cofactors C and their
+    permanents |C|, and whether C is surely zero (degenerate subset; only decided
+    when c_err = 0).
+
+    A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
+    (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
+    the precise one. The scan of a subset stops once both sides surely hold more than
+    F points (it can then bound no valid halfspace), so counts above F are not exact."""
+    n, k = Y.shape
+    count = subsets.shape[0]
+    plus = np.zeros(count, dtype=np.int64)
+    minus = np.zeros(count, dtype=np.int64)
+    unc = np.zeros(count, dtype=np.int64)
+    degenerate = np.zeros(count, dtype=np.bool_)
+    cof = np.empty((count, k))
+    cof_abs = np.empty((count, k))
+    M = 0.0
+    for q in range(n):
+        for j in range(k):
+            M = max(M, abs(Y[q, j]))
+    chunks = 64
+    for c in prange(chunks):
+        _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, count * c // chunks,
+                        count * (c + 1) // chunks, plus, minus, unc, degenerate, cof,
+                        cof_abs)
     return plus, minus, unc, degenerate, cof, cof_abs

@@ -131,7 +131,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
-    from ._candidates import classify_subsets, k_subsets
+    from ._candidates import classify, k_subsets
 
     m, k = Y.shape
     count = comb(m, k)
@@ -145,7 +145,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     exact_floats = k == 1 or bits <= _exact_float_bits(k)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
     subsets = k_subsets(m, k, count)
-    plus, minus, unc, degenerate, cof, cof_abs = classify_subsets(
+    plus, minus, unc, degenerate, cof, cof_abs = classify(
         np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms, signs,
         c_err, F)
     live = ~degenerate

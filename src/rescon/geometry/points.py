@@ -79,12 +79,35 @@ def _target(K: SafeKernel, target: Any) -> Vec:
     return tuple(Fraction(float(v)) for v in t)
 
 
+#: up to this many vertices, "auto" guides a projection in dimension ≤ 2 geometrically
+GEOMETRIC_GUIDE_VERTICES = 64
+
+
+def _geometric_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
+    """Nearest point of conv(V) to m for a kernel of dimension 1 or 2, in floats: m
+    itself (moved onto aff Ψ) if inside, else the nearest point of the segments between
+    vertices (every edge is one of them)."""
+    o, B = K.affine_origin, K.affine_basis
+    y = o + B.T @ (B @ (m - o))
+    if K.contains(y, tol=1e-12) and K.dim == 2:
+        return y
+    V = K.vertices
+    i, j = np.triu_indices(len(V), 1)
+    P, Q = V[i], V[j]
+    D = Q - P
+    t = np.clip(np.einsum("ij,ij->i", m - P, D) / np.einsum("ij,ij->i", D, D), 0.0, 1.0)
+    C = P + t[:, None] * D
+    return C[np.argmin(np.linalg.norm(C - m, axis=1))]
+
+
 def _float_guide(K: SafeKernel, m: Vec, backend: str) -> np.ndarray:
     from ..models.kernel_models import project
 
+    mf = np.array([float(v) for v in m])
+    if backend == "auto" and K.dim <= 2 and len(K.vertices) <= GEOMETRIC_GUIDE_VERTICES:
+        return _geometric_guide(K, mf)
     name = "clarabel" if backend in ("auto", "exact") else backend
-    return project(K.A, K.b, K.affine_origin, K.affine_basis,
-                   np.array([float(v) for v in m]), backend=name)
+    return project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend=name)
 
 
 def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:

@@ -19,6 +19,7 @@ the fixed-group system, and verified exactly before anything is returned.
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass
 from fractions import Fraction
@@ -36,6 +37,8 @@ Matrix = list[list[Fraction]]
 #: The MILP's weights below this are read as 0 when guessing the support. The guess
 #: is only a warm start: every answer is re-derived and verified exactly.
 SUPPORT_GUESS = 1e-9
+#: Seconds of the MILP's first attempt; each restart doubles it (see ``_milp``).
+FIRST_BUDGET = 1.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,11 +79,14 @@ def tverberg_partition(
     Finds disjoint nonempty G_1, …, G_q (q = ``parts``) and a point y with
     y = Σ_{i∈G_p} w_{p,i} x_i, w_{p,i} > 0, Σ_{i∈G_p} w_{p,i} = 1 for every p, all in
     exact rational arithmetic. The MILP (binaries z_{i,p}: x_i ∈ G_p; weights
-    λ_{i,p} ≤ z_{i,p}; y free) is
+    λ_{i,p} ∈ [0, 1]; y free; no objective) is, for i = 0..n−1 and p = 1..q,
 
-        Σ_p z_{i,p} = 1                      (i = 0..n−1; WLOG, see Notes)
-        λ_{i,p} ≤ z_{i,p},  Σ_i λ_{i,p} = 1,  Σ_i λ_{i,p} x_i = y    (p = 1..q)
-        z_{0,1} = 1,  z_{i,p} ≤ Σ_{j<i} z_{j,p−1}   (groups ordered by first index)
+        Σ_p z_{i,p} = 1                         (every point in a group; WLOG, see Notes)
+        λ_{i,p} ≤ z_{i,p},  Σ_i λ_{i,p} = 1,  Σ_i λ_{i,p} x_i = y
+        z_{0,1} = 1,  z_{i,p} ≤ Σ_{j<i} z_{j,p−1}   (p ≥ 2: groups ordered by first index)
+
+    Σ_i λ_{i,p} = 1 with λ ≤ z keeps every group nonempty; ordering the groups by
+    their first index picks one of the q! labellings of each partition.
 
     Parameters
     ----------
@@ -242,7 +248,7 @@ def _rows(X: np.ndarray, q: int) -> list[tuple[float, float, dict[int, float]]]:
     return rows
 
 
-def _model(X: np.ndarray, q: int, time_limit: float | None):
+def _model(X: np.ndarray, q: int):
     """The HiGHS model of the partition MILP (no objective: feasibility)."""
     require_backend("highs", "MILP")
     import highspy
@@ -251,9 +257,7 @@ def _model(X: np.ndarray, q: int, time_limit: float | None):
     nz = n * q
     h = highspy.Highs()
     h.setOptionValue("output_flag", False)
-    if time_limit is not None:
-        h.setOptionValue("time_limit", float(time_limit))
-    # z_{i,p} = 0 for p > i (group p starts after the first indices of 0..p−1)
+    # z_{i,p} = 0 for p > i (0-based: group p starts after the first indices of 0..p−1)
     upper = np.array([1.0 if p <= i else 0.0 for i in range(n) for p in range(q)])
     lower = np.zeros(nz)
     lower[0] = 1.0  # point 0 opens group 0
@@ -276,20 +280,36 @@ def _model(X: np.ndarray, q: int, time_limit: float | None):
 
 def _milp(X: np.ndarray, q: int,
           time_limit: float | None) -> tuple[list[list[int]], np.ndarray] | None:
-    """The MILP's groups (covering 0..n−1) and weights λ (n, q); None if infeasible."""
+    """The MILP's groups (covering 0..n−1) and weights λ (n, q); None if infeasible.
+
+    HiGHS's time to a first solution of this feasibility model is heavy-tailed in its
+    random seed (n = 40, q = 14: from 1 s to over 60 s on one instance), so attempt k
+    runs with seed k for FIRST_BUDGET · 2^k s (Gomes et al. 2000, restarts); proving
+    infeasibility costs at most about twice one long run.
+    """
     n = X.shape[0]
-    h, highspy = _model(_normalise(X), q, time_limit)
-    h.run()
+    h, highspy = _model(_normalise(X), q)
     S = highspy.HighsModelStatus
-    status = h.getModelStatus()
-    if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
-        return None  # every column is bounded: the model cannot be unbounded
-    if status not in (S.kOptimal, S.kTimeLimit):
-        raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} "
-                          "on the Tverberg MILP")
-    if h.getInfo().primal_solution_status != 2:
-        raise TimeLimitReached(f"time limit of {time_limit} s reached before the MILP "
-                               f"found a partition into {q} parts or proved there is none")
+    deadline = None if time_limit is None else time.perf_counter() + time_limit
+    for seed in itertools.count():
+        budget = FIRST_BUDGET * 2.0**seed
+        if deadline is not None:
+            budget = min(budget, deadline - time.perf_counter())
+        if budget <= 0:
+            raise TimeLimitReached(f"time limit of {time_limit} s reached before the MILP "
+                                   f"found a partition into {q} parts or proved there is none")
+        h.clearSolver()
+        h.setOptionValue("random_seed", seed)
+        h.setOptionValue("time_limit", budget)
+        h.run()
+        status = h.getModelStatus()
+        if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
+            return None  # every column is bounded: the model cannot be unbounded
+        if status not in (S.kOptimal, S.kTimeLimit):
+            raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} "
+                              "on the Tverberg MILP")
+        if h.getInfo().primal_solution_status == 2:
+            break
     x = np.asarray(h.getSolution().col_value)
     member = x[: n * q].reshape(n, q).argmax(axis=1)
     groups = [[i for i in range(n) if member[i] == p] for p in range(q)]
