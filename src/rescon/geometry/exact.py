@@ -16,14 +16,14 @@ from math import gcd
 import numpy as np
 
 __all__ = [
-    "ExactPoints",
-    "exact_points",
-    "bareiss_rank",
     "AffineHull",
+    "ExactPoints",
     "affine_hull",
-    "solve_exact",
-    "nullspace_exact",
+    "bareiss_rank",
+    "exact_points",
     "int_vector",
+    "nullspace_exact",
+    "solve_exact",
 ]
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["Halfspaces", "valid_halfspaces", "candidate_cost", "MAX_CANDIDATE_COST"]
+__all__ = ["MAX_CANDIDATE_COST", "Halfspaces", "candidate_cost", "valid_halfspaces"]
 
 #: refuse inputs whose candidate enumeration needs more point tests than this
 MAX_CANDIDATE_COST = 4_000_000_000

@@ -11,18 +11,20 @@ from __future__ import annotations
 
 import operator
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
 from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact
+from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .polytope import ExactPolytope, clip_to_fixpoint
 
-__all__ = ["SafeKernel", "safe_kernel", "kernel_point", "kernel_points", "check_points", "check_F"]
+__all__ = ["SafeKernel", "check_F", "check_points", "kernel_point", "kernel_points", "safe_kernel"]
 
 
 def check_points(X: Any, name: str = "X") -> np.ndarray:
@@ -69,7 +71,7 @@ class _Exact:
     def contains(self, x: tuple[Fraction, ...]) -> bool:
         if not self.vertices:
             return False
-        dot = lambda a: sum(map(operator.mul, a, x))  # noqa: E731
+        dot = lambda a: sum(map(operator.mul, a, x))
         return (all(dot(a) == b for a, b in self.equalities)
                 and all(dot(a) <= b for a, b in self.constraints))
 
@@ -267,8 +269,13 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     H = valid_halfspaces(Yf, rows, np.array(weights), F)
     lo = [min(y[j] for y in rows) for j in range(hull.dim)]
     hi = [max(y[j] for y in rows) for j in range(hull.dim)]
+    first = np.flatnonzero(H.outside == F)
+    if hull.dim >= 2:
+        fast = certified_kernel(H, hull.dim, P.scale, first)
+        if fast is not None:
+            return fast
     poly = ExactPolytope.box(lo, hi)
-    clip_to_fixpoint(poly, H, P.scale, first=np.flatnonzero(H.outside == F))
+    clip_to_fixpoint(poly, H, P.scale, first=first)
     return poly
 
 
@@ -309,7 +316,10 @@ def _relative_facets(poly: ExactPolytope, hull: AffineHull, scale: int, d: int, 
     nv = len(poly.verts)
     out = []
     for h, members in sorted(poly.incidence().items()):
-        if len(members) >= dim and len(members) < nv and poly.face_dim(members) == dim - 1:
+        # a face tight on h (not on every vertex) has dimension ≤ dim − 1, so it is a
+        # facet iff its dimension is at least dim − 1
+        if len(members) >= dim and len(members) < nv and (
+                poly.clear_rank(members) >= dim - 1 or poly.face_dim(members) == dim - 1):
             out.append(_ambient(hull, d, poly.a[h], poly.b[h], scale))
     return out
 

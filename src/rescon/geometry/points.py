@@ -25,7 +25,7 @@ from .exact import solve_exact
 if TYPE_CHECKING:
     from .kernel import SafeKernel
 
-__all__ = ["kernel_point_of", "METHODS", "point_certificate"]
+__all__ = ["METHODS", "kernel_point_of", "point_certificate"]
 
 METHODS = ("project", "chebyshev", "vertex-mean")
 MAX_ACTIVE_SETS = 200_000

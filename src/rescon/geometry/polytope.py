@@ -246,21 +246,29 @@ class ExactPolytope:
                 out.setdefault(h, []).append(i)
         return out
 
-    def face_dim(self, members: list[int]) -> int:
-        """Affine dimension of the vertices ``members``. Full rank is read off the float
-        SVD when the smallest singular value exceeds the rounding perturbation
-        (Weyl: the exact matrix differs by ‖E‖₂ ≤ √(size) · 4ε · max|x|, plus the
-        SVD's own error); anything else is decided by exact elimination."""
-        if not members:
-            return -1
-        if len(members) == 1:
+    def clear_rank(self, members: list[int]) -> int:
+        """A lower bound on the affine dimension of the vertices ``members``: the
+        singular values of their float differences that exceed the rounding
+        perturbation (Weyl: the exact matrix differs by ‖E‖₂ ≤ √(size) · 8ε ·
+        (max|x| + ‖D‖₂)), each certifying one dimension."""
+        if len(members) < 2:
             return 0
         fv = self._float_array()[members]
         D = fv[1:] - fv[0]
         sv = np.linalg.svd(D, compute_uv=False)
         perturb = np.sqrt(D.size) * 8.0 * _EPS * (np.abs(fv).max() + sv[0])
-        if sv[-1] > 16.0 * perturb and len(sv) == min(D.shape):
-            return len(sv)
+        return int((sv > 16.0 * perturb).sum())
+
+    def face_dim(self, members: list[int]) -> int:
+        """Affine dimension of the vertices ``members``: read off the float SVD when
+        every possible dimension is certified (:meth:`clear_rank`), else by exact
+        elimination."""
+        if not members:
+            return -1
+        if len(members) == 1:
+            return 0
+        if self.clear_rank(members) == min(len(members) - 1, self.k):
+            return min(len(members) - 1, self.k)
         w0, *y0 = self.verts[members[0]]
         rows = [[yi * w0 - y0i * self.verts[m][0]
                  for yi, y0i in zip(self.verts[m][1:], y0, strict=True)] for m in members[1:]]

@@ -1,0 +1,214 @@
+"""Certified fast path for full-dimensional, simple kernels: qhull proposes, integers decide.
+
+Floats (a Chebyshev LP for an interior point, then qhull's halfspace intersection)
+propose the vertices of Ψ and, for each vertex, the k valid halfspaces that define it.
+The proposal is accepted only if, in exact arithmetic,
+
+1. every proposed vertex v (the exact solution of its k defining equations) satisfies
+   every valid halfspace, and is tight on none but its own k (a simple vertex) —
+   so conv(V) ⊆ Ψ by the characterisation theorem;
+2. for every vertex and every k − 1 of its defining halfspaces there is another
+   proposed vertex with the same k − 1: the edge of P_S = ⋂ (defining halfspaces)
+   leaving v along them ends at a proposed vertex (it lies on that line and in P_S),
+   so every edge of P_S is bounded and the vertex set V is closed under adjacency;
+   the graph of a polyhedron is connected, hence V is all of P_S's vertices and P_S
+   is the polytope conv(V).
+
+Then Ψ ⊆ P_S (valid halfspaces) = conv(V) ⊆ Ψ. Anything else — a lower-dimensional
+or degenerate kernel, a qhull failure, a vertex the check rejects — returns None and
+the caller clips exactly (:mod:`.polytope`).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from .polytope import ExactPolytope, _normalise
+
+__all__ = ["certified_kernel"]
+
+_EPS = 2.0**-53
+MAX_ROUNDS = 4
+
+
+def _interior_point(A: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """Centre of the largest ball in {x : A x ≤ b} (HiGHS LP), None if the ball is
+    tiny compared with the data (a flat or empty kernel)."""
+    from scipy.optimize import linprog
+
+    k = A.shape[1]
+    norms = np.linalg.norm(A, axis=1)
+    c = np.zeros(k + 1)
+    c[-1] = -1.0
+    res = linprog(c, A_ub=np.hstack([A, norms[:, None]]), b_ub=b,
+                  bounds=[(None, None)] * k + [(0, None)], method="highs")
+    if res.status != 0:
+        return None
+    x, r = res.x[:k], res.x[-1]
+    if r <= 1e-9 * (1.0 + np.abs(x).max()):
+        return None
+    return x
+
+
+def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
+    from scipy.spatial import HalfspaceIntersection, QhullError
+
+    A, b = H.af[sel], H.bf[sel]
+    x0 = _interior_point(A, b)
+    if x0 is None:
+        return None
+    try:
+        hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0, qhull_options="Qt")
+    except (QhullError, ValueError):
+        return None
+    return hs.intersections, [list(f) for f in hs.dual_facets]
+
+
+def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope | None:
+    """Ψ in scaled integer coordinates as an ExactPolytope (constraints: the facets),
+    or None when the fast path cannot certify it."""
+    if len(H) < k + 1:
+        return None
+    sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
+    for _ in range(MAX_ROUNDS):
+        prop = _propose(H, sel)
+        if prop is None:
+            return None
+        V, facets = prop
+        if any(len(f) != k for f in facets):
+            return None
+        # floats first: halfspaces clearly violated by a proposed vertex join sel
+        bad = (H.af @ V.T).max(axis=1) - H.bf > 1e-9 * (1.0 + np.abs(H.bf))
+        if bad.any():
+            sel = np.union1d(sel, np.flatnonzero(bad))
+            continue
+        return _certify(H, k, scale, sel, facets)
+    return None
+
+
+def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]]
+             ) -> ExactPolytope | None:
+    """Exact vertices from the proposed defining sets (merged when equal), their full
+    tight sets among the defining halfspaces S, feasibility against every valid
+    halfspace, and closure: every extreme ray of every vertex's tangent cone leads to
+    another proposed vertex (see the module docstring)."""
+    S_set = sorted({int(sel[i]) for f in facets for i in f})
+    where = {h: i for i, h in enumerate(S_set)}
+    index: dict[tuple[int, ...], int] = {}
+    verts: list[tuple[int, ...]] = []
+    tight: list[int] = []
+    for f in facets:
+        T = [int(sel[i]) for i in f]
+        v = _solve(H, T)
+        if v is None:
+            return None
+        i = index.setdefault(v, len(verts))
+        if i == len(verts):
+            verts.append(v)
+            tight.append(0)
+        for h in T:
+            tight[i] |= 1 << where[h]
+    # exact feasibility, and the complete tight sets within S: floats of the exact
+    # vertices (correctly rounded) with a rounding bound decide the clear cases
+    Vx = np.array([[yi / v[0] for yi in v[1:]] for v in verts]) / scale
+    c = 2.0 * (k + 4) * _EPS
+    M = np.abs(Vx).max()
+    row_bound = (H.c_err * (H.af_abs.sum(axis=1) * M + H.b_abs)
+                 + c * (np.abs(H.af).sum(axis=1) * M + np.abs(H.bf)))
+    rows = np.flatnonzero((H.af @ Vx.T).max(axis=1) - H.bf >= -row_bound)  # not surely slack
+    absV = np.abs(Vx).T
+    Sv = H.af[rows] @ Vx.T - H.bf[rows, None]
+    bound = H.c_err * (H.af_abs[rows] @ absV + H.b_abs[rows, None]) + c * (
+        np.abs(H.af[rows]) @ absV + np.abs(H.bf[rows])[:, None])
+    if (Sv > bound).any():
+        return None
+    for r, vi in zip(*np.nonzero(np.abs(Sv) <= bound), strict=True):
+        h, vi = int(rows[r]), int(vi)
+        if h in where and tight[vi] >> where[h] & 1:
+            continue
+        a, b = H.exact(h)
+        w, *y = verts[vi]
+        slack = sum(ai * yi for ai, yi in zip(a, y, strict=True)) - b * w
+        if slack > 0:
+            return None
+        if slack == 0 and h in where:
+            tight[vi] |= 1 << where[h]
+    normals = [H.exact(h)[0] for h in S_set]
+    members: dict[int, list[int]] = {}
+    for vi, t in enumerate(tight):
+        for h in _bits(t):
+            members.setdefault(h, []).append(vi)
+    for vi in range(len(verts)):
+        T = list(_bits(tight[vi]))
+        for Z in _extreme_rays(normals, T, k):
+            fewest = min((members[h] for h in _bits(Z)), key=len)
+            if not any((tight[u] & Z) == Z for u in fewest if u != vi):
+                return None
+    P = ExactPolytope(k)
+    for h in S_set:
+        a, b = H.exact(h)
+        P.a.append(a)
+        P.b.append(b)
+    P.verts = verts
+    P.tight = tight
+    return P
+
+
+def _solve(H, T: list[int]) -> tuple[int, ...] | None:
+    """The point where the k hyperplanes T meet, homogeneous (w > 0, primitive), by
+    Cramer's rule on integers; None if they do not meet in one point."""
+    from .halfspaces import _int_det
+
+    rows = [H.exact(h) for h in T]
+    A = [list(a) for a, _ in rows]
+    w = _int_det(A)
+    if w == 0:
+        return None
+    y = []
+    for j in range(len(A)):
+        Aj = [r[:j] + [b] + r[j + 1:] for r, (_, b) in zip(A, rows, strict=True)]
+        y.append(_int_det(Aj))
+    if w < 0:
+        w, y = -w, [-v for v in y]
+    return _normalise((w, *y))
+
+
+def _extreme_rays(normals: list[tuple[int, ...]], T: list[int], k: int):
+    """For the cone {d : a_h·d ≤ 0, h ∈ T} (a pointed cone: T has rank k), the bitset of
+    the constraints tight along each extreme ray. A ray is the null direction of k − 1
+    independent normals, signed to satisfy all of T."""
+    seen = set()
+    for sub in itertools.combinations(T, k - 1):
+        d = _null_direction([normals[h] for h in sub], k)
+        if d is None:
+            continue
+        vals = [sum(x * y for x, y in zip(normals[h], d, strict=True)) for h in T]
+        if all(v <= 0 for v in vals):
+            pass
+        elif all(v >= 0 for v in vals):
+            vals = [-v for v in vals]
+        else:
+            continue
+        Z = sum(1 << h for h, v in zip(T, vals, strict=True) if v == 0)
+        if Z not in seen:
+            seen.add(Z)
+            yield Z
+
+
+def _null_direction(rows: list[tuple[int, ...]], k: int) -> tuple[int, ...] | None:
+    """The generalised cross product of k − 1 integer vectors in Z^k (None if they are
+    dependent)."""
+    from .halfspaces import _int_det
+
+    d = tuple((-1) ** (k - 1 + j) * _int_det([list(r[:j] + r[j + 1:]) for r in rows])
+              for j in range(k))
+    return d if any(d) else None
+
+
+def _bits(t: int):
+    while t:
+        low = t & -t
+        yield low.bit_length() - 1
+        t ^= low
