@@ -270,3 +270,61 @@ def test_huge_input_refused_with_estimate():
     X = np.random.default_rng(0).normal(size=(400, 5))
     with pytest.raises(InputError, match="point tests"):
         rescon.safe_kernel(X, 10)
+
+
+# --------------------------------------------------------------------------- #
+# the certified fast path agrees with exact clipping, and refuses bad proposals
+# --------------------------------------------------------------------------- #
+
+
+def _both_paths(X, F):
+    from rescon.geometry import kernel as km
+    from rescon.geometry.exact import affine_hull, exact_points
+    from rescon.geometry.fastpath import certified_kernel
+    from rescon.geometry.halfspaces import valid_halfspaces
+    from rescon.geometry.polytope import ExactPolytope, clip_to_fixpoint
+
+    P = exact_points(np.asarray(X, float))
+    hull = affine_hull(P)
+    rows = sorted({tuple(r[c] for c in hull.coords) for r in P.ints})
+    W = np.array([sum(1 for r in P.ints if tuple(r[c] for c in hull.coords) == y)
+                  for y in rows])
+    Yf = np.array([[v / P.scale for v in y] for y in rows])
+    H = valid_halfspaces(Yf, rows, W, F)
+    first = np.flatnonzero(H.outside == F)
+    fast = certified_kernel(H, hull.dim, P.scale, first)
+    box = ExactPolytope.box([min(y[j] for y in rows) for j in range(hull.dim)],
+                            [max(y[j] for y in rows) for j in range(hull.dim)])
+    clip_to_fixpoint(box, H, P.scale, first=first)
+    assert km  # the module under test builds on both
+    return fast, box, H, hull, P
+
+
+@pytest.mark.parametrize("seed,d,n,F", [(0, 2, 30, 4), (1, 3, 25, 3), (2, 3, 40, 6),
+                                        (3, 2, 60, 15)])
+def test_fast_path_equals_exact_clipping(seed, d, n, F):
+    X = np.random.default_rng(seed).normal(size=(n, d))
+    fast, slow, *_ = _both_paths(X, F)
+    assert fast is not None, "the fast path should certify a Gaussian cloud"
+    assert set(fast.fraction_vertices()) == set(slow.fraction_vertices())
+
+
+def test_fast_path_refuses_incomplete_proposals():
+    from rescon.geometry import fastpath
+
+    X = np.random.default_rng(8).normal(size=(30, 3))
+    fast, slow, H, hull, P = _both_paths(X, 4)
+    first = np.flatnonzero(H.outside == 4)
+    V, facets = fastpath._propose(H, first)
+    # a vertex missing: closure fails
+    assert fastpath._certify(H, 3, P.scale, first, facets[1:]) is None
+    # a vertex defined by the wrong halfspaces: infeasible or not closed
+    bad = [list(f) for f in facets]
+    bad[0] = [bad[0][0], bad[0][1], (bad[0][2] + 1) % len(first)]
+    assert fastpath._certify(H, 3, P.scale, first, bad) is None
+    assert fastpath._certify(H, 3, P.scale, first, facets) is not None
+
+
+def test_fast_path_falls_back_on_flat_kernels():
+    fast, slow, *_ = _both_paths([[0, 0], [1, 0], [1, 1], [0, 1]], 1)
+    assert fast is None and slow.dim() == 0
