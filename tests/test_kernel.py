@@ -328,3 +328,28 @@ def test_fast_path_refuses_incomplete_proposals():
 def test_fast_path_falls_back_on_flat_kernels():
     fast, slow, *_ = _both_paths([[0, 0], [1, 0], [1, 1], [0, 1]], 1)
     assert fast is None and slow.dim() == 0
+
+
+@pytest.mark.parametrize("cloud", ["gaussian", "near_collinear", "duplicates"])
+def test_angular_sweep_equals_direct_scan(cloud, monkeypatch):
+    """n ≥ SWEEP_MIN_POINTS in the plane uses the angular sweep; it must give the same
+    exact kernel as the direct O(n³) scan, also with (near-)collinear points and ties."""
+    from rescon.geometry import halfspaces
+
+    rng = np.random.default_rng(21)
+    n = halfspaces.SWEEP_MIN_POINTS + 30
+    if cloud == "gaussian":
+        X = rng.normal(size=(n, 2))
+    elif cloud == "near_collinear":
+        t = rng.uniform(-1, 1, size=n) * 0.1
+        X = np.column_stack([t, 0.3 * t + 0.7])  # floats: collinear only up to rounding
+        X[: n // 3] = rng.normal(size=(n // 3, 2)) * 0.1
+    else:
+        X = np.repeat(rng.normal(size=(n // 3, 2)) / 3, 3, axis=0)
+    F = n // 8
+    swept = rescon.safe_kernel(X, F)
+    monkeypatch.setattr(halfspaces, "SWEEP_MIN_POINTS", 10**9)
+    direct = rescon.safe_kernel(X, F)
+    assert set(swept.exact_vertices) == set(direct.exact_vertices)
+    assert swept.dim == direct.dim
+    assert rescon.check_certificate(swept.certificate).valid

@@ -193,3 +193,97 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
                         count * (c + 1) // chunks, plus, minus, unc, degenerate, cof,
                         cof_abs)
     return plus, minus, unc, degenerate, cof, cof_abs
+
+
+#: angle error bound of atan2 on a correctly rounded difference vector (radians):
+#: the difference has relative error ≤ ε per component (≤ √2 ε in direction), atan2
+#: a few ulps of π; 64 ε is a wide margin.
+ANGLE_ERR = 64.0 * 2.0**-53 * np.pi
+
+
+@njit(cache=True, parallel=True)
+def sweep_pairs_2d(Y, W, subsets):
+    """Side counts of the lines through every pair (rows of ``subsets``, i < j) of
+    distinct points in the plane by an angular sweep around each point, O(n² log n).
+
+    For the directed line i → j, + is the left side (the sign of the cofactor
+    normal (−Δy, Δx)). A point whose angle around i is within 2·ANGLE_ERR of the
+    line's two directions is counted as uncertain (decided exactly later); the others
+    are certainly on their side, since each float angle is within ANGLE_ERR of the
+    true one."""
+    n = Y.shape[0]
+    count = subsets.shape[0]
+    plus = np.zeros(count, dtype=np.int64)
+    minus = np.zeros(count, dtype=np.int64)
+    unc = np.zeros(count, dtype=np.int64)
+    cof = np.empty((count, 2))
+    cof_abs = np.empty((count, 2))
+    # row offset of the pairs (i, ·): pairs are in lexicographic order
+    start = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        start[i + 1] = start[i] + (n - 1 - i)
+    two_pi = 2.0 * np.pi
+    tol = 2.0 * ANGLE_ERR
+    for i in prange(n - 1):
+        m = n - 1
+        ang = np.empty(m)
+        wts = np.empty(m, dtype=np.int64)
+        others = np.empty(m, dtype=np.int64)
+        c = 0
+        for q in range(n):
+            if q != i:
+                ang[c] = np.arctan2(Y[q, 1] - Y[i, 1], Y[q, 0] - Y[i, 0])
+                wts[c] = W[q]
+                others[c] = q
+                c += 1
+        order = np.argsort(ang)
+        a2 = np.empty(2 * m)
+        cw = np.zeros(2 * m + 1, dtype=np.int64)
+        for t in range(m):
+            a2[t] = ang[order[t]]
+            a2[t + m] = ang[order[t]] + two_pi
+        for t in range(2 * m):
+            cw[t + 1] = cw[t] + wts[order[t % m]]
+        for t in range(m):
+            j = others[t]
+            if j <= i:
+                continue
+            th = ang[t]
+            # window sums over (lo, hi] of the doubled, sorted angles
+            a = np.searchsorted(a2, th + tol, side="right")
+            b = np.searchsorted(a2, th + np.pi - tol, side="left")
+            cc = np.searchsorted(a2, th + np.pi + tol, side="right")
+            e = np.searchsorted(a2, th + two_pi - tol, side="left")
+            left = cw[b] - cw[a] if b > a else 0
+            right = cw[e] - cw[cc] if e > cc else 0
+            total = cw[m]
+            row = start[i] + (j - i - 1)
+            plus[row] = left
+            minus[row] = right
+            # everything else but j itself is uncertain
+            unc[row] = total - left - right - W[j]
+            dx = Y[j, 0] - Y[i, 0]
+            dy = Y[j, 1] - Y[i, 1]
+            cof[row, 0] = -dy
+            cof[row, 1] = dx
+            cof_abs[row, 0] = abs(dy)
+            cof_abs[row, 1] = abs(dx)
+    degenerate = np.zeros(count, dtype=np.bool_)
+    return plus, minus, unc, degenerate, cof, cof_abs
+
+
+@njit(cache=True, parallel=True)
+def row_max(A, b, V):
+    """max_v (A_h · v) − b_h for every row h, without the (rows × vertices) matrix."""
+    m, k = A.shape
+    out = np.empty(m)
+    for h in prange(m):
+        best = -np.inf
+        for v in range(V.shape[0]):
+            s = 0.0
+            for j in range(k):
+                s += A[h, j] * V[v, j]
+            if s > best:
+                best = s
+        out[h] = best - b[h]
+    return out

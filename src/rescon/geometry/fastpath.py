@@ -25,6 +25,7 @@ import itertools
 
 import numpy as np
 
+from ._candidates import row_max
 from .polytope import ExactPolytope, _normalise
 
 __all__ = ["certified_kernel"]
@@ -80,15 +81,17 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
         if any(len(f) != k for f in facets):
             return None
         # floats first: halfspaces clearly violated by a proposed vertex join sel
-        bad = (H.af @ V.T).max(axis=1) - H.bf > 1e-9 * (1.0 + np.abs(H.bf))
+        top = row_max(H.af, H.bf, np.ascontiguousarray(V))
+        bad = top > 1e-9 * (1.0 + np.abs(H.bf))
         if bad.any():
             sel = np.union1d(sel, np.flatnonzero(bad))
             continue
-        return _certify(H, k, scale, sel, facets)
+        return _certify(H, k, scale, sel, facets, V, top)
     return None
 
 
-def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]]
+def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
+             V: np.ndarray | None = None, top: np.ndarray | None = None
              ) -> ExactPolytope | None:
     """Exact vertices from the proposed defining sets (merged when equal), their full
     tight sets among the defining halfspaces S, feasibility against every valid
@@ -99,12 +102,14 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]]
     index: dict[tuple[int, ...], int] = {}
     verts: list[tuple[int, ...]] = []
     tight: list[int] = []
+    of_proposal: list[int] = []
     for f in facets:
         T = [int(sel[i]) for i in f]
         v = _solve(H, T)
         if v is None:
             return None
         i = index.setdefault(v, len(verts))
+        of_proposal.append(i)
         if i == len(verts):
             verts.append(v)
             tight.append(0)
@@ -115,9 +120,14 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]]
     Vx = np.array([[yi / v[0] for yi in v[1:]] for v in verts]) / scale
     c = 2.0 * (k + 4) * _EPS
     M = np.abs(Vx).max()
-    row_bound = (H.c_err * (H.af_abs.sum(axis=1) * M + H.b_abs)
-                 + c * (np.abs(H.af).sum(axis=1) * M + np.abs(H.bf)))
-    rows = np.flatnonzero((H.af @ Vx.T).max(axis=1) - H.bf >= -row_bound)  # not surely slack
+    l1, perm_sum, babs = H.row_terms()
+    row_bound = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs)
+    if V is None or top is None:
+        top = row_max(H.af, H.bf, np.ascontiguousarray(Vx))
+    else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
+        shift = np.abs(V - Vx[of_proposal]).max()
+        row_bound = row_bound + l1 * shift
+    rows = np.flatnonzero(top >= -row_bound)  # the rows not surely slack at every vertex
     absV = np.abs(Vx).T
     Sv = H.af[rows] @ Vx.T - H.bf[rows, None]
     bound = H.c_err * (H.af_abs[rows] @ absV + H.b_abs[rows, None]) + c * (

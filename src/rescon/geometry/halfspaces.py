@@ -18,6 +18,8 @@ import itertools
 from dataclasses import dataclass, field
 from math import comb, factorial, gcd
 
+from typing import Any
+
 import numpy as np
 
 from ..errors import InputError
@@ -27,6 +29,9 @@ __all__ = ["MAX_CANDIDATE_COST", "Halfspaces", "candidate_cost", "valid_halfspac
 #: refuse inputs whose candidate enumeration needs more point tests than this
 MAX_CANDIDATE_COST = 4_000_000_000
 _EPS = 2.0**-53
+#: from this many distinct points on, lines in the plane are counted by the angular
+#: sweep (O(n² log n)) instead of the direct scan (O(n³))
+SWEEP_MIN_POINTS = 150
 
 
 @dataclass
@@ -49,10 +54,18 @@ class Halfspaces:
     b_abs: np.ndarray  # (h,) the same for bf
     outside: np.ndarray  # (h,) points surely strictly outside (at most F)
     c_err: float
-    _cache: dict[int, tuple[tuple[int, ...], int]] = field(default_factory=dict)
+    _cache: dict[int, Any] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.sign)
+
+    def row_terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(Σ_j |af|_j, Σ_j af_abs_j, |bf|) per row, for per-row rounding bounds."""
+        out = self._cache.get(-1)
+        if out is None:
+            out = self._cache[-1] = (np.abs(self.af).sum(axis=1), self.af_abs.sum(axis=1),
+                                     np.abs(self.bf))
+        return out
 
     def exact(self, h: int) -> tuple[tuple[int, ...], int]:
         """(a, b), primitive integers: a·y ≤ b in the scaled integer coordinates."""
@@ -131,7 +144,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
-    from ._candidates import classify, k_subsets
+    from ._candidates import classify, k_subsets, sweep_pairs_2d
 
     m, k = Y.shape
     count = comb(m, k)
@@ -145,9 +158,13 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     exact_floats = k == 1 or bits <= _exact_float_bits(k)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
     subsets = k_subsets(m, k, count)
-    plus, minus, unc, degenerate, cof, cof_abs = classify(
-        np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms, signs,
-        c_err, F)
+    if k == 2 and not exact_floats and m >= SWEEP_MIN_POINTS:
+        plus, minus, unc, degenerate, cof, cof_abs = sweep_pairs_2d(
+            np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
+    else:
+        plus, minus, unc, degenerate, cof, cof_abs = classify(
+            np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms,
+            signs, c_err, F)
     live = ~degenerate
     sure_plus = live & (plus + unc <= F)
     sure_minus = live & (minus + unc <= F)
