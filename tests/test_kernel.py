@@ -313,9 +313,9 @@ def test_fast_path_refuses_incomplete_proposals():
     from rescon.geometry import fastpath
 
     X = np.random.default_rng(8).normal(size=(30, 3))
-    fast, slow, H, hull, P = _both_paths(X, 4)
+    _, _, H, _, P = _both_paths(X, 4)
     first = np.flatnonzero(H.outside == 4)
-    V, facets = fastpath._propose(H, first)
+    _, facets = fastpath._propose(H, first)
     # a vertex missing: closure fails
     assert fastpath._certify(H, 3, P.scale, first, facets[1:]) is None
     # a vertex defined by the wrong halfspaces: infeasible or not closed

@@ -283,7 +283,6 @@ def row_max(A, b, V):
             s = 0.0
             for j in range(k):
                 s += A[h, j] * V[v, j]
-            if s > best:
-                best = s
+            best = max(best, s)
         out[h] = best - b[h]
     return out

@@ -17,7 +17,6 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass, field
 from math import comb, factorial, gcd
-
 from typing import Any
 
 import numpy as np
