@@ -19,7 +19,6 @@ the fixed-group system, and verified exactly before anything is returned.
 
 from __future__ import annotations
 
-import itertools
 import time
 from dataclasses import dataclass
 from fractions import Fraction
@@ -37,8 +36,6 @@ Matrix = list[list[Fraction]]
 #: The MILP's weights below this are read as 0 when guessing the support. The guess
 #: is only a warm start: every answer is re-derived and verified exactly.
 SUPPORT_GUESS = 1e-9
-#: Seconds of the MILP's first attempt; each restart doubles it (see ``_milp``).
-FIRST_BUDGET = 1.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -97,8 +94,8 @@ def tverberg_partition(
         The number q of groups, 1 ≤ q ≤ n. With q = F + 1 the point lies in the
         safe kernel Ψ(X, F).
     time_limit : float, optional
-        Seconds allowed to the MILP solve (the exact reconstruction afterwards is
-        polynomial and not limited).
+        Seconds allowed to building and solving the MILP (the exact reconstruction
+        afterwards is polynomial and not limited).
 
     Returns
     -------
@@ -120,10 +117,15 @@ def tverberg_partition(
     -----
     Requiring every point in some group (Σ_p z_{i,p} = 1 instead of ≤ 1) loses
     nothing: a point can join any group with weight 0. The returned groups are the
-    exact supports, so unused points are dropped again. The MILP has 2nq + d columns
-    and O(n²q) nonzeros; it is NP-hard in general. The exact step solves systems of
-    (d+1)(q−1)+1 rows over Q: O(q d³) rational operations on the fast path, an exact
-    simplex on the fallback.
+    exact supports, so points may stay unused; disjoint groups are all the kernel
+    argument needs. ``exists`` False rests on HiGHS's infeasibility proof in floating
+    point, which is not checked. The MILP has 2nq + d columns and O(n²q) nonzeros;
+    its LP relaxation is weak (fractional z always fits), so the solve is a search
+    whose time varies widely: in the plane with q = ⌊(n − 1)/3⌋ + 1 (at or just above
+    Tverberg's bound), about 0.1 s for n = 10, 0.5–1.5 s for n = 20 and 20–120 s for
+    n = 40. The exact step
+    works on (d+1)(q−1)+1 equations over Q: O(q d³) rational operations on the fast
+    path, an exact simplex on the fallback.
 
     References
     ----------
@@ -173,7 +175,7 @@ def _check_input(X: Any, parts: Any, time_limit: Any) -> tuple[np.ndarray, int]:
         raise InputError("X must be a finite (n, d) array of real numbers with n, d ≥ 1; "
                          f"got shape {arr.shape} of dtype {arr.dtype}")
     if arr.dtype.kind in "iu" and np.any(np.abs(arr.astype(object)) > 2**53):
-        raise InputError("X has integers beyond 2^53, which float64 cannot hold exactly")
+        raise InputError("X has integers of magnitude > 2^53, not all exact in float64")
     arr = arr.astype(np.float64)
     bad = np.count_nonzero(~np.isfinite(arr))
     if bad:
@@ -280,36 +282,23 @@ def _model(X: np.ndarray, q: int):
 
 def _milp(X: np.ndarray, q: int,
           time_limit: float | None) -> tuple[list[list[int]], np.ndarray] | None:
-    """The MILP's groups (covering 0..n−1) and weights λ (n, q); None if infeasible.
-
-    HiGHS's time to a first solution of this feasibility model is heavy-tailed in its
-    random seed (n = 40, q = 14: from 1 s to over 60 s on one instance), so attempt k
-    runs with seed k for FIRST_BUDGET · 2^k s (Gomes et al. 2000, restarts); proving
-    infeasibility costs at most about twice one long run.
-    """
+    """The MILP's groups (covering 0..n−1) and weights λ (n, q); None if infeasible."""
+    deadline = None if time_limit is None else time.perf_counter() + time_limit
     n = X.shape[0]
     h, highspy = _model(_normalise(X), q)
+    if deadline is not None:
+        h.setOptionValue("time_limit", max(deadline - time.perf_counter(), 1e-3))
+    h.run()
     S = highspy.HighsModelStatus
-    deadline = None if time_limit is None else time.perf_counter() + time_limit
-    for seed in itertools.count():
-        budget = FIRST_BUDGET * 2.0**seed
-        if deadline is not None:
-            budget = min(budget, deadline - time.perf_counter())
-        if budget <= 0:
-            raise TimeLimitReached(f"time limit of {time_limit} s reached before the MILP "
-                                   f"found a partition into {q} parts or proved there is none")
-        h.clearSolver()
-        h.setOptionValue("random_seed", seed)
-        h.setOptionValue("time_limit", budget)
-        h.run()
-        status = h.getModelStatus()
-        if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
-            return None  # every column is bounded: the model cannot be unbounded
-        if status not in (S.kOptimal, S.kTimeLimit):
-            raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} "
-                              "on the Tverberg MILP")
-        if h.getInfo().primal_solution_status == 2:
-            break
+    status = h.getModelStatus()
+    if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
+        return None  # every column is bounded: the model cannot be unbounded
+    if status not in (S.kOptimal, S.kTimeLimit):
+        raise SolverError(f"HiGHS returned {h.modelStatusToString(status)} "
+                          "on the Tverberg MILP")
+    if h.getInfo().primal_solution_status != 2:
+        raise TimeLimitReached(f"time limit of {time_limit} s reached before the MILP "
+                               f"found a partition into {q} parts or proved there is none")
     x = np.asarray(h.getSolution().col_value)
     member = x[: n * q].reshape(n, q).argmax(axis=1)
     groups = [[i for i in range(n) if member[i] == p] for p in range(q)]
