@@ -1,4 +1,11 @@
-"""Benchmark runner: ``python -m benchmarks.run robustness [options]``.
+"""Benchmark runner: ``python -m benchmarks.run robustness|kernels [options]``.
+
+``kernels`` (BENCHMARKS.md §2): rescon.safe_kernel, the kernel point and the emptiness
+certificate against the subset LP and the subset-hull qhull baselines on the point
+clouds of ``benchmarks/kernel_clouds.py``; results ``<out>/kernels_<name>.{csv,md}``.
+See the "Safe kernels" section of ``benchmarks/README.md``.
+
+``robustness`` (BENCHMARKS.md §1):
 
 For every instance of the selected graph families (``benchmarks/families.py``) the
 runner times the candidate (``rescon.robustness`` by default) and, in the same
@@ -17,6 +24,7 @@ from __future__ import annotations
 import argparse
 import csv
 import datetime as _dt
+import math
 import os
 import platform
 import statistics
@@ -28,9 +36,14 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
 import networkx as nx
+import numpy as np
 
 from . import baselines as B
+from . import kernel_baselines as KB
 from .families import FAMILIES, STRUCTURED, Instance, instances, known_s_star, variant_label
+from .kernel_clouds import CLOUD_FAMILIES, Cloud, make_cloud
+from .kernel_clouds import DEFAULT_SIZES as KC_DEFAULT_SIZES
+from .kernel_clouds import clouds as kernel_clouds_iter
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_OUT = REPO / "benchmarks" / "results"
@@ -568,6 +581,563 @@ def summarise(rows: list[dict[str, Any]], cfg: Config, cand: str, cand_desc: str
     return "\n".join(lines)
 
 
+# =========================================================================== kernels (§2)
+#
+# ``python -m benchmarks.run kernels``: rescon.safe_kernel (polytope), K.point("project")
+# (point + certificate, timed separately), the emptiness certificate (the safe_kernel
+# call that returns a ``kernel_empty`` certificate), and the subset LP / subset-hull
+# qhull baselines (benchmarks/kernel_baselines.py) on the point clouds of
+# benchmarks/kernel_clouds.py. Answers are compared before any time is reported and
+# every certificate is verified by rescon.check_certificate (not timed).
+
+KERNEL_CSV_FIELDS = [
+    "family", "d", "n", "F", "seed", "method", "empty", "dim", "vertices", "seconds",
+    "status", "cert", "detail",
+]
+
+#: the instances behind the reference times quoted in BENCHMARKS.md §2
+#: (subset LP 7.6 s at n = 25, F = 4, d = 2; qhull 4.9 s at n = 20, F = 6)
+KERNEL_REFERENCE: tuple[tuple[str, int, int, int, str, float], ...] = (
+    ("gaussian", 2, 25, 4, "lp", 7.6),
+    ("gaussian", 2, 20, 6, "qhull", 4.9),
+)
+
+KERNEL_BASELINES = ("lp", "qhull")
+
+
+@dataclass(frozen=True)
+class KernelSet:
+    """A named set of clouds and baseline settings for ``benchmarks.run kernels``."""
+
+    name: str
+    families: tuple[str, ...]
+    sizes: dict[int, tuple[int, ...]]
+    f_values: tuple[int, ...] | None = None  # None: kernel_clouds.f_values
+    baselines: tuple[str, ...] = KERNEL_BASELINES
+    max_subsets: int = KB.MAX_SUBSETS
+    time_limit: float = 600.0
+    reference: bool = True  # add the reference instances (baselines forced on them)
+    description: str = ""
+
+
+KERNEL_SETS: dict[str, KernelSet] = {
+    "core": KernelSet(
+        "core", tuple(CLOUD_FAMILIES), dict(KC_DEFAULT_SIZES),
+        description="BENCHMARKS.md §2 grid: all families, d = 2 (n to 1000), d = 3 (n to 100), "
+                    "a few d = 4, 5; baselines up to 2·10^5 subsets, 600 s limit",
+    ),
+    "reduced": KernelSet(
+        "reduced", tuple(CLOUD_FAMILIES), dict(KC_DEFAULT_SIZES), max_subsets=5_000,
+        time_limit=120.0,
+        description="REDUCED RUN: the full §2 cloud grid for rescon, but the baselines only "
+                    "where C(n,F) ≤ 5000 subsets (plus the two reference instances); "
+                    "the full-baseline run is `--set core`",
+    ),
+    "quick": KernelSet(
+        "quick", tuple(CLOUD_FAMILIES), {2: (10, 20, 50), 3: (10, 20)}, max_subsets=2_000,
+        time_limit=60.0, reference=False,
+        description="CI smoke test (< 3 min): d = 2 (n ≤ 50), d = 3 (n ≤ 20), baselines where "
+                    "C(n,F) ≤ 2000",
+    ),
+}
+
+
+@dataclass
+class KernelConfig:
+    set: KernelSet
+    families: tuple[str, ...]
+    sizes: dict[int, tuple[int, ...]]
+    f_values: tuple[int, ...] | None
+    baselines: tuple[str, ...]
+    max_subsets: int
+    time_limit: float
+    reference: bool
+    repeats: int
+    out: Path
+    stem: str
+    argv: list[str]
+
+
+@dataclass
+class KernelRecord:
+    """Everything measured on one cloud."""
+
+    cloud: Cloud
+    forced: bool = False  # a reference instance: baselines run whatever max_subsets says
+    empty: bool | None = None
+    dim: int | None = None
+    n_vertices: int | None = None
+    t_poly: float | None = None
+    t_point: float | None = None
+    kcert: str = ""
+    kcert_reason: str = ""
+    pcert: str = ""
+    pcert_reason: str = ""
+    base: dict[str, tuple[str, float | None, str]] = field(default_factory=dict)
+    hausdorff: float | None = None
+    errors: list[str] = field(default_factory=list)
+
+
+class _Nondeterministic(RuntimeError):
+    pass
+
+
+def _time_call(fn: Callable[[], Any], repeats: int, same: Callable[[Any, Any], bool] | None,
+               budget: float = 1.0) -> tuple[Any, float]:
+    """Run fn; repeat while the total stays < budget, up to ``repeats`` runs; median."""
+    times: list[float] = []
+    first: Any = None
+    while True:
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+        if len(times) == 1:
+            first = out
+        elif same is not None and not same(first, out):
+            raise _Nondeterministic("a repeated call gave a different answer")
+        if len(times) >= repeats or sum(times) >= budget:
+            return first, statistics.median(times)
+
+
+def _cert_status(check: Callable[[dict], Any], cert: dict) -> tuple[str, str]:
+    """valid / trusted / too_large (checker work limit: not verified) / INVALID / error."""
+    try:
+        r = check(cert)
+    except Exception as exc:  # noqa: BLE001
+        return "error", f"{type(exc).__name__}: {exc}"
+    if r.valid:
+        return ("trusted" if r.trusted else "valid"), r.reason
+    if "too large to check" in r.reason:
+        return "too_large", r.reason
+    return "INVALID", r.reason
+
+
+def _same_kernel(a: Any, b: Any) -> bool:
+    return a.dim == b.dim and a.exact_vertices == b.exact_vertices
+
+
+def _same_point(a: Any, b: Any) -> bool:
+    return bool(np.array_equal(a[0], b[0])) and a[1].get("x") == b[1].get("x")
+
+
+def _rescon_kernel_api() -> tuple[Any, str]:
+    src = REPO / "src"
+    if src.is_dir() and str(src) not in sys.path:
+        sys.path.insert(0, str(src))
+    try:
+        import rescon
+    except Exception as exc:  # noqa: BLE001
+        raise CandidateUnavailable(f"cannot import rescon: {type(exc).__name__}: {exc}") from exc
+    missing = [a for a in ("safe_kernel", "check_certificate") if not hasattr(rescon, a)]
+    if missing:
+        raise CandidateUnavailable(f"rescon lacks {missing}")
+    where = getattr(rescon, "__file__", None) or str(list(getattr(rescon, "__path__", [])))
+    return rescon, f"rescon.safe_kernel + SafeKernel.point('project') ({where}, version " \
+                   f"{getattr(rescon, '__version__', '?')})"
+
+
+def _kernel_clouds(cfg: KernelConfig) -> list[tuple[Cloud, bool]]:
+    out = [(c, False) for c in kernel_clouds_iter(cfg.families, cfg.sizes, cfg.f_values)]
+    if cfg.reference:
+        have = {(c.family, c.d, c.n, c.F): i for i, (c, _) in enumerate(out)}
+        for fam, d, n, F, _, _ in KERNEL_REFERENCE:
+            key = (fam, d, n, F)
+            if key in have:
+                out[have[key]] = (out[have[key]][0], True)
+            else:
+                out.append((make_cloud(fam, d, n, F), True))
+    return out
+
+
+def _kernel_warmup(rescon: Any, todo: list[tuple[Cloud, bool]], log: Any) -> None:
+    """Compile numba (rescon's kernels) and load HiGHS / qhull before any timing: a
+    small cloud per dimension plus the first cloud of each (family, d) at its smallest
+    n. Failures here are not fatal (they show up as error rows later)."""
+    t0 = time.perf_counter()
+    warm: list[tuple[np.ndarray, int]] = []
+    for d in sorted({c.d for c, _ in todo}):
+        warm.append((make_cloud("gaussian", d, 2 * d + 4, 1).X, 1))
+        warm.append((make_cloud("above_helly", d, 2 * d + 4, (2 * d + 3) // (d + 1) + 1).X,
+                     (2 * d + 3) // (d + 1) + 1))
+    seen: set[tuple[str, int]] = set()
+    for c, _ in sorted(todo, key=lambda t: (t[0].n, t[0].F)):
+        if (c.family, c.d) not in seen and c.n <= 100:
+            seen.add((c.family, c.d))
+            warm.append((c.X, c.F))
+    for X, F in warm:
+        try:
+            K = rescon.safe_kernel(X, F)
+            if not K.is_empty:
+                K.point("project")
+        except Exception:  # noqa: BLE001
+            pass
+    X = make_cloud("gaussian", 2, 6, 1).X
+    KB.subset_lp(X, 1)
+    KB.subset_hull_qhull(X, 1)
+    print(f"warm-up {time.perf_counter() - t0:.1f} s ({len(warm)} clouds)", file=log, flush=True)
+
+
+def _kernel_one(rescon: Any, cloud: Cloud, forced: bool, cfg: KernelConfig) -> KernelRecord:
+    rec = KernelRecord(cloud, forced)
+    X, F, n, d = cloud.X, cloud.F, cloud.n, cloud.d
+    try:
+        K, rec.t_poly = _time_call(lambda: rescon.safe_kernel(X, F), cfg.repeats, _same_kernel)
+    except Exception as exc:  # noqa: BLE001
+        tb = traceback.format_exc(limit=3).strip().splitlines()[-1]
+        rec.errors.append(f"rescon.safe_kernel failed: {type(exc).__name__}: {exc} [{tb}]")
+        return rec
+    rec.empty, rec.dim, rec.n_vertices = K.is_empty, K.dim, len(K.vertices)
+    rec.kcert, rec.kcert_reason = _cert_status(rescon.check_certificate, K.certificate)
+    want = "kernel_empty" if K.is_empty else "safe_kernel"
+    if K.certificate.get("kind") != want:
+        rec.errors.append(f"certificate kind {K.certificate.get('kind')!r}, expected {want!r}")
+    if rec.kcert in ("INVALID", "error"):
+        rec.errors.append(f"{want} certificate rejected by the checker: {rec.kcert_reason}")
+    if cloud.expect_empty is not None and cloud.expect_empty != K.is_empty:
+        rec.errors.append(f"kernel {'empty' if K.is_empty else 'nonempty'} but the construction "
+                          f"forces it {'empty' if cloud.expect_empty else 'nonempty'} "
+                          f"(F = {F}, Helly bound {(n - 1) // (d + 1)})")
+    if not K.is_empty:
+        try:
+            (x, pc), rec.t_point = _time_call(lambda: K.point("project"), cfg.repeats,
+                                              _same_point)
+            rec.pcert, rec.pcert_reason = _cert_status(rescon.check_certificate, pc)
+            if rec.pcert in ("INVALID", "error"):
+                rec.errors.append(f"kernel_point certificate rejected: {rec.pcert_reason}")
+            if not K.contains(x, tol=1e-9):
+                rec.errors.append(f"K.point('project') = {x.tolist()} not in K (tol 1e-9)")
+        except Exception as exc:  # noqa: BLE001
+            tb = traceback.format_exc(limit=3).strip().splitlines()[-1]
+            rec.errors.append(f"K.point('project') failed: {type(exc).__name__}: {exc} [{tb}]")
+    C = math.comb(n, F)
+    for b in cfg.baselines:
+        cap = max(cfg.max_subsets, C) if forced else cfg.max_subsets
+        if C > cap:
+            rec.base[b] = ("skipped", None, f"C({n},{F}) = {C} > {cap} subsets")
+            continue
+        try:
+            if b == "lp":
+                r, t = _time_call(lambda: KB.subset_lp(X, F, max_subsets=cap,
+                                                       time_limit=cfg.time_limit),
+                                  cfg.repeats, lambda a, b_: a.status == b_.status)
+                err = KB.compare_lp(K, r)
+                detail = (f"{r.n_vars} variables; " + (f"x = {r.x.tolist()}" if r.x is not None
+                                                         else r.detail)).strip()
+            else:
+                r, t = _time_call(lambda: KB.subset_hull_qhull(X, F, max_subsets=cap,
+                                                               time_limit=cfg.time_limit),
+                                  cfg.repeats, lambda a, b_: a.status == b_.status)
+                err, rec.hausdorff = KB.compare_qhull(K, r)
+                detail = f"{r.n_halfspaces} halfspaces" + (
+                    f", Hausdorff {rec.hausdorff:.3g}" if rec.hausdorff is not None else "") + (
+                    f"; {r.detail}" if r.detail else "")
+        except Exception as exc:  # noqa: BLE001
+            tb = traceback.format_exc(limit=3).strip().splitlines()[-1]
+            rec.base[b] = (f"error:{type(exc).__name__}", None, f"{exc} [{tb}]")
+            rec.errors.append(f"{b} failed: {type(exc).__name__}: {exc}")
+            continue
+        rec.base[b] = (r.status, t, detail)
+        if err:
+            rec.errors.append(f"{'subset LP' if b == 'lp' else 'qhull'} disagrees with rescon: "
+                              f"{err}")
+        elif r.status.startswith("error"):
+            rec.errors.append(f"{b} failed: {r.status} {r.detail}")
+    return rec
+
+
+def _kernel_rows(rec: KernelRecord) -> list[dict[str, Any]]:
+    c = rec.cloud
+    common = {"family": c.family, "d": c.d, "n": c.n, "F": c.F, "seed": c.seed}
+    rows = []
+    if rec.t_poly is not None:
+        rows.append({**common, "method": "rescon_empty" if rec.empty else "rescon_polytope",
+                     "empty": int(bool(rec.empty)), "dim": rec.dim, "vertices": rec.n_vertices,
+                     "seconds": f"{rec.t_poly:.6f}", "status": "ok", "cert": rec.kcert,
+                     "detail": rec.kcert_reason if rec.kcert != "valid" else ""})
+    if rec.t_point is not None:
+        rows.append({**common, "method": "rescon_point", "empty": 0, "dim": rec.dim,
+                     "vertices": rec.n_vertices, "seconds": f"{rec.t_point:.6f}",
+                     "status": "ok", "cert": rec.pcert,
+                     "detail": rec.pcert_reason if rec.pcert != "valid" else ""})
+    for b, (st, t, detail) in rec.base.items():
+        rows.append({**common, "method": "subset_lp" if b == "lp" else "qhull", "empty": "",
+                     "dim": "", "vertices": "", "seconds": "" if t is None else f"{t:.6f}",
+                     "status": st, "cert": "", "detail": detail})
+    if rec.errors:
+        rows.append({**common, "method": "check", "empty": "", "dim": "", "vertices": "",
+                     "seconds": "", "status": "error", "cert": "",
+                     "detail": "; ".join(rec.errors)})
+    return rows
+
+
+def run_kernels(cfg: KernelConfig, log: Any = sys.stderr) -> int:
+    rescon, desc = _rescon_kernel_api()  # raises CandidateUnavailable
+    todo = _kernel_clouds(cfg)
+    if not todo:
+        print("error: the selection contains no cloud", file=sys.stderr)
+        return 2
+    cfg.out.mkdir(parents=True, exist_ok=True)
+    csv_path = cfg.out / f"{cfg.stem}.csv"
+    md_path = cfg.out / f"{cfg.stem}.md"
+    _kernel_warmup(rescon, todo, log)
+    recs: list[KernelRecord] = []
+    interrupted = False
+    started = time.perf_counter()
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=KERNEL_CSV_FIELDS)
+        w.writeheader()
+        try:
+            for k, (cloud, forced) in enumerate(todo, 1):
+                rec = _kernel_one(rescon, cloud, forced, cfg)
+                recs.append(rec)
+                w.writerows(_kernel_rows(rec))
+                fh.flush()
+                parts = []
+                if rec.t_poly is not None:
+                    parts.append(("empty" if rec.empty else f"dim {rec.dim}, {rec.n_vertices} v")
+                                 + f" {rec.t_poly * 1e3:.3g} ms")
+                if rec.t_point is not None:
+                    parts.append(f"point {rec.t_point * 1e3:.3g} ms")
+                parts.append(f"cert {rec.kcert}" + (f"/{rec.pcert}" if rec.pcert else ""))
+                for b, (st, t, _) in rec.base.items():
+                    if st != "skipped":
+                        parts.append(f"{b} {st} {t:.3g} s" if t is not None else f"{b} {st}")
+                print(f"[{k}/{len(todo)}] {cloud.label} " + ", ".join(parts)
+                      + (" ERROR: " + "; ".join(rec.errors) if rec.errors else ""),
+                      file=log, flush=True)
+        except KeyboardInterrupt:
+            interrupted = True
+            print("interrupted: writing the partial summary", file=log, flush=True)
+    md = summarise_kernels(recs, cfg, desc, time.perf_counter() - started, interrupted)
+    md_path.write_text(md)
+    n_err = sum(1 for r in recs if r.errors)
+    print(f"wrote {csv_path} and {md_path}; {n_err} cloud(s) with errors", file=log)
+    if interrupted:
+        return 130
+    return 1 if n_err else 0
+
+
+# --------------------------------------------------------------------------- kernels summary
+
+
+def _ms(x: float | None, lower: bool = False) -> str:
+    if x is None:
+        return "–"
+    x *= 1e3
+    s = f"{x:.3g}" if x < 1000 else f"{x:.0f}"
+    return ("≥ " if lower else "") + s
+
+
+def _base_time(rec: KernelRecord, b: str, limit: float) -> tuple[float | None, bool]:
+    st, t, _ = rec.base.get(b, ("", None, ""))
+    if st == "time_limit":
+        return limit, True
+    if t is None or st in ("skipped",) or st.startswith("error"):
+        return None, False
+    return t, False
+
+
+def _cand_time(rec: KernelRecord, b: str) -> float | None:
+    """The rescon time a baseline is compared with: the polytope for qhull; the polytope
+    plus the point (or the emptiness proof) for the subset LP, which returns a point."""
+    if rec.t_poly is None:
+        return None
+    if b == "lp":
+        return rec.t_poly + (rec.t_point or 0.0)
+    return rec.t_poly
+
+
+def _agg(recs: list[KernelRecord], limit: float) -> list[str]:
+    """Cells for one row of the per-size / per-family tables."""
+    ok = [r for r in recs if not r.errors]
+    tp = [r.t_poly for r in recs if r.t_poly is not None and not r.empty]
+    te = [r.t_poly for r in recs if r.t_poly is not None and r.empty]
+    tq = [r.t_point for r in recs if r.t_point is not None]
+    cells = [str(len(recs)), str(sum(1 for r in recs if r.empty)),
+             _ms(_median(tp)), _ms(max(tp) if tp else None),
+             _ms(_median(tq)), _ms(max(tq) if tq else None),
+             _ms(max(te) if te else None)]
+    for b in KERNEL_BASELINES:
+        ts, rat, lower, ran = [], [], False, 0
+        extra = 0
+        for r in recs:
+            st = r.base.get(b, ("", None, ""))[0]
+            if b == "qhull" and st == "n/a":
+                extra += 1
+            bt, lb = _base_time(r, b, limit)
+            if bt is None:
+                continue
+            ran += 1
+            ts.append(bt)
+            lower |= lb
+            ct = _cand_time(r, b)
+            if r in ok and ct:
+                rat.append(bt / max(ct, 1e-9))
+        cells += [str(ran), _fmt_t(_median(ts), lower), _fmt_r(_median(rat), lower)]
+        if b == "qhull":
+            cells.append(str(extra))
+    cells.append(str(len(recs) - len(ok)))
+    return cells
+
+
+_AGG_HEAD = ["clouds", "empty", "polytope med ms", "polytope max ms", "point med ms",
+             "point max ms", "empty-cert max ms", "LP runs", "LP med s", "LP/rescon",
+             "qhull runs", "qhull med s", "qhull/rescon", "qhull n/a", "errors"]
+
+
+def _target(recs: list[KernelRecord], goal: float, what: str, label: str,
+            get: Callable[[KernelRecord], float | None]) -> str | None:
+    vals = [(get(r), r) for r in recs]
+    vals = [(t, r) for t, r in vals if t is not None]
+    if not vals:
+        return f"| {label} | {what} ≤ {_ms(goal)} ms | no instance in this run | – |"
+    ts = [t for t, _ in vals]
+    worst, wr = max(vals, key=lambda v: v[0])
+    over = sum(1 for t in ts if t > goal)
+    med = statistics.median(ts)
+    verdict = "met" if over == 0 else (
+        f"**NOT met** ({over}/{len(ts)} over" + ("; median met)" if med <= goal else ")"))
+    return (f"| {label} | {what} ≤ {_ms(goal)} ms | median {_ms(med)} ms, max {_ms(worst)} ms "
+            f"({wr.cloud.label}), {len(ts)} clouds | {verdict} |")
+
+
+def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wall: float,
+                      interrupted: bool = False) -> str:
+    lim = cfg.time_limit
+    lines = [f"# Safe-kernel benchmark — set `{cfg.set.name}`", ""]
+    if interrupted:
+        lines += ["**INTERRUPTED: partial results.**", ""]
+    errors = [r for r in recs if r.errors]
+    n_empty = sum(1 for r in recs if r.empty)
+
+    def cert_counts(attr: str) -> str:
+        cnt: dict[str, int] = {}
+        for r in recs:
+            v = getattr(r, attr)
+            if v:
+                cnt[v] = cnt.get(v, 0) + 1
+        order = ["valid", "trusted", "too_large", "INVALID", "error"]
+        return ", ".join(f"{k} {cnt[k]}" for k in order if k in cnt) or "none"
+
+    status = ("**All answers agree** (rescon, the baselines that ran, Helly / construction "
+              "expectations) and no certificate was rejected." if not errors else
+              f"**{len(errors)} cloud(s) with disagreements or failures — see Errors.**")
+    lines += [
+        f"- Generated {_dt.datetime.now(_dt.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')} by "
+        f"`python -m benchmarks.run {' '.join(cfg.argv)}` in {wall:.0f} s.",
+        f"- Set `{cfg.set.name}`: {cfg.set.description}.",
+        f"- Candidate: {desc}.",
+        f"- Baselines: {', '.join(cfg.baselines) or 'none'} (subset LP = `subset_lp`, qhull = "
+        f"`subset_hull_qhull` in benchmarks/kernel_baselines.py), run where C(n,F) ≤ "
+        f"{cfg.max_subsets}" + (" and on the reference instances" if cfg.reference else "")
+        + f"; time limit {lim:g} s per call.",
+        f"- Machine: {_machine()}.",
+        f"- {_versions()}.",
+        f"- {len(recs)} clouds ({n_empty} with an empty kernel); {status}",
+        f"- Certificates (rescon.check_certificate, not timed): kernel/emptiness "
+        f"{cert_counts('kcert')}; point {cert_counts('pcert')}. `trusted` = accepted with "
+        f"the proof method trusted, `too_large` = beyond the checker's work limit "
+        f"(not verified, not counted as a failure).",
+        "",
+        "Times are wall-clock (`time.perf_counter`), median of up to "
+        f"{cfg.repeats} repeats while one cloud's calls stay under 1 s, after a numba "
+        "warm-up. *polytope* = `rescon.safe_kernel(X, F)` on nonempty kernels; *point* = "
+        "`K.point('project')` (exact point + `kernel_point` certificate, timed separately); "
+        "*empty-cert* = `safe_kernel` on clouds whose kernel is empty (it returns the "
+        "`kernel_empty` certificate). Ratios (> 1: rescon faster) are medians over clouds of "
+        "baseline time / rescon time, where rescon time = polytope + point for the subset LP "
+        "(which also returns a point) and polytope for qhull (which returns the vertices); "
+        "clouds with errors are left out. A baseline time-out counts as the limit (≥).",
+        "",
+    ]
+
+    def sel(pred: Callable[[KernelRecord], bool]) -> list[KernelRecord]:
+        return [r for r in recs if pred(r)]
+
+    poly = lambda r: r.t_poly if r.t_poly is not None and not r.empty else None  # noqa: E731
+    pt = lambda r: r.t_point  # noqa: E731
+    emp = lambda r: r.t_poly if r.t_poly is not None and r.empty else None  # noqa: E731
+    tg = [
+        _target(sel(lambda r: r.cloud.d == 2 and r.cloud.n <= 100), 0.020, "polytope",
+                "d = 2, n ≤ 100: exact polytope", poly),
+        _target(sel(lambda r: r.cloud.d == 2 and r.cloud.n <= 100), 0.005, "point + cert",
+                "d = 2, n ≤ 100: point + certificate", pt),
+        _target(sel(lambda r: r.cloud.d == 2 and r.cloud.n == 1000), 1.0, "polytope",
+                "d = 2, n = 1000: exact polytope", poly),
+        _target(sel(lambda r: r.cloud.d == 3 and r.cloud.n == 50), 0.050, "polytope",
+                "d = 3, n = 50: exact polytope", poly),
+        _target(sel(lambda r: r.cloud.d == 3 and r.cloud.n == 100), 0.150, "polytope",
+                "d = 3, n = 100: exact polytope", poly),
+        _target(sel(lambda r: True), 0.020, "emptiness cert", "emptiness certificate (all)",
+                emp),
+    ]
+    for d in sorted({r.cloud.d for r in recs}):
+        tg.append(_target(sel(lambda r, d=d: r.cloud.d == d), 0.020, "emptiness cert",
+                          f"… of which d = {d}", emp))
+    lines += ["## Targets (BENCHMARKS.md §2)", "",
+              "Verdict `met` only when **every** cloud of the group is within the target.", "",
+              "| target | goal | measured | verdict |", "|---|---|---|---|",
+              *[t for t in tg if t], ""]
+
+    if cfg.reference:
+        lines += ["## Reference instances (BENCHMARKS.md §2 quotes)", "",
+                  "| instance | baseline | quoted | measured here | rescon (poly + point) | "
+                  "ratio | agree |", "|---|---|---|---|---|---|---|"]
+        for fam, d, n, F, b, quoted in KERNEL_REFERENCE:
+            r = next((x for x in recs if (x.cloud.family, x.cloud.d, x.cloud.n, x.cloud.F)
+                      == (fam, d, n, F)), None)
+            if r is None or b not in cfg.baselines:
+                continue
+            bt, lb = _base_time(r, b, lim)
+            ct = _cand_time(r, b)
+            st = r.base.get(b, ("–", None, ""))[0]
+            ratio = _fmt_r(bt / max(ct, 1e-9), lb) if bt is not None and ct else "–"
+            lines.append(f"| {r.cloud.label} | {'subset LP' if b == 'lp' else 'qhull'} | "
+                         f"{quoted:g} s | {_fmt_t(bt, lb)} s ({st}) | {_ms(ct)} ms | {ratio} | "
+                         f"{'no' if r.errors else 'yes'} |")
+        lines.append("")
+
+    by_size: dict[tuple[int, int], list[KernelRecord]] = {}
+    by_fam: dict[tuple[str, int, int], list[KernelRecord]] = {}
+    for r in recs:
+        by_size.setdefault((r.cloud.d, r.cloud.n), []).append(r)
+        by_fam.setdefault((r.cloud.family, r.cloud.d, r.cloud.n), []).append(r)
+    lines += ["## By size (all families and F)", "",
+              "| d | n | " + " | ".join(_AGG_HEAD) + " |", "|" + "---|" * (2 + len(_AGG_HEAD))]
+    for (d, n) in sorted(by_size):
+        lines.append(f"| {d} | {n} | " + " | ".join(_agg(by_size[(d, n)], lim)) + " |")
+    lines += ["", "## By family and size (all F)", "",
+              "| family | d | n | F | " + " | ".join(_AGG_HEAD) + " |",
+              "|" + "---|" * (4 + len(_AGG_HEAD))]
+    fam_order = list(CLOUD_FAMILIES)
+    for key in sorted(by_fam, key=lambda k: (fam_order.index(k[0]) if k[0] in fam_order
+                                             else 99, k[1], k[2])):
+        rs = by_fam[key]
+        Fs = ",".join(str(r.cloud.F) for r in rs)
+        lines.append(f"| {key[0]} | {key[1]} | {key[2]} | {Fs} | " + " | ".join(_agg(rs, lim))
+                     + " |")
+    lines.append("")
+    hd = [r.hausdorff for r in recs if r.hausdorff is not None]
+    if hd:
+        lines += [f"qhull vs rescon vertices: {len(hd)} full-dimensional kernels compared, "
+                  f"largest Hausdorff distance {max(hd):.3g} (tolerance 1e-6).", ""]
+    if errors:
+        lines += ["## Errors", "", "| cloud | seed | detail |", "|---|---|---|"]
+        for r in errors:
+            dtl = "; ".join(r.errors).replace("|", "\\|")
+            lines.append(f"| {r.cloud.label} | {r.cloud.seed} | {dtl} |")
+        lines.append("")
+    big = [r for r in recs if "too_large" in (r.kcert, r.pcert)]
+    if big:
+        cnt: dict[tuple[int, int], int] = {}
+        for r in big:
+            cnt[(r.cloud.d, r.cloud.n)] = cnt.get((r.cloud.d, r.cloud.n), 0) + 1
+        lines += ["## Certificates beyond the checker's work limit (not verified)", "",
+                  ", ".join(f"d = {d}, n = {n}: {k}" for (d, n), k in sorted(cnt.items()))
+                  + ".", ""]
+    return "\n".join(lines)
+
+
 # --------------------------------------------------------------------------- CLI
 
 
@@ -600,12 +1170,82 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output directory")
     r.add_argument("--name", help="output file stem (default depends on the set: "
                    + ", ".join(f"{s.name}→{s.stem}" for s in SETS.values()) + ")")
+
+    k = sub.add_parser("kernels", help="safe kernels against the subset LP and qhull")
+    k.add_argument("--set", choices=sorted(KERNEL_SETS), default="core",
+                   help="named set (default core = BENCHMARKS.md §2 grid; reduced: same "
+                        "clouds, small baselines only; quick: CI smoke)")
+    k.add_argument("--quick", action="store_true", help="alias for --set quick (< 3 min)")
+    k.add_argument("--families", nargs="+",
+                   help=f"cloud families among {', '.join(CLOUD_FAMILIES)}")
+    k.add_argument("--dims", nargs="+", help="dimensions d, e.g. --dims 2 3")
+    k.add_argument("--sizes", nargs="+", help="point counts n (for every d selected)")
+    k.add_argument("--F", nargs="+", dest="F",
+                   help="F values instead of {1, n/10, h, h+1..h+3} (those < n are used)")
+    k.add_argument("--baselines", nargs="+", help="subset of lp,qhull; 'none' for none")
+    k.add_argument("--max-subsets", type=int,
+                   help="run a baseline only when C(n,F) is at most this (set default)")
+    k.add_argument("--time-limit", type=float, help="baseline time limit per call, seconds")
+    k.add_argument("--no-reference", action="store_true",
+                   help="do not add the reference instances (gaussian d=2 n=25 F=4, n=20 F=6)")
+    k.add_argument("--repeats", type=int, default=5,
+                   help="repeats while a cloud's calls take < 1 s (median is kept); default 5")
+    k.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output directory")
+    k.add_argument("--name", help="results go to kernels_<name>.{csv,md} (default: the set name)")
     return p
+
+
+def _kernels_main(args: argparse.Namespace, argv: list[str]) -> int:
+    kset = KERNEL_SETS["quick" if args.quick else args.set]
+    try:
+        fams = tuple(_split(args.families)) or kset.families
+        bad = [f for f in fams if f not in CLOUD_FAMILIES]
+        if bad:
+            raise ValueError(f"--families: unknown {bad}; known: {', '.join(CLOUD_FAMILIES)}")
+        dims = tuple(int(x) for x in _split(args.dims)) or tuple(kset.sizes)
+        if any(d < 1 for d in dims):
+            raise ValueError(f"--dims: every d must be >= 1; got {list(dims)}")
+        ns = tuple(int(x) for x in _split(args.sizes))
+        if any(n < 2 for n in ns):
+            raise ValueError(f"--sizes: every n must be >= 2; got {list(ns)}")
+        sizes = {d: ns or kset.sizes.get(d) or KC_DEFAULT_SIZES.get(d, (10,)) for d in dims}
+        Fs = tuple(int(x) for x in _split(args.F)) or kset.f_values
+        if Fs is not None and any(F < 1 for F in Fs):
+            raise ValueError(f"--F: every F must be >= 1; got {list(Fs)}")
+        bl = tuple(_split(args.baselines)) if args.baselines else kset.baselines
+        bl = () if bl == ("none",) else bl
+        if any(b not in KERNEL_BASELINES for b in bl):
+            raise ValueError(f"--baselines: expected a subset of {list(KERNEL_BASELINES)}; "
+                             f"got {list(bl)}")
+        cap = args.max_subsets if args.max_subsets is not None else kset.max_subsets
+        if cap < 1:
+            raise ValueError(f"--max-subsets must be >= 1; got {cap}")
+        tl = args.time_limit if args.time_limit is not None else kset.time_limit
+        if not tl > 0:
+            raise ValueError(f"--time-limit must be > 0; got {tl}")
+        name = args.name or kset.name
+        if not name or "/" in name:
+            raise ValueError(f"--name must be a plain file-name part; got {name!r}")
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    cfg = KernelConfig(set=kset, families=fams, sizes=sizes, f_values=Fs, baselines=bl,
+                       max_subsets=cap, time_limit=tl,
+                       reference=kset.reference and not args.no_reference,
+                       repeats=max(1, args.repeats), out=args.out, stem=f"kernels_{name}",
+                       argv=argv)
+    try:
+        return run_kernels(cfg)
+    except CandidateUnavailable as exc:
+        print(f"error: rescon unavailable: {exc}", file=sys.stderr)
+        return 2
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     args = _parser().parse_args(argv)
+    if args.command == "kernels":
+        return _kernels_main(args, argv)
     bset = SETS["quick" if args.quick else args.set]
     try:
         fams = tuple(_split(args.families)) or bset.families

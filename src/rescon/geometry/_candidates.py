@@ -272,12 +272,10 @@ def sweep_pairs_2d(Y, W, subsets):
     return plus, minus, unc, degenerate, cof, cof_abs
 
 
-@njit(cache=True, parallel=True)
-def row_max(A, b, V):
-    """max_v (A_h · v) − b_h for every row h, without the (rows × vertices) matrix."""
-    m, k = A.shape
-    out = np.empty(m)
-    for h in prange(m):
+@njit(cache=True, nogil=True)
+def _row_max_range(A, b, V, h0, h1, out):
+    k = A.shape[1]
+    for h in range(h0, h1):
         best = -np.inf
         for v in range(V.shape[0]):
             s = 0.0
@@ -285,4 +283,22 @@ def row_max(A, b, V):
                 s += A[h, j] * V[v, j]
             best = max(best, s)
         out[h] = best - b[h]
+
+
+@njit(cache=True, parallel=True)
+def _row_max_parallel(A, b, V, out):
+    m = A.shape[0]
+    chunks = 64
+    for c in prange(chunks):
+        _row_max_range(A, b, V, m * c // chunks, m * (c + 1) // chunks, out)
+
+
+def row_max(A, b, V):
+    """max_v (A_h · v) − b_h for every row h, without the (rows × vertices) matrix
+    (threads only for large inputs)."""
+    out = np.empty(A.shape[0])
+    if A.shape[0] * V.shape[0] >= 200_000:
+        _row_max_parallel(A, b, V, out)
+    else:
+        _row_max_range(A, b, V, 0, A.shape[0], out)
     return out

@@ -27,6 +27,11 @@ from .polytope import ExactPolytope, clip_to_fixpoint
 __all__ = ["SafeKernel", "check_F", "check_points", "kernel_point", "kernel_points", "safe_kernel"]
 
 
+#: below this many valid halfspaces exact clipping is faster than the fast path's
+#: LP + qhull set-up (and tiny kernels are often flat, which the fast path declines)
+FAST_PATH_MIN_HALFSPACES = 400
+
+
 def check_points(X: Any, name: str = "X") -> np.ndarray:
     """X as a finite float array (n, d), n ≥ 1, d ≥ 1, or InputError saying what came."""
     try:
@@ -270,7 +275,7 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     lo = [min(y[j] for y in rows) for j in range(hull.dim)]
     hi = [max(y[j] for y in rows) for j in range(hull.dim)]
     first = np.flatnonzero(H.outside == F)
-    if hull.dim >= 2:
+    if hull.dim >= 2 and len(H) >= FAST_PATH_MIN_HALFSPACES:
         fast = certified_kernel(H, hull.dim, P.scale, first)
         if fast is not None:
             return fast
