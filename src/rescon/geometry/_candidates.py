@@ -102,6 +102,36 @@ def k_subsets(n, k, count):
     return subsets
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
+    """The point scan of _classify_range for k = 3 with scalars (the hot loop)."""
+    c0, c1, c2 = C[0], C[1], C[2]
+    a0, a1, a2 = Cabs[0], Cabs[1], Cabs[2]
+    x0, x1, x2 = Y[i0, 0], Y[i0, 1], Y[i0, 2]
+    np_, nm, nu = 0, 0, 0
+    for q in range(Y.shape[0]):
+        if q == i0 or q == i1 or q == i2:
+            continue
+        d0 = Y[q, 0] - x0
+        d1 = Y[q, 1] - x1
+        d2 = Y[q, 2] - x2
+        s = d0 * c0 + d1 * c1 + d2 * c2
+        bound = coarse
+        if abs(s) <= coarse:
+            bound = c_err * (abs(d0) * a0 + abs(d1) * a1 + abs(d2) * a2)
+        if s > bound:
+            np_ += W[q]
+            if np_ > F and nm > F:
+                break
+        elif s < -bound:
+            nm += W[q]
+            if np_ > F and nm > F:
+                break
+        elif c_err != 0.0:
+            nu += W[q]
+    return np_, nm, nu
+
+
 @njit(cache=True, nogil=True)
 def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
                     plus, minus, unc, degenerate, cof, cof_abs):
@@ -131,6 +161,12 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
             degenerate[t] = True
             continue
         p0 = idx[0]
+        if k == 3:
+            np_, nm, nu = _scan3(Y, W, idx[0], idx[1], idx[2], C, Cabs, coarse, c_err, F)
+            plus[t] = np_
+            minus[t] = nm
+            unc[t] = nu
+            continue
         np_, nm, nu = 0, 0, 0
         for q in range(n):
             is_member = False
