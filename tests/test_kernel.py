@@ -353,3 +353,20 @@ def test_angular_sweep_equals_direct_scan(cloud, monkeypatch):
     assert set(swept.exact_vertices) == set(direct.exact_vertices)
     assert swept.dim == direct.dim
     assert rescon.check_certificate(swept.certificate).valid
+
+
+@pytest.mark.parametrize("d,F", [(2, 2), (3, 1), (3, 3)])
+def test_plot_writes_a_figure(tmp_path, d, F):
+    pytest.importorskip("matplotlib")
+    X = np.random.default_rng(d + F).normal(size=(10, d))
+    K = rescon.safe_kernel(X, F)
+    path = tmp_path / "k.png"
+    point = None if K.is_empty else K.point()[0]
+    ax = K.plot(point=point, path=path)
+    assert path.stat().st_size > 1000 and ax is not None
+
+
+def test_plot_refuses_high_dimensions():
+    K = rescon.safe_kernel(np.random.default_rng(0).normal(size=(8, 4)), 1)
+    with pytest.raises(InputError, match="d = 2 or 3"):
+        K.plot()
