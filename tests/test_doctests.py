@@ -13,6 +13,10 @@ MODULES = [
     "rescon.graphs.generators",
     "rescon.graphs.attacks",
     "rescon.io",
+    "rescon.geometry.kernel",
+    "rescon.geometry.tverberg",
+    "rescon.consensus.dos",
+    "rescon.consensus.adversaries",
 ]
 
 

@@ -27,6 +27,9 @@ from .graphs.robustness import (
     max_s,
     robustness,
 )
+from .consensus.engine import simulate
+from .consensus.scenario import Scenario, ScenarioWarning
+from .consensus.trajectory import Trajectory
 from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kernel
 from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.sarymsakov import is_sarymsakov
@@ -43,9 +46,12 @@ __all__ = [
     "RobustnessCheck",
     "RobustnessReport",
     "SafeKernel",
+    "Scenario",
+    "ScenarioWarning",
     "SolverError",
     "SolverNotFound",
     "TimeLimitReached",
+    "Trajectory",
     "TverbergPartition",
     "check_assumption2",
     "check_attack_model",
@@ -58,5 +64,6 @@ __all__ = [
     "max_s",
     "robustness",
     "safe_kernel",
+    "simulate",
     "tverberg_partition",
 ]

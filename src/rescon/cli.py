@@ -148,6 +148,44 @@ def _cmd_kernel(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    import warnings
+    from pathlib import Path
+
+    from .consensus.engine import simulate
+    from .consensus.scenario import Scenario, ScenarioWarning
+
+    sc = Scenario.from_toml(args.scenario)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ScenarioWarning)
+        traj = simulate(sc)
+    for w in caught:
+        print(f"rescon: warning: {w.message}", file=sys.stderr)
+    out = {"steps": sc.steps, "N": len(sc.nodes), "d": sc.d, "F": sc.F,
+           "algorithm": sc.algorithm, "policy": sc.policy,
+           "final_diameter": traj.final_diameter, "max_validity": traj.max_validity,
+           "assumptions_violated": traj.info["assumptions_violated"],
+           "seconds": round(traj.seconds, 6)}
+    if args.out:
+        d = Path(args.out)
+        d.mkdir(parents=True, exist_ok=True)
+        (d / "trajectory.json").write_text(json.dumps(traj.to_json()) + "\n", encoding="utf-8")
+        traj.to_csv(d / "trajectory.csv")
+        if args.plot:
+            traj.plot(d / "trajectory.png")
+        out["out"] = str(d)
+    elif args.plot:
+        raise RESCONError("--plot needs --out DIR (where the figure is written)")
+    lines = [f"{sc.algorithm} with policy {sc.policy}: N = {len(sc.nodes)}, d = {sc.d}, "
+             f"F = {sc.F}, {sc.steps} steps in {traj.seconds:.2f} s",
+             f"final benign diameter {traj.final_diameter:.3e}, largest distance to the "
+             f"initial benign hull {traj.max_validity:.3e}"]
+    if args.out:
+        lines.append(f"written to {args.out}")
+    _emit(out, args.json, lines)
+    return 0
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     from rescon_certificates.check import check, load, main as check_main
 
@@ -215,6 +253,13 @@ def _parser() -> argparse.ArgumentParser:
     ker.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
     ker.add_argument("--json", action="store_true", help="one JSON object on stdout")
     ker.set_defaults(func=_cmd_kernel)
+
+    sim = sub.add_parser("simulate", help="run Algorithm 1 (or a baseline) on a scenario")
+    sim.add_argument("scenario", help="scenario TOML file")
+    sim.add_argument("--out", metavar="DIR", help="write trajectory.json/.csv (and .png)")
+    sim.add_argument("--plot", action="store_true", help="with --out: draw the trajectory")
+    sim.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    sim.set_defaults(func=_cmd_simulate)
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")

@@ -1,1 +1,1 @@
-"""rescon.consensus (under construction)."""
+"""Resilient consensus: Algorithm 1, adversaries, DoS schedules, metrics."""

@@ -25,7 +25,6 @@ import itertools
 
 import numpy as np
 
-from ._candidates import row_max
 from .polytope import ExactPolytope, _normalise
 
 __all__ = ["certified_kernel"]
@@ -81,6 +80,8 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
         if any(len(f) != k for f in facets):
             return None
         # floats first: halfspaces clearly violated by a proposed vertex join sel
+        from ._candidates import row_max
+
         top = row_max(H.af, H.bf, np.ascontiguousarray(V))
         bad = top > 1e-9 * (1.0 + np.abs(H.bf))
         if bad.any():
@@ -123,6 +124,8 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     l1, perm_sum, babs = H.row_terms()
     row_bound = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs)
     if V is None or top is None:
+        from ._candidates import row_max
+
         top = row_max(H.af, H.bf, np.ascontiguousarray(Vx))
     else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
         shift = np.abs(V - Vx[of_proposal]).max()

@@ -40,8 +40,8 @@ def plot_kernel(K: Any, *, ax: Any = None, point: Any = None, path: Any = None) 
         P = _ordered_polygon(V)
         ax.fill(P[:, 0], P[:, 1], alpha=0.35, color="tab:blue", label=label)
     elif d == 3 and K.dim == 3:
-        from scipy.spatial import ConvexHull
         from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+        from scipy.spatial import ConvexHull
 
         hull = ConvexHull(V)
         ax.add_collection3d(Poly3DCollection([V[s] for s in hull.simplices], alpha=0.3,

@@ -1,0 +1,340 @@
+"""A consensus experiment: graph, initial states, attacks, algorithm and its parameters.
+
+Build one in Python (:class:`Scenario`), from a TOML file (:meth:`Scenario.from_toml`,
+format in the README) or take the paper's example (:meth:`Scenario.paper_example`,
+SPEC §5). Inputs are validated once, here; assumptions of the paper's theorems that
+the scenario violates (Assumption 2, the F-local / F-total model, ((d+1)F+1)-
+robustness) are reported as :class:`ScenarioWarning` with their witnesses — the
+run still goes ahead, because showing what happens then is the point.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+import warnings
+from collections.abc import Callable, Hashable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from ..errors import InputError
+from .adversaries import behaviour_from_dict, paper_adversaries
+from .dos import DoSAttack, paper_attacks, schedule_from_dict
+
+__all__ = ["ALGORITHMS", "CENTRES", "POLICIES", "Scenario", "ScenarioWarning"]
+
+POLICIES = ("hold", "zero", "drop")
+ALGORITHMS = ("alg1", "kernel", "wmsr", "mean")
+CENTRES = ("box", "mean")
+KERNEL_POINTS = ("project", "vertex-mean")
+
+
+class ScenarioWarning(UserWarning):
+    """An assumption of the convergence theorems does not hold for this scenario."""
+
+
+def _residual(spec: Any) -> Callable[[float], float]:
+    """ε(t): "none" (0), "0.1^t" / a number r ∈ (0, 1) (r^t), or a callable."""
+    if callable(spec):
+        return spec
+    if spec in (None, "none", 0, 0.0):
+        return lambda t: 0.0
+    if isinstance(spec, str) and spec.endswith("^t"):
+        try:
+            spec = float(spec[:-2])
+        except ValueError:
+            raise InputError(f"residual must be 'none', 'r^t' or a number r in (0, 1); "
+                             f"got {spec!r}") from None
+    if isinstance(spec, (int, float)) and not isinstance(spec, bool) and 0 < spec < 1:
+        r = float(spec)
+        return lambda t: r**t
+    raise InputError(f"residual must be 'none', 'r^t' or a number r in (0, 1); got {spec!r}")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One run of Algorithm 1 (or a baseline).
+
+    Parameters
+    ----------
+    graph : networkx.DiGraph (an undirected Graph counts both ways); edge (u, v):
+        v receives u's state.
+    x0 : mapping node → initial state (d,), or an (N, d) array in ``graph`` node order.
+        Adversaries' rows are only used for plotting before they first send.
+    F : the adversary bound of the algorithm.
+    adversaries : mapping node → behaviour (:mod:`rescon.consensus.adversaries`).
+    dos : DoS attacks; their links (i, j) = agent i's link from j, in node labels.
+    T : sampling period (s); t_k = k T.
+    steps : number of updates K (the trajectory has K + 1 states).
+    model : "local" or "total" (F-local / F-total), checked against the graph.
+    policy : what a blocked link delivers: "hold" (the last value received before the
+        attack — Algorithm 1), "zero" (the zero vector — the baseline the paper shows
+        failing) or "drop" (nothing).
+    algorithm : "alg1" (Algorithm 1), "kernel" (a safe-kernel point of all received
+        values, Yan et al. 2022), "wmsr" (coordinate-wise W-MSR) or "mean".
+    centre : Cen(Λ) of Algorithm 1: "box" ((min + max)/2 per coordinate, used in the
+        agreement proof) or "mean" (mean of Λ, inside conv Λ, needed for validity).
+    alpha : α_i, a number or a mapping node → number; must satisfy α_i < c and
+        1 − α_i < c.
+    c : the constant 0.5 < c < 1 of the convergence theorem.
+    residual : ε_i(t_k) added to every coordinate: "0.1^t" (the paper), "none", a
+        number r (r^t) or a callable t → float.
+    seed : seed of the one numpy Generator behind every random choice.
+    kernel_point : which point of Ψ(Y, F) the algorithm picks: "project" (closest to
+        the mean of Y) or "vertex-mean".
+    """
+
+    graph: Any
+    x0: Any
+    F: int
+    adversaries: Mapping[Hashable, Any] = field(default_factory=dict)
+    dos: tuple[DoSAttack, ...] = ()
+    T: float = 0.5
+    steps: int = 200
+    model: str = "local"
+    policy: str = "hold"
+    algorithm: str = "alg1"
+    centre: str = "mean"
+    alpha: Any = 0.5
+    c: float = 0.75
+    residual: Any = "0.1^t"
+    seed: int = 0
+    kernel_point: str = "project"
+    check_robustness: bool = True
+
+    def __post_init__(self) -> None:
+        G = self.graph
+        if not isinstance(G, (nx.Graph, nx.DiGraph)) or G.number_of_nodes() < 2:
+            raise InputError(f"graph must be a networkx graph with at least 2 nodes; got "
+                             f"{type(G).__name__}")
+        D = G if G.is_directed() else G.to_directed()
+        object.__setattr__(self, "graph", nx.DiGraph(D))
+        nodes = list(self.graph.nodes)
+        object.__setattr__(self, "x0", self._states(nodes))
+        for name, value, low in (("F", self.F, 0), ("steps", self.steps, 0),
+                                 ("seed", self.seed, 0)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+                raise InputError(f"{name} must be an integer >= {low}; got {value!r}")
+        if not (isinstance(self.T, (int, float)) and math.isfinite(self.T) and self.T > 0):
+            raise InputError(f"T must be a positive number of seconds; got {self.T!r}")
+        for name, value, allowed in (("model", self.model, ("local", "total")),
+                                     ("policy", self.policy, POLICIES),
+                                     ("algorithm", self.algorithm, ALGORITHMS),
+                                     ("centre", self.centre, CENTRES),
+                                     ("kernel_point", self.kernel_point, KERNEL_POINTS)):
+            if value not in allowed:
+                raise InputError(f"{name} must be one of {', '.join(allowed)}; got {value!r}")
+        unknown = [a for a in self.adversaries if a not in self.graph]
+        if unknown:
+            raise InputError(f"adversaries {unknown} are not nodes of the graph")
+        for att in self.dos:
+            missing = [(i, j) for i, j in att.links if not self.graph.has_edge(j, i)]
+            if missing:
+                raise InputError(f"DoS attack {att.name!r}: links {missing} (i, j) = agent "
+                                 "i's link from j are not edges j -> i of the graph")
+        object.__setattr__(self, "alpha", self._alphas(nodes))
+        object.__setattr__(self, "residual", _residual(self.residual))
+        benign = [v for v in nodes if v not in self.adversaries]
+        low = [v for v in benign if self.graph.in_degree(v) <= self.F]
+        if low:
+            raise InputError(f"F = {self.F} must be below every benign agent's in-degree; "
+                             f"agents {low[:5]} have in-degree <= F")
+
+    # ------------------------------------------------------------------ #
+
+    @property
+    def nodes(self) -> list[Hashable]:
+        return list(self.graph.nodes)
+
+    @property
+    def d(self) -> int:
+        return self.x0.shape[1]
+
+    @property
+    def benign(self) -> list[Hashable]:
+        return [v for v in self.graph.nodes if v not in self.adversaries]
+
+    def _states(self, nodes: list[Hashable]) -> np.ndarray:
+        x0 = self.x0
+        if isinstance(x0, Mapping):
+            missing = [v for v in nodes if v not in x0]
+            extra = [v for v in x0 if v not in self.graph]
+            if extra:
+                raise InputError(f"x0 has states for {extra}, which are not nodes of the graph")
+            if missing:
+                raise InputError(f"x0 has no state for nodes {missing[:5]}")
+            rows = [np.asarray(x0[v], dtype=np.float64).reshape(-1) for v in nodes]
+            if len({r.shape for r in rows}) != 1:
+                raise InputError("x0: every state must have the same dimension d; got "
+                                 f"{sorted({r.shape[0] for r in rows})}")
+            arr = np.array(rows)
+        else:
+            try:
+                arr = np.array(x0, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise InputError("x0 must be a mapping node -> state or an (N, d) array") from None
+            if arr.ndim != 2 or arr.shape[0] != len(nodes):
+                raise InputError(f"x0 must have shape (N, d) = ({len(nodes)}, d); got "
+                                 f"{arr.shape}")
+        if arr.shape[1] < 1 or not np.isfinite(arr).all():
+            raise InputError(f"x0 must be finite with d >= 1; got shape {arr.shape}")
+        arr.setflags(write=False)
+        return arr
+
+    def _alphas(self, nodes: list[Hashable]) -> np.ndarray:
+        c = self.c
+        if not (isinstance(c, (int, float)) and 0.5 < c < 1):
+            raise InputError(f"c must satisfy 0.5 < c < 1; got {c!r}")
+        a = self.alpha
+        if isinstance(a, Mapping):
+            arr = np.array([a.get(v, 0.5) for v in nodes], dtype=np.float64)
+        else:
+            arr = np.full(len(nodes), a, dtype=np.float64)
+        bad = [v for v, x in zip(nodes, arr, strict=True) if not (x < c and 1 - x < c)]
+        if bad:
+            raise InputError(f"alpha must satisfy alpha < c and 1 - alpha < c (c = {c}); "
+                             f"agents {bad[:5]} violate it")
+        arr.setflags(write=False)
+        return arr
+
+    # ------------------------------------------------------------------ #
+
+    def assumptions(self) -> list[str]:
+        """The theorem assumptions this scenario violates, each with its witness."""
+        from ..graphs.attacks import check_assumption2, check_attack_model
+
+        out = []
+        a2 = check_assumption2(self.graph, self.d, self.F, adversaries=list(self.adversaries))
+        if not a2.holds:
+            out.append(f"Assumption 2 fails: (d+1)F+1 = {a2.required} in-neighbours needed; "
+                       f"(agent, in-degree): {list(a2.violations)[:5]}")
+        am = check_attack_model(self.graph, list(self.adversaries), self.F, model=self.model)
+        if not am.holds:
+            out.append(f"the adversaries are not F-{self.model} (F = {self.F}): "
+                       f"{list(am.violations)[:5]}")
+        if self.check_robustness and self.graph.number_of_nodes() <= 64:
+            from ..graphs.robustness import is_r_robust
+
+            r = (self.d + 1) * self.F + 1
+            res = is_r_robust(self.graph, r, time_limit=5.0)
+            if res.holds is False:
+                out.append(f"the graph is not {r}-robust (= (d+1)F+1) as the theorems need; "
+                           f"witness S1 = {sorted(res.witness[0])}, S2 = {sorted(res.witness[1])}")
+        return out
+
+    def warn(self) -> list[str]:
+        """Issue a ScenarioWarning for every violated assumption; returns them."""
+        problems = self.assumptions()
+        for p in problems:
+            warnings.warn(p, ScenarioWarning, stacklevel=3)
+        return problems
+
+    # ------------------------------------------------------------------ #
+
+    @classmethod
+    def paper_example(cls, **overrides: Any) -> Scenario:
+        """SPEC §5: N = 12, d = 2, F = 2, adversaries 2 and 12, T = 0.5 s, α = 0.5,
+        residual 0.1^t, DoS_1..3 on the table's links with the documented periodic
+        timing of :func:`rescon.consensus.dos.paper_schedules`. The adversaries' own
+        in-neighbours are not in the paper (they do not matter for the dynamics);
+        every other agent is taken as one."""
+        table = {1: (2, 3, 5, 7, 9, 10, 11, 12), 3: (1, 2, 4, 5, 6, 7, 11),
+                 4: (2, 3, 5, 8, 9, 10, 12), 5: (1, 3, 4, 6, 7, 11, 12),
+                 6: (2, 3, 5, 7, 9, 10, 11), 7: (1, 2, 3, 5, 8, 9, 10, 11),
+                 8: (2, 3, 5, 7, 9, 11, 12), 9: (1, 3, 5, 7, 8, 10, 12),
+                 10: (1, 3, 5, 7, 9, 11, 12), 11: (1, 3, 4, 5, 8, 9, 12)}
+        G = nx.DiGraph()
+        G.add_nodes_from(range(1, 13))
+        for i, nbrs in table.items():
+            G.add_edges_from((j, i) for j in nbrs)
+        for adv in (2, 12):
+            G.add_edges_from((j, adv) for j in range(1, 13) if j != adv)
+        x0 = {1: (0, 0), 3: (0, 4), 4: (2, 8), 5: (4, 12), 6: (6, 18), 7: (8, 10),
+              8: (10, 7), 9: (10, 6), 10: (10, 2), 11: (10, 0)}
+        adversaries = paper_adversaries()
+        for a, beh in adversaries.items():
+            x0[a] = tuple(np.asarray(beh.f(0.0), dtype=float))
+        kw: dict[str, Any] = {"graph": G, "x0": x0, "F": 2, "adversaries": adversaries,
+                              "dos": tuple(paper_attacks()), "T": 0.5, "steps": 200,
+                              "alpha": 0.5, "residual": "0.1^t"}
+        kw.update(overrides)
+        return cls(**kw)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Scenario:
+        """Read a scenario file (format: README, "Scenario files")."""
+        p = Path(path)
+        try:
+            data = tomllib.loads(p.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise InputError(f"{p}: no such scenario file") from None
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise InputError(f"{p}: malformed TOML ({exc})") from None
+        return _from_dict(data, p.parent, str(p))
+
+
+_TOP = {"scenario", "graph", "initial", "adversaries", "dos"}
+_SCENARIO = {"F", "T", "steps", "model", "policy", "algorithm", "centre", "alpha", "c",
+             "residual", "seed", "kernel_point", "paper_example", "check_robustness"}
+_GRAPH = {"edgelist", "edges", "undirected"}
+
+
+def _keys(d: Mapping, allowed: set[str], where: str) -> None:
+    extra = sorted(set(d) - allowed)
+    if extra:
+        raise InputError(f"{where}: unknown keys {extra} (allowed: {sorted(allowed)})")
+
+
+def _label(text: str) -> Hashable:
+    try:
+        return int(text)
+    except ValueError:
+        return text
+
+
+def _from_dict(data: dict, base: Path, where: str) -> Scenario:
+    _keys(data, _TOP, where)
+    sc = dict(data.get("scenario", {}))
+    _keys(sc, _SCENARIO, f"{where} [scenario]")
+    if sc.pop("paper_example", False):
+        return Scenario.paper_example(**sc)
+    if "graph" not in data or "initial" not in data or "F" not in sc:
+        raise InputError(f"{where}: needs [graph], [initial] and scenario.F "
+                         "(or scenario.paper_example = true)")
+    g = data["graph"]
+    _keys(g, _GRAPH, f"{where} [graph]")
+    if "edgelist" in g:
+        from ..io import read_graph
+
+        G = read_graph(base / g["edgelist"], undirected=bool(g.get("undirected", False)))
+    elif "edges" in g:
+        G = nx.DiGraph()
+        for e in g["edges"]:
+            if not isinstance(e, list) or len(e) != 2:
+                raise InputError(f"{where} [graph] edges: each edge is [u, v]; got {e!r}")
+            G.add_edge(e[0], e[1])
+        if g.get("undirected", False):
+            G = G.to_undirected().to_directed()
+    else:
+        raise InputError(f"{where} [graph]: give 'edgelist' (a file) or 'edges'")
+    init = data["initial"]
+    if "file" in init:
+        from ..io import read_points
+
+        x0: Any = read_points(base / init["file"])
+    else:
+        x0 = {_label(k): v for k, v in init.items()}
+    adversaries = {_label(k): behaviour_from_dict(v)
+                   for k, v in data.get("adversaries", {}).items()}
+    dos = []
+    for m, att in enumerate(data.get("dos", [])):
+        _keys(att, {"name", "links", "schedule"}, f"{where} [[dos]] #{m + 1}")
+        links = frozenset((int(i), int(j)) if isinstance(i, int) else (i, j)
+                          for i, j in att.get("links", []))
+        dos.append(DoSAttack(att.get("name", f"DoS_{m + 1}"), links,
+                             schedule_from_dict(att.get("schedule", {}))))
+    return Scenario(graph=G, x0=x0, adversaries=adversaries, dos=tuple(dos), **sc)

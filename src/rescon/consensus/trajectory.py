@@ -1,0 +1,87 @@
+"""The result of a run: states over time, who is benign, and the metrics per step."""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Trajectory"]
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """States x_i(t_k) of every agent, k = 0..K.
+
+    Attributes
+    ----------
+    times : (K+1,) t_k = k T.
+    states : (K+1, N, d); adversaries' rows hold what they sent (their own value for
+        a function of time; NaN when nothing finite was sent).
+    nodes : the N node labels, in row order.
+    benign : indices of the benign agents.
+    metrics : per step — ``spread`` (K+1, d) per-coordinate max − min over benign
+        agents, ``diameter`` (K+1,), ``validity`` (K+1,) the largest distance of a benign
+        state to conv(benign initial states), ``validity_per_agent`` (K+1, |B|),
+        ``blocked_links`` (K+1,) links under DoS at t_k, ``starved`` (K+1,) benign
+        agents that held their state for lack of usable values.
+    info : the scenario's settings and the assumptions it violates.
+    """
+
+    times: np.ndarray
+    states: np.ndarray
+    nodes: tuple[Any, ...]
+    benign: np.ndarray
+    metrics: dict[str, np.ndarray] = field(repr=False)
+    info: dict[str, Any] = field(default_factory=dict, repr=False)
+    seconds: float = 0.0
+
+    @property
+    def max_validity(self) -> float:
+        """max over time and benign agents of the distance to conv(initial benign)."""
+        return float(self.metrics["validity"].max())
+
+    @property
+    def final_diameter(self) -> float:
+        return float(self.metrics["diameter"][-1])
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN written as null)."""
+
+        def clean(a: np.ndarray) -> Any:
+            return np.where(np.isfinite(a), a, np.nan).astype(object).tolist() if a.size else []
+
+        def nan_to_none(x: Any) -> Any:
+            if isinstance(x, list):
+                return [nan_to_none(v) for v in x]
+            return None if isinstance(x, float) and math.isnan(x) else x
+
+        return {"nodes": list(self.nodes), "benign": [self.nodes[i] for i in self.benign],
+                "times": self.times.tolist(),
+                "states": nan_to_none(clean(self.states)),
+                "metrics": {k: nan_to_none(clean(v)) for k, v in self.metrics.items()},
+                "info": self.info, "seconds": self.seconds}
+
+    def to_csv(self, path: str | Path) -> Path:
+        """One row per (step, agent): k, t, node, benign, x_1..x_d."""
+        p = Path(path)
+        d = self.states.shape[2]
+        benign = set(self.benign.tolist())
+        with p.open("w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(["k", "t", "node", "benign"] + [f"x{p + 1}" for p in range(d)])
+            for k, t in enumerate(self.times):
+                for i, node in enumerate(self.nodes):
+                    w.writerow([k, t, node, int(i in benign)] + self.states[k, i].tolist())
+        return p
+
+    def plot(self, path: str | Path | None = None, *, log_diameter: bool = True) -> Any:
+        """x(1), x(2), ... against t (benign blue, adversaries red, as the paper's
+        Figs. 3–4) and the diameter (log scale). Returns the matplotlib Figure."""
+        from ..plot.consensus import plot_trajectory
+
+        return plot_trajectory(self, path=path, log_diameter=log_diameter)
