@@ -160,7 +160,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         warnings.simplefilter("always", ScenarioWarning)
         traj = simulate(sc)
     for w in caught:
-        print(f"rescon: warning: {w.message}", file=sys.stderr)
+        if issubclass(w.category, ScenarioWarning):
+            print(f"rescon: warning: {w.message}", file=sys.stderr)
     out = {"steps": sc.steps, "N": len(sc.nodes), "d": sc.d, "F": sc.F,
            "algorithm": sc.algorithm, "policy": sc.policy,
            "final_diameter": traj.final_diameter, "max_validity": traj.max_validity,

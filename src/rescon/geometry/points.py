@@ -95,7 +95,8 @@ def _geometric_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
     i, j = np.triu_indices(len(V), 1)
     P, Q = V[i], V[j]
     D = Q - P
-    t = np.clip(np.einsum("ij,ij->i", m - P, D) / np.einsum("ij,ij->i", D, D), 0.0, 1.0)
+    dd = np.einsum("ij,ij->i", D, D)
+    t = np.clip(np.einsum("ij,ij->i", m - P, D) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
     C = P + t[:, None] * D
     return C[np.argmin(np.linalg.norm(C - m, axis=1))]
 
