@@ -277,3 +277,17 @@ def test_assumption_warnings_name_witnesses():
         simulate(sc)
     msgs = [str(w.message) for w in caught]
     assert any("Assumption 2" in m for m in msgs)
+
+
+def test_example_scenarios_load():
+    from pathlib import Path
+
+    base = Path(__file__).parent.parent / "examples" / "scenarios"
+    paper = Scenario.from_toml(base / "paper.toml")
+    assert sorted(paper.adversaries) == [2, 12] and paper.steps == 200
+    ring = Scenario.from_toml(base / "ring_attack.toml")
+    assert ring.F == 1 and len(ring.nodes) == 20 and len(ring.dos) == 1
+    short = Scenario(**{**_fields(ring), "dos": ring.dos, "steps": 8,
+                        "adversaries": ring.adversaries})
+    tr = simulate(short)
+    assert tr.metrics["diameter"][-1] < tr.metrics["diameter"][0]
