@@ -370,3 +370,30 @@ def test_plot_refuses_high_dimensions():
     K = rescon.safe_kernel(np.random.default_rng(0).normal(size=(8, 4)), 1)
     with pytest.raises(InputError, match="d = 2 or 3"):
         K.plot()
+
+
+def _clouds():
+    rng = np.random.default_rng(31)
+    out = {"gaussian": (rng.normal(size=(30, 2)), 3),
+           "sphere": (np.column_stack([np.cos(t := np.linspace(0, 6, 25)), np.sin(t)]), 5),
+           "attack": (np.vstack([rng.normal(size=(18, 2)) * 0.5, rng.normal(size=(2, 2)) * 50]),
+                      2),
+           "converged": (np.vstack([1 + 1e-7 * rng.normal(size=(12, 2)), [[9, 9], [-9, 4]]]),
+                         2),
+           "grid": (rng.integers(0, 5, size=(25, 2)).astype(float), 4),
+           "gaussian3d": (rng.normal(size=(25, 3)), 2)}
+    return out
+
+
+@pytest.mark.parametrize("name", list(_clouds()))
+def test_every_qp_backend_agrees_on_benchmark_clouds(name):
+    """Each backend's float QP (no exact snapping) is within 1e-6 of the exact point."""
+    from rescon.models.kernel_models import project, qp_backends
+
+    X, F = _clouds()[name]
+    K = rescon.safe_kernel(X, F)
+    exact, _ = K.point("project")
+    for backend in qp_backends():
+        x = project(K.A, K.b, K.affine_origin, K.affine_basis, X.mean(axis=0),
+                    backend=backend)
+        assert np.abs(x - exact).max() <= 1e-6, (backend, x, exact)

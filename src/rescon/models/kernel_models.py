@@ -194,7 +194,13 @@ def project(A, b, origin, basis, target, *, backend="clarabel", solver=None) -> 
     y = _vector(target, "target", hull.origin.size)
     if hull.k == 0:
         return hull.origin.copy()
-    return hull.lift(_SOLVE_QP[name](hull, _target_t(hull, y), solver))
+    # conditioning: in units of the polytope's size s (the largest facet distance from
+    # the origin), u = t / s; the minimiser of ½‖u − c/s‖² over G u ≤ h/s is t*/s
+    s = float(np.abs(hull.h).max()) if hull.h.size else 0.0
+    if not (s > 0 and np.isfinite(s)):
+        s = 1.0
+    scaled = _Hull(hull.origin, hull.basis, hull.G, hull.h / s)
+    return hull.lift(s * _SOLVE_QP[name](scaled, _target_t(hull, y) / s, solver))
 
 
 def chebyshev(A, b, origin, basis, *, backend="highs", solver=None) -> tuple[np.ndarray, float]:
