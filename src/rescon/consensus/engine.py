@@ -191,9 +191,37 @@ def _auxiliary(sc, links, x, values, usable, benign, d):
     return aux, starved
 
 
+#: largest point sets the planar batch path takes (it holds m(m−1) lines per set)
+SMALL_BATCH_MAX = 64
+
+
 def _kernel_points(problems: list[np.ndarray], F: int, method: str) -> list[np.ndarray]:
-    """A point of Ψ(X, F) for every X (exact; Ψ is nonempty for |X| ≥ (d+1)F+1)."""
-    return [safe_kernel(X, F).point(method)[0] for X in problems]
+    """A point of Ψ(X, F) for every X (Ψ is nonempty for |X| ≥ (d+1)F+1).
+
+    "project" in the plane goes through the numba batch path
+    (:mod:`rescon.geometry._small2d`: exact decisions, float geometry, certified error
+    bound); the sets it declines (flat kernels, undecided signs) and every other case
+    are computed exactly. "project-exact" computes everything exactly."""
+    from ..geometry._small2d import OK, project_small_2d
+
+    out: list[np.ndarray | None] = [None] * len(problems)
+    if method == "project":
+        sizes: dict[int, list[int]] = {}
+        for k, X in enumerate(problems):
+            if X.shape[1] == 2 and len(X) <= SMALL_BATCH_MAX:
+                sizes.setdefault(len(X), []).append(k)
+        for idx in sizes.values():
+            Ys = np.ascontiguousarray(np.stack([problems[k] for k in idx]), dtype=np.float64)
+            pts = np.empty((len(idx), 2))
+            err = np.empty(len(idx))
+            status = np.empty(len(idx), dtype=np.int64)
+            project_small_2d(Ys, F, pts, err, status)
+            for k, p, st in zip(idx, pts, status, strict=True):
+                if st == OK:
+                    out[k] = p
+    exact = "project" if method == "project-exact" else method
+    return [p if p is not None else safe_kernel(X, F).point(exact)[0]
+            for p, X in zip(out, problems, strict=True)]
 
 
 def _wmsr(own: np.ndarray, X: np.ndarray, F: int) -> np.ndarray:

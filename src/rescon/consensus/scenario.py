@@ -30,7 +30,7 @@ __all__ = ["ALGORITHMS", "CENTRES", "POLICIES", "Scenario", "ScenarioWarning"]
 POLICIES = ("hold", "zero", "drop")
 ALGORITHMS = ("alg1", "kernel", "wmsr", "mean")
 CENTRES = ("box", "mean")
-KERNEL_POINTS = ("project", "vertex-mean")
+KERNEL_POINTS = ("project", "project-exact", "vertex-mean")
 
 
 class ScenarioWarning(UserWarning):
@@ -85,7 +85,9 @@ class Scenario:
         number r (r^t) or a callable t → float.
     seed : seed of the one numpy Generator behind every random choice.
     kernel_point : which point of Ψ(Y, F) the algorithm picks: "project" (closest to
-        the mean of Y) or "vertex-mean".
+        the mean of Y; in the plane by the batch path — exact decisions, float geometry
+        within a certified ~1e-15 relative bound — else exactly), "project-exact" (the
+        same point, all in exact arithmetic) or "vertex-mean".
     """
 
     graph: Any

@@ -1,0 +1,375 @@
+"""numba batch path for many small planar kernels: exact decisions, float geometry.
+
+For each point set Y (m points in the plane) and F, the point of Ψ(Y, F) closest to
+mean(Y) is computed in floats, but every combinatorial decision — which side of a
+candidate line a point lies on, which polygon vertices a halfplane cuts, which edge
+or vertex is nearest — is taken only when a rounding-error bound proves it; otherwise
+the problem is flagged and the caller computes it exactly (:mod:`.kernel`). So the
+answer has the exact combinatorics and differs from the exact point only by the
+tracked geometric error (returned per problem, typically ~1e-15 of the data scale).
+
+Error bookkeeping: every float vertex v carries e_v ≥ ‖v − v_exact‖_∞. A value
+a·v − c (a, c from the data, with their own rounding bounds) is decided when its
+magnitude exceeds |a|_1 e_v + its rounding bound; an intersection of an edge with a
+line inherits a bound from its endpoints and from the error of the parameter t.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+EPS = 2.0**-53
+OK, FALLBACK = 0, 1
+#: why a problem fell back (status values ≥ 1): a side count, a clip, a flat or empty
+#: kernel, the nearest feature
+LINES_UNDECIDED, CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED = 1, 2, 3, 4
+
+
+@njit(cache=True, nogil=True)
+def _lines(Y, F, A, C, Aerr, Cerr, ends):
+    """Valid halfplanes a·x ≤ c of Ψ(Y, F): through two distinct points, ≤ F points
+    strictly outside. Returns their number, or −1 if a side count is undecided."""
+    m = Y.shape[0]
+    nh = 0
+    for i in range(m):
+        for j in range(i + 1, m):
+            dx = Y[j, 0] - Y[i, 0]
+            dy = Y[j, 1] - Y[i, 1]
+            if dx == 0.0 and dy == 0.0:
+                continue  # the same point twice: no line
+            a0, a1 = -dy, dx  # each with relative error ≤ ε (one subtraction)
+            plus = 0
+            minus = 0
+            for q in range(m):
+                if q == i or q == j:
+                    continue
+                u0 = Y[q, 0] - Y[i, 0]
+                u1 = Y[q, 1] - Y[i, 1]
+                s = a0 * u0 + a1 * u1
+                bound = 8.0 * EPS * (abs(a0 * u0) + abs(a1 * u1))
+                if s > bound:
+                    plus += 1
+                elif s < -bound:
+                    minus += 1
+                else:
+                    return -1  # on or near the line: decided exactly by the caller
+            for sign, outside in ((1.0, plus), (-1.0, minus)):
+                if outside <= F:
+                    A[nh, 0] = sign * a0
+                    A[nh, 1] = sign * a1
+                    C[nh] = sign * (a0 * Y[i, 0] + a1 * Y[i, 1])
+                    Aerr[nh] = EPS * (abs(a0) + abs(a1))
+                    ends[nh, 0] = i
+                    ends[nh, 1] = j
+                    Cerr[nh] = 4.0 * EPS * (abs(a0 * Y[i, 0]) + abs(a1 * Y[i, 1])) + Aerr[nh] * (
+                        abs(Y[i, 0]) + abs(Y[i, 1]))
+                    nh += 1
+    return nh
+
+
+@njit(cache=True, nogil=True)
+def _on_side(Y, i, side, box):
+    """Data point i lies on box side ``side`` (0 bottom, 1 right, 2 top, 3 left):
+    exactly, since the box is made of the data's own extreme coordinates."""
+    if side == 0:
+        return Y[i, 1] == box[2]
+    if side == 1:
+        return Y[i, 0] == box[1]
+    if side == 2:
+        return Y[i, 1] == box[3]
+    return Y[i, 0] == box[0]
+
+
+@njit(cache=True, nogil=True)
+def _meet(g, a0, a1, c, aerr, cerr, A, C, Aerr, Cerr, box, out):
+    """The intersection of the edge line g (a data line, or box side −1−g) with
+    a0 x + a1 y = c by Cramer's rule, into out; returns its error bound (the lines'
+    own errors and the rounding, divided by the certified part of the determinant),
+    −1 if the lines are too close to parallel to tell."""
+    if g >= 0:
+        b0, b1, d, berr, derr = A[g, 0], A[g, 1], C[g], Aerr[g], Cerr[g]
+    else:
+        side = -1 - g
+        berr, derr = 0.0, 0.0
+        if side == 0:
+            b0, b1, d = 0.0, -1.0, -box[2]
+        elif side == 1:
+            b0, b1, d = 1.0, 0.0, box[1]
+        elif side == 2:
+            b0, b1, d = 0.0, 1.0, box[3]
+        else:
+            b0, b1, d = -1.0, 0.0, -box[0]
+    det = b0 * a1 - b1 * a0
+    x_num = d * a1 - c * b1
+    y_num = b0 * c - a0 * d
+    na, nb = abs(a0) + abs(a1), abs(b0) + abs(b1)
+    det_err = berr * na + aerr * nb + 4.0 * EPS * (abs(b0 * a1) + abs(b1 * a0))
+    x_err = derr * na + abs(d) * aerr + cerr * nb + abs(c) * berr \
+        + 4.0 * EPS * (abs(d * a1) + abs(c * b1))
+    y_err = berr * abs(c) + nb * cerr + aerr * abs(d) + na * derr \
+        + 4.0 * EPS * (abs(b0 * c) + abs(a0 * d))
+    if abs(det) <= 2.0 * det_err:
+        return -1.0
+    x = x_num / det
+    y = y_num / det
+    out[0] = x
+    out[1] = y
+    denom = abs(det) - det_err
+    return max((x_err + abs(x) * det_err) / denom, (y_err + abs(y) * det_err) / denom) \
+        + 4.0 * EPS * max(abs(x), abs(y))
+
+
+@njit(cache=True, nogil=True)
+def _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL):
+    """Clip the convex polygon P[:nv] (errors E; PT[v] = data point v equals exactly, or
+    −1; EL[v] = line of the edge v → v+1, −1 for the box) by line h into Q/QE/QPT/QEL.
+    A vertex equal to an endpoint of h is exactly on it; an intersection of h with an
+    edge whose line shares an endpoint with h is exactly that data point. Returns the
+    new vertex count, or −1 when a sign is too close to call."""
+    a0, a1, c = A[h, 0], A[h, 1], C[h]
+    aerr, cerr = Aerr[h], Cerr[h]
+    i0, i1 = ends[h, 0], ends[h, 1]
+    s = np.empty(nv)
+    for v in range(nv):
+        if PT[v] == i0 or PT[v] == i1:
+            s[v] = 0.0
+            continue
+        val = a0 * P[v, 0] + a1 * P[v, 1] - c
+        bound = (abs(a0) + abs(a1)) * E[v] + aerr * (abs(P[v, 0]) + abs(P[v, 1])) + cerr \
+            + 4.0 * EPS * (abs(a0 * P[v, 0]) + abs(a1 * P[v, 1]) + abs(c))
+        if abs(val) <= bound:
+            return -1
+        s[v] = val
+    nq = 0
+    for v in range(nv):
+        w = (v + 1) % nv
+        if s[v] <= 0:
+            Q[nq, 0] = P[v, 0]
+            Q[nq, 1] = P[v, 1]
+            QE[nq] = E[v]
+            QPT[nq] = PT[v]
+            # the edge leaving v: still on its line if w is kept or cut, else on h
+            QEL[nq] = EL[v] if s[w] <= 0 or s[v] < 0 else h
+            nq += 1
+        if (s[v] < 0 and s[w] > 0) or (s[v] > 0 and s[w] < 0):
+            g = EL[v]
+            shared = -1
+            if g >= 0:
+                if ends[g, 0] == i0 or ends[g, 0] == i1:
+                    shared = ends[g, 0]
+                elif ends[g, 1] == i0 or ends[g, 1] == i1:
+                    shared = ends[g, 1]
+            else:  # a side of the bounding box: the data points on it are exactly on it
+                side = -1 - g
+                if _on_side(Y, i0, side, box):
+                    shared = i0
+                elif _on_side(Y, i1, side, box):
+                    shared = i1
+            if shared >= 0:
+                Q[nq, 0] = Y[shared, 0]
+                Q[nq, 1] = Y[shared, 1]
+                QE[nq] = 0.0
+                QPT[nq] = shared
+            else:
+                e = _meet(g, a0, a1, c, aerr, cerr, A, C, Aerr, Cerr, box, Q[nq])
+                if e < 0:
+                    return -1
+                QE[nq] = e
+                QPT[nq] = -1
+            # entering (v out, w in): the new edge continues on g; leaving: it runs on h
+            QEL[nq] = g if s[v] > 0 else h
+            nq += 1
+    return nq
+
+
+@njit(cache=True, nogil=True)
+def _project(P, E, nv, m0, m1, merr, out):
+    """Nearest point of the polygon P[:nv] to (m0, m1), if the nearest feature (inside,
+    an edge's interior, a vertex) is decided; returns its error bound or −1."""
+    # inside: every edge (counter-clockwise) has the point on its left
+    inside = True
+    undecided = False
+    for v in range(nv):
+        w = (v + 1) % nv
+        ex = P[w, 0] - P[v, 0]
+        ey = P[w, 1] - P[v, 1]
+        cr = ex * (m1 - P[v, 1]) - ey * (m0 - P[v, 0])
+        err = (abs(ex) + abs(ey)) * (2.0 * max(E[v], E[w]) * 2.0 + merr) + 8.0 * EPS * (
+            abs(ex * (m1 - P[v, 1])) + abs(ey * (m0 - P[v, 0])))
+        if cr < -err:
+            inside = False
+        elif cr <= err:
+            undecided = True
+    if inside and not undecided:
+        out[0] = m0
+        out[1] = m1
+        return merr
+    if inside and undecided:
+        return -1.0
+    best = np.inf
+    bx = 0.0
+    by = 0.0
+    be = 0.0
+    for v in range(nv):
+        w = (v + 1) % nv
+        ex = P[w, 0] - P[v, 0]
+        ey = P[w, 1] - P[v, 1]
+        ll = ex * ex + ey * ey
+        t = 0.0
+        if ll > 0:
+            t = ((m0 - P[v, 0]) * ex + (m1 - P[v, 1]) * ey) / ll
+        t = min(1.0, max(0.0, t))
+        px = P[v, 0] + t * ex
+        py = P[v, 1] + t * ey
+        dist = np.sqrt((px - m0) ** 2 + (py - m1) ** 2)
+        if dist < best:
+            best = dist
+            bx, by = px, py
+            be = 2.0 * max(E[v], E[w])
+    # a point of P within δ of the minimal distance d lies within √(2δ(2d + δ)) of the
+    # nearest point (parallelogram law), so a near-tie costs at most that much
+    out[0] = bx
+    out[1] = by
+    delta = 2.0 * be + 2.0 * merr + 8.0 * EPS * (abs(bx) + abs(by) + abs(m0) + abs(m1))
+    return be + merr + np.sqrt(2.0 * delta * (2.0 * best + delta)) + delta
+
+
+@njit(cache=True, nogil=True)
+def _orient(Y, i, j, k):
+    """Sign of the orientation of (p_i, p_j, p_k) when the float filter decides it, else 0
+    (then the caller falls back: 0 is not claimed to be exact)."""
+    a0 = Y[j, 0] - Y[i, 0]
+    a1 = Y[j, 1] - Y[i, 1]
+    b0 = Y[k, 0] - Y[i, 0]
+    b1 = Y[k, 1] - Y[i, 1]
+    det = a0 * b1 - a1 * b0
+    bound = 8.0 * EPS * (abs(a0 * b1) + abs(a1 * b0))
+    if det > bound:
+        return 1
+    if det < -bound:
+        return -1
+    return 0
+
+
+@njit(cache=True, nogil=True)
+def _radon4(Y, out):
+    """Ψ(Y, 1) for 4 points in general position is one point: the crossing of the
+    diagonals (convex position) or the point inside the triangle of the others.
+    Returns its error bound, or −1 when an orientation is undecided."""
+    tri = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))
+    for k in range(4):
+        if _orient(Y, tri[k][0], tri[k][1], tri[k][2]) == 0:
+            return -1.0
+    for k in range(4):
+        if _inside(Y, k):
+            out[0] = Y[k, 0]
+            out[1] = Y[k, 1]
+            return 0.0
+    # convex position: (0, j) is a diagonal iff the other two lie on opposite sides
+    for j in (1, 2, 3):
+        others = [q for q in (1, 2, 3) if q != j]
+        if _orient(Y, 0, j, others[0]) * _orient(Y, 0, j, others[1]) < 0:
+            a0, a1 = -(Y[j, 1] - Y[0, 1]), Y[j, 0] - Y[0, 0]
+            c = a0 * Y[0, 0] + a1 * Y[0, 1]
+            b0, b1 = -(Y[others[1], 1] - Y[others[0], 1]), Y[others[1], 0] - Y[others[0], 0]
+            d = b0 * Y[others[0], 0] + b1 * Y[others[0], 1]
+            aerr = EPS * (abs(a0) + abs(a1))
+            berr = EPS * (abs(b0) + abs(b1))
+            cerr = 4.0 * EPS * (abs(a0 * Y[0, 0]) + abs(a1 * Y[0, 1])) + aerr * (
+                abs(Y[0, 0]) + abs(Y[0, 1]))
+            derr = 4.0 * EPS * (abs(b0 * Y[others[0], 0]) + abs(b1 * Y[others[0], 1])) + berr * (
+                abs(Y[others[0], 0]) + abs(Y[others[0], 1]))
+            A = np.array([[b0, b1]])
+            C = np.array([d])
+            Ae = np.array([berr])
+            Ce = np.array([derr])
+            return _meet(0, a0, a1, c, aerr, cerr, A, C, Ae, Ce, np.zeros(4), out)
+    return -1.0
+
+
+@njit(cache=True, nogil=True)
+def _inside(Y, k):
+    """Point k strictly inside the triangle of the other three (decided orientations)."""
+    idx = [q for q in range(4) if q != k]
+    s0 = _orient(Y, idx[0], idx[1], k)
+    s1 = _orient(Y, idx[1], idx[2], k)
+    s2 = _orient(Y, idx[2], idx[0], k)
+    return s0 != 0 and s0 == s1 and s1 == s2
+
+
+@njit(cache=True, nogil=True)
+def project_small_2d(Ys, F, out, err, status):
+    """For each problem b: the point of Ψ(Ys[b], F) nearest to mean(Ys[b]) into out[b],
+    its error bound into err[b], status OK or FALLBACK (compute exactly)."""
+    B, m, _ = Ys.shape
+    H = m * (m - 1)
+    A = np.empty((H, 2))
+    C = np.empty(H)
+    Aerr = np.empty(H)
+    Cerr = np.empty(H)
+    ends = np.empty((H, 2), dtype=np.int64)
+    cap = 4 + 2 * H + 4
+    P = np.empty((cap, 2))
+    E = np.empty(cap)
+    PT = np.empty(cap, dtype=np.int64)
+    EL = np.empty(cap, dtype=np.int64)
+    Q = np.empty((cap, 2))
+    QE = np.empty(cap)
+    QPT = np.empty(cap, dtype=np.int64)
+    QEL = np.empty(cap, dtype=np.int64)
+    for b in range(B):
+        Y = Ys[b]
+        if m == 4 and F == 1:  # Ψ is a single (Radon) point
+            e = _radon4(Y, out[b])
+            status[b] = OK if e >= 0 else FLAT
+            err[b] = max(e, 0.0)
+            continue
+        status[b] = LINES_UNDECIDED
+        nh = _lines(Y, F, A, C, Aerr, Cerr, ends)
+        if nh <= 0:
+            continue
+        status[b] = FLAT
+        lo0, hi0 = Y[:, 0].min(), Y[:, 0].max()
+        lo1, hi1 = Y[:, 1].min(), Y[:, 1].max()
+        if lo0 == hi0 or lo1 == hi1:
+            continue  # collinear along an axis: exact path
+        P[0, 0], P[0, 1] = lo0, lo1
+        P[1, 0], P[1, 1] = hi0, lo1
+        P[2, 0], P[2, 1] = hi0, hi1
+        P[3, 0], P[3, 1] = lo0, hi1
+        E[:4] = 0.0
+        PT[:4] = -1
+        for k in range(4):  # a corner may be a data point (extreme in x and in y)
+            for q in range(m):
+                if Y[q, 0] == P[k, 0] and Y[q, 1] == P[k, 1]:
+                    PT[k] = q
+        for k in range(4):
+            EL[k] = -1 - k  # box side k: edge k → k+1 (bottom, right, top, left)
+        box = np.array([lo0, hi0, lo1, hi1])
+        nv = 4
+        for h in range(nh):
+            nq = _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL)
+            if nq < 0:
+                status[b] = CLIP_UNDECIDED
+            if nq < 3:
+                nv = -1  # undecided, or degenerate / empty: exact path
+                break
+            for v in range(nq):
+                P[v, 0] = Q[v, 0]
+                P[v, 1] = Q[v, 1]
+                E[v] = QE[v]
+                PT[v] = QPT[v]
+                EL[v] = QEL[v]
+            nv = nq
+        if nv < 3:
+            continue
+        m0 = Y[:, 0].mean()
+        m1 = Y[:, 1].mean()
+        merr = 2.0 * m * EPS * np.abs(Y).max()  # the float mean vs the exact one
+        e = _project(P, E, nv, m0, m1, merr, out[b])
+        if e < 0:
+            status[b] = NEAREST_UNDECIDED
+            continue
+        err[b] = e
+        status[b] = OK
