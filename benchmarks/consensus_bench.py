@@ -1,0 +1,129 @@
+"""Consensus engine benchmark (BENCHMARKS.md §3): steps per second of rescon.simulate
+against the naive per-agent CVXPY loop (benchmarks/consensus_naive.py), same run.
+
+    python -m benchmarks.consensus_bench [--quick] [--out benchmarks/results]
+
+Writes ``consensus.csv`` and ``consensus.md``. Before any time is reported, the engine
+and the naive loop are checked to agree (to 1e-6 on the steps both ran).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import platform
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.consensus_naive import simulate_naive
+from rescon.consensus.adversaries import FunctionOfTime
+from rescon.consensus.engine import simulate
+from rescon.consensus.scenario import Scenario
+from rescon.graphs.generators import circulant
+
+
+def _adversary(t: float) -> np.ndarray:
+    return np.array([3 * np.sin(t), t + 2])
+
+
+def _adversary3(t: float) -> np.ndarray:
+    return np.array([3 * np.sin(t), t + 2, np.cos(t)])
+
+
+def case(N: int, d: int, F: int, steps: int, seed: int = 1) -> Scenario:
+    """An ((d+1)F+1)-robust circulant (each agent hears its 2k nearest, k = (d+1)F+1),
+    F adversaries sending a function of time, random initial states."""
+    k = (d + 1) * F + 1
+    G = circulant(N, k)
+    x0 = np.random.default_rng(seed).uniform(0, 10, size=(N, d))
+    f = _adversary if d == 2 else _adversary3
+    adv = {i * (N // max(F, 1)): FunctionOfTime(f) for i in range(F)}
+    return Scenario(graph=G, x0=x0, F=F, adversaries=adv, steps=steps, residual="none",
+                    check_robustness=False)
+
+
+def timed(fn) -> tuple[float, object]:
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def run(quick: bool) -> list[dict]:
+    rows = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        simulate(case(20, 2, 1, 2))  # compile numba kernels outside the timings
+        sc = Scenario.paper_example(steps=200)
+        sec, _ = timed(lambda: simulate(sc))
+        rows.append({"case": "paper example (N=12, d=2, F=2)", "steps": 200,
+                     "engine_s": sec, "engine_steps_per_s": 200 / sec,
+                     "naive_steps_per_s": None, "ratio": None, "target": "200 steps < 1 s",
+                     "met": sec < 1.0})
+        sizes = [(100, 2, 1, 40, 1), (100, 3, 2, 4, 1), (1000, 2, 1, 20, 0)]
+        if quick:
+            sizes = [(100, 2, 1, 10, 1), (1000, 2, 1, 5, 0)]
+        for N, d, F, steps, naive_steps in sizes:
+            sec, traj = timed(lambda: simulate(case(N, d, F, steps)))
+            eng = steps / sec
+            naive = ratio = None
+            if naive_steps:
+                short = case(N, d, F, naive_steps)
+                nsec, states = timed(lambda: simulate_naive(short))
+                fast = simulate(short).states
+                benign = [i for i, v in enumerate(short.nodes) if v not in short.adversaries]
+                diff = np.abs(fast[:, benign] - states[:, benign]).max()
+                if diff > 1e-6:
+                    raise AssertionError(f"engine and naive loop disagree by {diff} (N={N})")
+                naive = naive_steps / nsec
+                ratio = eng / naive
+            target, met = "", None
+            if N == 1000:
+                target, met = ">= 10 steps/s", eng >= 10
+            elif N == 100 and d == 2:
+                target, met = ">= 100x naive", ratio is not None and ratio >= 100
+            rows.append({"case": f"N={N}, d={d}, F={F}", "steps": steps, "engine_s": sec,
+                         "engine_steps_per_s": eng, "naive_steps_per_s": naive,
+                         "ratio": ratio, "target": target, "met": met})
+    return rows
+
+
+def write(rows: list[dict], out: Path, seconds: float) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    with (out / "consensus.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    fmt = lambda x, p=3: "–" if x is None else (f"{x:.{p}g}" if isinstance(x, float) else str(x))  # noqa: E731
+    lines = ["# Consensus engine benchmark (BENCHMARKS.md §3)", "",
+             f"- `python -m benchmarks.consensus_bench` in {seconds:.0f} s on "
+             f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
+             "loop checked to agree to 1e-6 before timing is reported.",
+             "- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
+             "(benchmarks/consensus_naive.py), run for 1 step.", "",
+             "| case | steps | engine s | engine steps/s | naive steps/s | ratio | target | met |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['steps']} | {fmt(r['engine_s'])} | "
+                     f"{fmt(r['engine_steps_per_s'])} | {fmt(r['naive_steps_per_s'])} | "
+                     f"{fmt(r['ratio'])} | {r['target']} | "
+                     f"{'' if r['met'] is None else ('met' if r['met'] else 'NOT met')} |")
+    (out / "consensus.md").write_text("\n".join(lines) + "\n")
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--quick", action="store_true")
+    p.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    args = p.parse_args(argv)
+    t0 = time.perf_counter()
+    rows = run(args.quick)
+    write(rows, Path(args.out), time.perf_counter() - t0)
+    print((Path(args.out) / "consensus.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
