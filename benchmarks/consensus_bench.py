@@ -66,12 +66,13 @@ def run(quick: bool) -> list[dict]:
         if quick:
             sizes = [(100, 2, 1, 10, 1), (1000, 2, 1, 5, 0)]
         for N, d, F, steps, naive_steps in sizes:
-            sec, traj = timed(lambda: simulate(case(N, d, F, steps)))
+            sc = case(N, d, F, steps)
+            sec, _ = timed(lambda sc=sc: simulate(sc))
             eng = steps / sec
             naive = ratio = None
             if naive_steps:
                 short = case(N, d, F, naive_steps)
-                nsec, states = timed(lambda: simulate_naive(short))
+                nsec, states = timed(lambda short=short: simulate_naive(short))
                 fast = simulate(short).states
                 benign = [i for i, v in enumerate(short.nodes) if v not in short.adversaries]
                 diff = np.abs(fast[:, benign] - states[:, benign]).max()
@@ -96,13 +97,15 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    fmt = lambda x, p=3: "–" if x is None else (f"{x:.{p}g}" if isinstance(x, float) else str(x))  # noqa: E731
+    def fmt(x, p=3):
+        return "–" if x is None else (f"{x:.{p}g}" if isinstance(x, float) else str(x))
+
     lines = ["# Consensus engine benchmark (BENCHMARKS.md §3)", "",
              f"- `python -m benchmarks.consensus_bench` in {seconds:.0f} s on "
-             f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
-             "loop checked to agree to 1e-6 before timing is reported.",
-             "- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
-             "(benchmarks/consensus_naive.py), run for 1 step.", "",
+             (f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
+              "loop checked to agree to 1e-6 before timing is reported."),
+             ("- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
+              "(benchmarks/consensus_naive.py), run for 1 step."), "",
              "| case | steps | engine s | engine steps/s | naive steps/s | ratio | target | met |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
