@@ -101,8 +101,8 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
         return "–" if x is None else (f"{x:.{p}g}" if isinstance(x, float) else str(x))
 
     lines = ["# Consensus engine benchmark (BENCHMARKS.md §3)", "",
-             f"- `python -m benchmarks.consensus_bench` in {seconds:.0f} s on "
-             (f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
+             (f"- `python -m benchmarks.consensus_bench` in {seconds:.0f} s on "
+              f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
               "loop checked to agree to 1e-6 before timing is reported."),
              ("- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
               "(benchmarks/consensus_naive.py), run for 1 step."), "",
