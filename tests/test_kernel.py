@@ -397,3 +397,23 @@ def test_every_qp_backend_agrees_on_benchmark_clouds(name):
         x = project(K.A, K.b, K.affine_origin, K.affine_basis, X.mean(axis=0),
                     backend=backend)
         assert np.abs(x - exact).max() <= 1e-6, (backend, x, exact)
+
+
+def test_project_survives_a_failing_guide(monkeypatch):
+    """With backend "auto" the QP only guides the exact search: a solver failure there
+    must not fail the projection; with an explicit backend it is reported."""
+    from rescon.errors import SolverError
+    from rescon.geometry import points
+
+    X = np.random.default_rng(12).normal(size=(12, 3))
+    K = rescon.safe_kernel(X, 1)
+    expected, _ = K.point("project")
+
+    def broken(*args, **kwargs):
+        raise SolverError("clarabel: solver status 'AlmostSolved' is not optimal")
+
+    monkeypatch.setattr(points, "_float_guide", broken)
+    x, cert = K.point("project")
+    assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
+    with pytest.raises(SolverError, match="AlmostSolved"):
+        K.point("project", backend="clarabel")

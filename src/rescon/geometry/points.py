@@ -112,17 +112,33 @@ def _float_guide(K: SafeKernel, m: Vec, backend: str) -> np.ndarray:
 
 
 def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:
+    """Exact projection: active sets from the float guide first (subsets of the dim + 1
+    facets with the smallest slack at the guide's point), then all of them."""
     ex = K._exact
     if K.dim == 0:
         return ex.vertices[0]
     facets = list(ex.facets)
-    guess = _float_guide(K, m, backend)
-    A = K.A
-    slack = K.b - A @ guess
-    scale = 1e-7 * (1.0 + np.abs(K.b) + np.abs(A) @ np.abs(guess))
-    active = tuple(int(i) for i in np.flatnonzero(slack <= scale))
+    try:
+        guess = _float_guide(K, m, backend)
+    except SolverError:
+        if backend not in ("auto", "exact"):
+            raise  # the backend the user asked for failed: say so
+        guess = None  # "auto": the guide is only a hint; the exact search decides
+    candidates: list[tuple[int, ...]] = []
+    if guess is not None and len(facets):
+        slack = (K.b - K.A @ guess) / (1.0 + np.abs(K.b))
+        near = sorted(np.argsort(slack)[: K.dim + 1].tolist())
+        for size in range(K.dim + 1):
+            candidates += [tuple(sorted(c)) for c in itertools.combinations(near, size)]
+        tight = slack <= 1e-9  # a hint only: the KKT check below decides
+
+        def plausibility(S: tuple[int, ...]) -> tuple[int, int]:
+            return (sum(not tight[i] for i in S) + sum(tight[i] for i in near if i not in S),
+                    len(S))
+
+        candidates.sort(key=plausibility)
     tried = set()
-    for S in itertools.chain([active], _active_sets(len(facets), K.dim)):
+    for S in itertools.chain(candidates, _active_sets(len(facets), K.dim)):
         if S in tried or len(S) > K.dim:
             continue
         tried.add(S)
