@@ -113,7 +113,7 @@ def subset_lp(X: Any, F: int, *, objective: np.ndarray | None = None,
         r_l.append(np.broadcast_to(base + t, (C, k)).ravel())
         c_l.append(lam.ravel())
         v_l.append(X[S, t].ravel())
-        r_l.append((np.arange(C) * (d + 1) + t))
+        r_l.append(np.arange(C) * (d + 1) + t)
         c_l.append(np.full(C, t))
         v_l.append(np.full(C, -1.0))
     r_l.append(np.broadcast_to(base + d, (C, k)).ravel())

@@ -617,6 +617,7 @@ class KernelSet:
     max_subsets: int = KB.MAX_SUBSETS
     time_limit: float = 600.0
     reference: bool = True  # add the reference instances (baselines forced on them)
+    cert_timeout: float = 60.0  # seconds per rescon.check_certificate call
     description: str = ""
 
 
@@ -628,14 +629,14 @@ KERNEL_SETS: dict[str, KernelSet] = {
     ),
     "reduced": KernelSet(
         "reduced", tuple(CLOUD_FAMILIES), dict(KC_DEFAULT_SIZES), max_subsets=5_000,
-        time_limit=120.0,
+        cert_timeout=10.0,
         description="REDUCED RUN: the full §2 cloud grid for rescon, but the baselines only "
-                    "where C(n,F) ≤ 5000 subsets (plus the two reference instances); "
-                    "the full-baseline run is `--set core`",
+                    "where C(n,F) ≤ 5000 subsets (plus the two reference instances) and "
+                    "10 s per certificate check; the full run is `--set core`",
     ),
     "quick": KernelSet(
         "quick", tuple(CLOUD_FAMILIES), {2: (10, 20, 50), 3: (10,)}, max_subsets=2_000,
-        time_limit=60.0, reference=False,
+        time_limit=60.0, reference=False, cert_timeout=30.0,
         description="CI smoke test (< 3 min): all families, d = 2 (n ≤ 50), d = 3 (n = 10), "
                     "baselines where C(n,F) ≤ 2000",
     ),
@@ -656,6 +657,7 @@ class KernelConfig:
     out: Path
     stem: str
     argv: list[str]
+    cert_timeout: float = 60.0
 
 
 @dataclass
@@ -702,17 +704,56 @@ def _time_call(fn: Callable[[], Any], repeats: int, same: Callable[[Any, Any], b
             return first, statistics.median(times)
 
 
-def _cert_status(check: Callable[[dict], Any], cert: dict) -> tuple[str, str]:
-    """valid / trusted / too_large (checker work limit: not verified) / INVALID / error."""
-    try:
-        r = check(cert)
-    except Exception as exc:  # noqa: BLE001
-        return "error", f"{type(exc).__name__}: {exc}"
-    if r.valid:
-        return ("trusted" if r.trusted else "valid"), r.reason
-    if "too large to check" in r.reason:
-        return "too_large", r.reason
-    return "INVALID", r.reason
+def _check_in_worker(cert: dict) -> tuple[bool, str, tuple[str, ...]]:
+    import rescon
+
+    r = rescon.check_certificate(cert)
+    return bool(r.valid), str(r.reason), tuple(r.trusted)
+
+
+class _CertChecker:
+    """rescon.check_certificate with a wall-clock limit: the check runs in a forked
+    worker process (the runner waits for it, so nothing is timed meanwhile); a check
+    that takes longer than ``timeout`` s is abandoned (worker killed and restarted) and
+    reported as ``timeout``. ``timeout`` ≤ 0: in-process, no limit."""
+
+    def __init__(self, timeout: float):
+        self.timeout = timeout
+        self._pool: Any = None
+
+    def start(self) -> None:
+        if self.timeout > 0 and self._pool is None:
+            import multiprocessing
+
+            self._pool = multiprocessing.get_context("fork").Pool(1)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+    def __call__(self, cert: dict) -> tuple[str, str]:
+        """valid / trusted / too_large (checker work limit) / timeout / INVALID / error."""
+        import multiprocessing
+
+        try:
+            if self.timeout > 0:
+                self.start()
+                valid, reason, trusted = self._pool.apply_async(
+                    _check_in_worker, (cert,)).get(self.timeout)
+            else:
+                valid, reason, trusted = _check_in_worker(cert)
+        except multiprocessing.TimeoutError:
+            self.close()
+            return "timeout", f"checker still running after {self.timeout:g} s: not verified"
+        except Exception as exc:  # noqa: BLE001
+            return "error", f"{type(exc).__name__}: {exc}"
+        if valid:
+            return ("trusted" if trusted else "valid"), reason
+        if "too large to check" in reason:
+            return "too_large", reason
+        return "INVALID", reason
 
 
 def _same_kernel(a: Any, b: Any) -> bool:
@@ -772,15 +813,16 @@ def _kernel_warmup(rescon: Any, todo: list[tuple[Cloud, bool]], log: Any) -> Non
             K = rescon.safe_kernel(X, F)
             if not K.is_empty:
                 K.point("project")
-        except Exception:  # noqa: BLE001
-            pass
+        except Exception as exc:  # noqa: BLE001 - reported again, as an error row, later
+            print(f"warm-up: {type(exc).__name__}: {exc}", file=log, flush=True)
     X = make_cloud("gaussian", 2, 6, 1).X
     KB.subset_lp(X, 1)
     KB.subset_hull_qhull(X, 1)
     print(f"warm-up {time.perf_counter() - t0:.1f} s ({len(warm)} clouds)", file=log, flush=True)
 
 
-def _kernel_one(rescon: Any, cloud: Cloud, forced: bool, cfg: KernelConfig) -> KernelRecord:
+def _kernel_one(rescon: Any, cloud: Cloud, forced: bool, cfg: KernelConfig,
+                checker: Callable[[dict], tuple[str, str]]) -> KernelRecord:
     rec = KernelRecord(cloud, forced)
     X, F, n, d = cloud.X, cloud.F, cloud.n, cloud.d
     try:
@@ -790,7 +832,7 @@ def _kernel_one(rescon: Any, cloud: Cloud, forced: bool, cfg: KernelConfig) -> K
         rec.errors.append(f"rescon.safe_kernel failed: {type(exc).__name__}: {exc} [{tb}]")
         return rec
     rec.empty, rec.dim, rec.n_vertices = K.is_empty, K.dim, len(K.vertices)
-    rec.kcert, rec.kcert_reason = _cert_status(rescon.check_certificate, K.certificate)
+    rec.kcert, rec.kcert_reason = checker(K.certificate)
     want = "kernel_empty" if K.is_empty else "safe_kernel"
     if K.certificate.get("kind") != want:
         rec.errors.append(f"certificate kind {K.certificate.get('kind')!r}, expected {want!r}")
@@ -804,7 +846,7 @@ def _kernel_one(rescon: Any, cloud: Cloud, forced: bool, cfg: KernelConfig) -> K
         try:
             (x, pc), rec.t_point = _time_call(lambda: K.point("project"), cfg.repeats,
                                               _same_point)
-            rec.pcert, rec.pcert_reason = _cert_status(rescon.check_certificate, pc)
+            rec.pcert, rec.pcert_reason = checker(pc)
             if rec.pcert in ("INVALID", "error"):
                 rec.errors.append(f"kernel_point certificate rejected: {rec.pcert_reason}")
             if not K.contains(x, tol=1e-9):
@@ -820,15 +862,15 @@ def _kernel_one(rescon: Any, cloud: Cloud, forced: bool, cfg: KernelConfig) -> K
             continue
         try:
             if b == "lp":
-                r, t = _time_call(lambda: KB.subset_lp(X, F, max_subsets=cap,
-                                                       time_limit=cfg.time_limit),
+                r, t = _time_call(lambda cap=cap: KB.subset_lp(X, F, max_subsets=cap,
+                                                               time_limit=cfg.time_limit),
                                   cfg.repeats, lambda a, b_: a.status == b_.status)
                 err = KB.compare_lp(K, r)
                 detail = (f"{r.n_vars} variables; " + (f"x = {r.x.tolist()}" if r.x is not None
                                                          else r.detail)).strip()
             else:
-                r, t = _time_call(lambda: KB.subset_hull_qhull(X, F, max_subsets=cap,
-                                                               time_limit=cfg.time_limit),
+                r, t = _time_call(lambda cap=cap: KB.subset_hull_qhull(
+                                      X, F, max_subsets=cap, time_limit=cfg.time_limit),
                                   cfg.repeats, lambda a, b_: a.status == b_.status)
                 err, rec.hausdorff = KB.compare_qhull(K, r)
                 detail = f"{r.n_halfspaces} halfspaces" + (
@@ -898,6 +940,8 @@ def run_kernels(cfg: KernelConfig, log: Any = sys.stderr) -> int:
     cfg.out.mkdir(parents=True, exist_ok=True)
     csv_path = cfg.out / f"{cfg.stem}.csv"
     md_path = cfg.out / f"{cfg.stem}.md"
+    checker = _CertChecker(cfg.cert_timeout)
+    checker.start()  # fork the worker before numba starts its threads
     _kernel_warmup(rescon, todo, log)
     recs: list[KernelRecord] = []
     interrupted = False
@@ -907,7 +951,7 @@ def run_kernels(cfg: KernelConfig, log: Any = sys.stderr) -> int:
         w.writeheader()
         try:
             for k, (cloud, forced) in enumerate(todo, 1):
-                rec = _kernel_one(rescon, cloud, forced, cfg)
+                rec = _kernel_one(rescon, cloud, forced, cfg, checker)
                 recs.append(rec)
                 w.writerows(_kernel_rows(rec))
                 fh.flush()
@@ -928,6 +972,8 @@ def run_kernels(cfg: KernelConfig, log: Any = sys.stderr) -> int:
         except KeyboardInterrupt:
             interrupted = True
             print("interrupted: writing the partial summary", file=log, flush=True)
+        finally:
+            checker.close()
     md = summarise_kernels(recs, cfg, desc, time.perf_counter() - started, interrupted)
     md_path.write_text(md)
     n_err = sum(1 for r in recs if r.errors)
@@ -952,8 +998,8 @@ def _base_time(rec: KernelRecord, b: str, limit: float) -> tuple[float | None, b
     st, t, _ = rec.base.get(b, ("", None, ""))
     if st == "time_limit":
         return limit, True
-    if t is None or st in ("skipped",) or st.startswith("error"):
-        return None, False
+    if t is None or st in ("skipped", "n/a") or st.startswith("error"):
+        return None, False  # no answer: no time to report
     return t, False
 
 
@@ -1038,7 +1084,7 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
             v = getattr(r, attr)
             if v:
                 cnt[v] = cnt.get(v, 0) + 1
-        order = ["valid", "trusted", "too_large", "INVALID", "error"]
+        order = ["valid", "trusted", "too_large", "timeout", "INVALID", "error"]
         return ", ".join(f"{k} {cnt[k]}" for k in order if k in cnt) or "none"
 
     n_wrong = sum(1 for r in recs for v in r.base_issues.values() if "WRONG" in v)
@@ -1064,8 +1110,9 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
         f"- {len(recs)} clouds ({n_empty} with an empty kernel); {status}",
         f"- Certificates (rescon.check_certificate, not timed): kernel/emptiness "
         f"{cert_counts('kcert')}; point {cert_counts('pcert')}. `trusted` = accepted with "
-        f"the proof method trusted, `too_large` = beyond the checker's work limit "
-        f"(not verified, not counted as a failure).",
+        f"the proof method trusted, `too_large` = beyond the checker's work limit, "
+        f"`timeout` = the checker ran longer than {cfg.cert_timeout:g} s (both: not "
+        f"verified, not counted as failures).",
         "",
         "Times are wall-clock (`time.perf_counter`), median of up to "
         f"{cfg.repeats} repeats while one cloud's calls stay under 1 s, after a numba "
@@ -1079,12 +1126,17 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
         "",
     ]
 
-    def sel(pred: Callable[[KernelRecord], bool]) -> list[KernelRecord]:  # noqa: E306
+    def sel(pred: Callable[[KernelRecord], bool]) -> list[KernelRecord]:
         return [r for r in recs if pred(r)]
 
-    poly = lambda r: r.t_poly if r.t_poly is not None and not r.empty else None  # noqa: E731
-    pt = lambda r: r.t_point  # noqa: E731
-    emp = lambda r: r.t_poly if r.t_poly is not None and r.empty else None  # noqa: E731
+    def poly(r: KernelRecord) -> float | None:
+        return r.t_poly if r.t_poly is not None and not r.empty else None
+
+    def pt(r: KernelRecord) -> float | None:
+        return r.t_point
+
+    def emp(r: KernelRecord) -> float | None:
+        return r.t_poly if r.t_poly is not None and r.empty else None
     tg = [
         _target(sel(lambda r: r.cloud.d == 2 and r.cloud.n <= 100), 0.020, "polytope",
                 "d = 2, n ≤ 100: exact polytope", poly),
@@ -1172,14 +1224,17 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
                 lines.append(f"| {r.cloud.label} | {r.cloud.seed} | {b} | "
                              + v.replace("|", "\\|") + " |")
         lines.append("")
-    big = [r for r in recs if "too_large" in (r.kcert, r.pcert)]
+    big = [r for r in recs if {"too_large", "timeout"} & {r.kcert, r.pcert}]
     if big:
-        cnt: dict[tuple[int, int], int] = {}
+        cnt: dict[tuple[int, int, str], int] = {}
         for r in big:
-            cnt[(r.cloud.d, r.cloud.n)] = cnt.get((r.cloud.d, r.cloud.n), 0) + 1
-        lines += ["## Certificates beyond the checker's work limit (not verified)", "",
-                  ", ".join(f"d = {d}, n = {n}: {k}" for (d, n), k in sorted(cnt.items()))
-                  + ".", ""]
+            for kind, st in (("kernel", r.kcert), ("point", r.pcert)):
+                if st in ("too_large", "timeout"):
+                    key = (r.cloud.d, r.cloud.n, f"{kind} {st}")
+                    cnt[key] = cnt.get(key, 0) + 1
+        lines += ["## Certificates not verified (checker work limit or time-out)", "",
+                  "; ".join(f"d = {d}, n = {n}: {k} {what}"
+                            for (d, n, what), k in sorted(cnt.items())) + ".", ""]
     return "\n".join(lines)
 
 
@@ -1233,6 +1288,10 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--time-limit", type=float, help="baseline time limit per call, seconds")
     k.add_argument("--no-reference", action="store_true",
                    help="do not add the reference instances (gaussian d=2 n=25 F=4, n=20 F=6)")
+    k.add_argument("--cert-timeout", type=float,
+                   help="seconds allowed to rescon.check_certificate per certificate (in a "
+                        "worker process; beyond: 'timeout', not verified); 0: no limit; "
+                        "default: core 60, reduced 10, quick 30")
     k.add_argument("--repeats", type=int, default=5,
                    help="repeats while a cloud's calls take < 1 s (median is kept); default 5")
     k.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output directory")
@@ -1276,9 +1335,10 @@ def _kernels_main(args: argparse.Namespace, argv: list[str]) -> int:
         return 2
     cfg = KernelConfig(set=kset, families=fams, sizes=sizes, f_values=Fs, baselines=bl,
                        max_subsets=cap, time_limit=tl,
-                       reference=kset.reference and not args.no_reference,
+                       reference=kset.reference and not args.no_reference and bool(bl),
                        repeats=max(1, args.repeats), out=args.out, stem=f"kernels_{name}",
-                       argv=argv)
+                       argv=argv, cert_timeout=(kset.cert_timeout if args.cert_timeout is None
+                                                else args.cert_timeout))
     try:
         return run_kernels(cfg)
     except CandidateUnavailable as exc:

@@ -48,7 +48,7 @@ def _ddalpha_missing() -> str | None:
         return "Rscript not found (install Debian r-cran-ddalpha for the Tukey-depth oracle)"
     try:
         p = subprocess.run([rs, "-e", "suppressMessages(library(ddalpha)); cat('ok')"],
-                           capture_output=True, text=True, timeout=120)
+                           check=False, capture_output=True, text=True, timeout=120)
     except (OSError, subprocess.TimeoutExpired) as exc:
         return f"Rscript failed: {exc}"
     if p.returncode != 0 or "ok" not in p.stdout:
@@ -81,7 +81,8 @@ def ddalpha_depths(batch: list[tuple[np.ndarray, np.ndarray]]) -> list[np.ndarra
             np.savetxt(d / f"query_{i}.txt", np.atleast_2d(Q), fmt="%.17g")
         (d / "depth.R").write_text(_R_SCRIPT)
         p = subprocess.run([shutil.which("Rscript") or "Rscript", str(d / "depth.R"), str(d),
-                            str(len(batch))], capture_output=True, text=True, timeout=600)
+                            str(len(batch))], check=False, capture_output=True, text=True,
+                           timeout=600)
         assert p.returncode == 0, p.stderr
         out = []
         for i, (X, Q) in enumerate(batch, 1):
@@ -285,7 +286,8 @@ def test_runner_kernels_end_to_end(tmp_path):
                  "--sizes", "8", "--no-reference", "--repeats", "1", "--out", str(tmp_path),
                  "--name", "t"])
     assert rc == 0
-    rows = list(csv.DictReader(open(tmp_path / "kernels_t.csv")))
+    with open(tmp_path / "kernels_t.csv") as fh:
+        rows = list(csv.DictReader(fh))
     methods = {r["method"] for r in rows}
     assert {"rescon_polytope", "rescon_empty", "rescon_point", "subset_lp", "qhull"} <= methods
     assert not [r for r in rows if r["method"] == "check"]
