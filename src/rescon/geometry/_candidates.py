@@ -103,6 +103,29 @@ def k_subsets(n, k, count):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _side(s, bound, c_err):
+    """+1 / −1: surely on that side; 0: on the hyperplane (exact mode, c_err = 0);
+    2: undecided (within the rounding bound)."""
+    if s > bound:
+        return 1
+    if s < -bound:
+        return -1
+    return 0 if c_err == 0.0 else 2
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _tally(side, w, np_, nm, nu):
+    """Add weight w to the count of ``side`` (see _side)."""
+    if side == 1:
+        return np_ + w, nm, nu
+    if side == -1:
+        return np_, nm + w, nu
+    if side == 2:
+        return np_, nm, nu + w
+    return np_, nm, nu
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
     """The point scan of _classify_range for k = 3 with scalars (the hot loop)."""
     c0, c1, c2 = C[0], C[1], C[2]
@@ -119,16 +142,10 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
         bound = coarse
         if abs(s) <= coarse:
             bound = c_err * (abs(d0) * a0 + abs(d1) * a1 + abs(d2) * a2)
-        if s > bound:
-            np_ += W[q]
-            if np_ > F and nm > F:
-                break
-        elif s < -bound:
-            nm += W[q]
-            if np_ > F and nm > F:
-                break
-        elif c_err != 0.0:
-            nu += W[q]
+        side = _side(s, bound, c_err)
+        np_, nm, nu = _tally(side, W[q], np_, nm, nu)
+        if np_ > F and nm > F:
+            break
     return np_, nm, nu
 
 
@@ -185,16 +202,9 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
                 bound *= c_err
             else:
                 bound = coarse
-            if s > bound:
-                np_ += W[q]
-                if np_ > F and nm > F:
-                    break
-            elif s < -bound:
-                nm += W[q]
-                if np_ > F and nm > F:
-                    break
-            elif c_err != 0.0:
-                nu += W[q]
+            np_, nm, nu = _tally(_side(s, bound, c_err), W[q], np_, nm, nu)
+            if np_ > F and nm > F:
+                break
         plus[t] = np_
         minus[t] = nm
         unc[t] = nu

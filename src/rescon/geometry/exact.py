@@ -145,26 +145,38 @@ def affine_hull(P: ExactPoints) -> AffineHull:
     return AffineHull(k, (0, *(r + 1 for r in sorted(rows))), tuple(sorted(coords)))
 
 
+def _rref(A: list[list[Fraction]], ncols: int) -> list[int]:
+    """Reduce A in place to reduced row echelon form on its first ``ncols`` columns
+    (the others, e.g. a right-hand side, follow along); returns the pivot columns."""
+    pivots: list[int] = []
+    r = 0
+    for col in range(ncols):
+        pr = next((i for i in range(r, len(A)) if A[i][col] != 0), None)
+        if pr is None:
+            continue
+        A[r], A[pr] = A[pr], A[r]
+        piv = A[r][col]
+        A[r] = [v / piv for v in A[r]]
+        for i in range(len(A)):
+            if i != r and A[i][col] != 0:
+                f = A[i][col]
+                A[i] = [vi - f * vr for vi, vr in zip(A[i], A[r], strict=True)]
+        pivots.append(col)
+        r += 1
+        if r == len(A):
+            break
+    return pivots
+
+
 def solve_exact(M: list[list[Fraction]], rhs: list[Fraction]) -> list[Fraction] | None:
     """The unique solution of M c = rhs (M with at least as many rows as columns), or
     None when M has dependent columns or the system is inconsistent."""
-    n = len(M)
     A = [list(map(Fraction, row)) + [Fraction(r)] for row, r in zip(M, rhs, strict=True)]
-    ncols = len(A[0]) - 1  # n ≥ ncols: an overdetermined system must be consistent
-    for col in range(ncols):
-        pr = next((i for i in range(col, n) if A[i][col] != 0), None)
-        if pr is None:
-            return None
-        A[col], A[pr] = A[pr], A[col]
-        piv = A[col][col]
-        A[col] = [v / piv for v in A[col]]
-        for i in range(n):
-            if i != col and A[i][col] != 0:
-                f = A[i][col]
-                A[i] = [vi - f * vc for vi, vc in zip(A[i], A[col], strict=True)]
-    for i in range(ncols, n):  # extra rows must be consistent
-        if A[i][-1] != 0:
-            return None
+    ncols = len(A[0]) - 1
+    if len(_rref(A, ncols)) < ncols:
+        return None
+    if any(A[i][-1] != 0 for i in range(ncols, len(A))):  # extra rows: consistent?
+        return None
     return [A[i][-1] for i in range(ncols)]
 
 
@@ -173,24 +185,8 @@ def nullspace_exact(M: list[list[Fraction]]) -> list[list[Fraction]]:
     if not M:
         return []
     A = [list(map(Fraction, row)) for row in M]
-    rows, cols = len(A), len(A[0])
-    pivots: list[int] = []
-    r = 0
-    for col in range(cols):
-        pr = next((i for i in range(r, rows) if A[i][col] != 0), None)
-        if pr is None:
-            continue
-        A[r], A[pr] = A[pr], A[r]
-        piv = A[r][col]
-        A[r] = [v / piv for v in A[r]]
-        for i in range(rows):
-            if i != r and A[i][col] != 0:
-                f = A[i][col]
-                A[i] = [vi - f * vr for vi, vr in zip(A[i], A[r], strict=True)]
-        pivots.append(col)
-        r += 1
-        if r == rows:
-            break
+    cols = len(A[0])
+    pivots = _rref(A, cols)
     free = [c for c in range(cols) if c not in pivots]
     basis = []
     for fc in free:

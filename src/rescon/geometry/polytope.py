@@ -235,9 +235,6 @@ class ExactPolytope:
                 for v in self.verts[1:]]
         return bareiss_rank(rows)[0] if rows else 0
 
-    def tight_vertices(self, h: int) -> list[int]:
-        return [i for i, t in enumerate(self.tight) if t >> h & 1]
-
     def incidence(self) -> dict[int, list[int]]:
         """constraint → the vertices tight on it (only constraints tight somewhere)."""
         out: dict[int, list[int]] = {}
