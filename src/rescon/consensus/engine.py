@@ -77,6 +77,7 @@ def simulate(scenario: Scenario, *, progress: bool | None = None) -> Trajectory:
                "validity": np.empty(K + 1), "validity_per_agent": np.empty((K + 1, len(benign))),
                "blocked_links": np.zeros(K + 1, dtype=np.int64),
                "starved": np.zeros(K + 1, dtype=np.int64)}
+    exact_cache: dict = {}
     bar = _bar(progress, K)
     for k in range(K + 1):
         t = k * sc.T
@@ -93,7 +94,7 @@ def simulate(scenario: Scenario, *, progress: bool | None = None) -> Trajectory:
         metrics["validity"][k] = dist.max()
         if k == K:
             break
-        aux, starved = _auxiliary(sc, links, x, values, usable, benign, d)
+        aux, starved = _auxiliary(sc, links, x, values, usable, benign, d, exact_cache)
         metrics["starved"][k] = len(starved)
         alpha = sc.alpha[benign][:, None]
         new = alpha * x[benign] + (1 - alpha) * aux + sc.residual(t)
@@ -146,7 +147,7 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
     return values, usable, sent
 
 
-def _auxiliary(sc, links, x, values, usable, benign, d):
+def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     """x̃_i for every benign agent (rows in ``benign`` order) and the rows (positions in
     ``benign``) that must hold their state."""
     m = (d + 1) * sc.F + 1
@@ -177,7 +178,7 @@ def _auxiliary(sc, links, x, values, usable, benign, d):
             aux[r] = _wmsr(x[i], X, sc.F)
         else:
             aux[r] = np.vstack([X, x[i]]).mean(axis=0) if len(X) else x[i]
-    points = _kernel_points(problems, sc.F, sc.kernel_point)
+    points = _kernel_points(problems, sc.F, sc.kernel_point, cache)
     if sc.algorithm == "kernel":
         for (r, _, _), pt in zip(where, points, strict=True):
             aux[r] = pt
@@ -195,13 +196,15 @@ def _auxiliary(sc, links, x, values, usable, benign, d):
 SMALL_BATCH_MAX = 64
 
 
-def _kernel_points(problems: list[np.ndarray], F: int, method: str) -> list[np.ndarray]:
+def _kernel_points(problems: list[np.ndarray], F: int, method: str,
+                   cache: dict) -> list[np.ndarray]:
     """A point of Ψ(X, F) for every X (Ψ is nonempty for |X| ≥ (d+1)F+1).
 
     "project" in the plane goes through the numba batch path
     (:mod:`rescon.geometry._small2d`: exact decisions, float geometry, certified error
-    bound); the sets it declines (flat kernels, undecided signs) and every other case
-    are computed exactly. "project-exact" computes everything exactly."""
+    bound); the sets it declines (some flat kernels) and every other case are computed
+    exactly, once per distinct set in a run (``cache``: held values and converged
+    states repeat the same sets). "project-exact" computes everything exactly."""
     from ..geometry._small2d import OK, project_small_2d
 
     out: list[np.ndarray | None] = [None] * len(problems)
@@ -220,8 +223,13 @@ def _kernel_points(problems: list[np.ndarray], F: int, method: str) -> list[np.n
                 if st == OK:
                     out[k] = p
     exact = "project" if method == "project-exact" else method
-    return [p if p is not None else safe_kernel(X, F).point(exact)[0]
-            for p, X in zip(out, problems, strict=True)]
+    for k, X in enumerate(problems):
+        if out[k] is None:
+            key = (X.shape, X[np.lexsort(X.T[::-1])].tobytes())  # Ψ ignores the order
+            if key not in cache:
+                cache[key] = safe_kernel(X, F).point(exact)[0]
+            out[k] = cache[key]
+    return out
 
 
 def _wmsr(own: np.ndarray, X: np.ndarray, F: int) -> np.ndarray:

@@ -19,41 +19,77 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._expansions import PARALLEL, difference, orient, side_of_meet
+
 EPS = 2.0**-53
-OK, FALLBACK = 0, 1
-#: why a problem fell back (status values ≥ 1): a side count, a clip, a flat or empty
-#: kernel, the nearest feature
-LINES_UNDECIDED, CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED = 1, 2, 3, 4
+OK = 0
+#: why a problem fell back to the exact path (status ≥ 1): a meeting point of nearly
+#: parallel lines, a flat kernel the path does not handle, the nearest feature
+#: undecided, coordinates outside the range where expansions cannot underflow/overflow
+CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED, OUT_OF_RANGE = 2, 3, 4, 5
+#: nonzero |coordinates| must lie in [2^-120, 2^120]: then degree-4 products of
+#: differences (the deepest predicate) neither underflow nor overflow
+TINY, HUGE = 2.0**-120, 2.0**120
 
 
 @njit(cache=True, nogil=True)
-def _lines(Y, F, A, C, Aerr, Cerr, ends):
+def _orient(Y, i, j, q):
+    """Sign of (p_j − p_i) × (p_q − p_i): the float value when its rounding bound
+    decides it, else the exact sign."""
+    a0 = Y[j, 0] - Y[i, 0]
+    a1 = Y[j, 1] - Y[i, 1]
+    u0 = Y[q, 0] - Y[i, 0]
+    u1 = Y[q, 1] - Y[i, 1]
+    s = a0 * u1 - a1 * u0
+    bound = 8.0 * EPS * (abs(a0 * u1) + abs(a1 * u0))
+    if s > bound:
+        return 1
+    if s < -bound:
+        return -1
+    return orient(Y[i, 0], Y[i, 1], Y[j, 0], Y[j, 1], Y[q, 0], Y[q, 1])
+
+
+@njit(cache=True, nogil=True)
+def _representatives(Y, rep):
+    """rep[q] = the first index with exactly the coordinates of point q; returns the
+    number of distinct points."""
+    distinct = 0
+    for q in range(Y.shape[0]):
+        rep[q] = q
+        for r in range(q):
+            if Y[r, 0] == Y[q, 0] and Y[r, 1] == Y[q, 1]:
+                rep[q] = r
+                break
+        if rep[q] == q:
+            distinct += 1
+    return distinct
+
+
+@njit(cache=True, nogil=True)
+def _lines(Y, F, rep, A, C, Aerr, Cerr, ends, sgn):
     """Valid halfplanes a·x ≤ c of Ψ(Y, F): through two distinct points, ≤ F points
-    strictly outside. Returns their number, or −1 if a side count is undecided."""
+    strictly outside (sides decided exactly; copies of an endpoint lie on the line).
+    a = sgn·(−(y_j − y_i), x_j − x_i), so a·(p − p_i) = sgn·orient(i, j, p).
+    Returns their number."""
     m = Y.shape[0]
     nh = 0
     for i in range(m):
+        if rep[i] != i:
+            continue
         for j in range(i + 1, m):
-            dx = Y[j, 0] - Y[i, 0]
-            dy = Y[j, 1] - Y[i, 1]
-            if dx == 0.0 and dy == 0.0:
-                continue  # the same point twice: no line
-            a0, a1 = -dy, dx  # each with relative error ≤ ε (one subtraction)
+            if rep[j] != j:
+                continue
             plus = 0
             minus = 0
             for q in range(m):
-                if q == i or q == j:
+                if rep[q] == i or rep[q] == j:
                     continue
-                u0 = Y[q, 0] - Y[i, 0]
-                u1 = Y[q, 1] - Y[i, 1]
-                s = a0 * u0 + a1 * u1
-                bound = 8.0 * EPS * (abs(a0 * u0) + abs(a1 * u1))
-                if s > bound:
+                o = _orient(Y, i, j, q)
+                if o > 0:
                     plus += 1
-                elif s < -bound:
+                elif o < 0:
                     minus += 1
-                else:
-                    return -1  # on or near the line: decided exactly by the caller
+            a0, a1 = -(Y[j, 1] - Y[i, 1]), Y[j, 0] - Y[i, 0]  # relative error ≤ ε each
             for sign, outside in ((1.0, plus), (-1.0, minus)):
                 if outside <= F:
                     A[nh, 0] = sign * a0
@@ -62,10 +98,72 @@ def _lines(Y, F, A, C, Aerr, Cerr, ends):
                     Aerr[nh] = EPS * (abs(a0) + abs(a1))
                     ends[nh, 0] = i
                     ends[nh, 1] = j
+                    sgn[nh] = 1 if sign > 0 else -1
                     Cerr[nh] = 4.0 * EPS * (abs(a0 * Y[i, 0]) + abs(a1 * Y[i, 1])) + Aerr[nh] * (
                         abs(Y[i, 0]) + abs(Y[i, 1]))
                     nh += 1
     return nh
+
+
+@njit(cache=True, nogil=True)
+def _collinear(Y, F, rep, merr, out):
+    """When all distinct points lie on one line, Ψ is the segment between the
+    (F+1)-th smallest and the (F+1)-th largest point along it (points with multiplicity,
+    ordered by x, or by y on a vertical line), and the point nearest the mean (which lies
+    on the line) is the mean clamped to it. Returns its error bound; −1 when the mean's
+    position against an end is undecided or Ψ is empty, −2 when not collinear."""
+    m = Y.shape[0]
+    i0 = 0
+    j0 = -1
+    for q in range(m):
+        if rep[q] == q and q != i0:
+            if j0 < 0:
+                j0 = q
+            elif _orient(Y, i0, j0, q) != 0:
+                return -2.0
+    p = 0 if Y[j0, 0] != Y[i0, 0] else 1
+    vals = np.sort(Y[:, p])
+    lo, hi = vals[F], vals[m - 1 - F]
+    if lo > hi:
+        return -1.0
+    mp = Y[:, p].mean()
+    if mp + merr < lo or mp - merr > hi:
+        target = lo if mp < lo else hi
+        for q in range(m):
+            if Y[q, p] == target:
+                out[0], out[1] = Y[q, 0], Y[q, 1]
+                return 0.0
+    if lo < mp - merr and mp + merr < hi:
+        out[0], out[1] = Y[:, 0].mean(), Y[:, 1].mean()
+        return merr
+    return -1.0
+
+
+@njit(cache=True, nogil=True)
+def _pinned(Y, rep, nh, ends, sgn):
+    """Two different lines through a data point p, each valid on both sides (so both
+    halfplanes of each are in the list, consecutively), give Ψ ⊂ {p}; then Ψ = {p} iff
+    p satisfies every valid halfplane (exact orientations). Returns p, or −1 (no such
+    pair, or Ψ empty)."""
+    for h in range(nh - 1):
+        if ends[h, 0] != ends[h + 1, 0] or ends[h, 1] != ends[h + 1, 1]:
+            continue
+        for g in range(h + 2, nh - 1):
+            if ends[g, 0] != ends[g + 1, 0] or ends[g, 1] != ends[g + 1, 1]:
+                continue
+            for p in (ends[h, 0], ends[h, 1]):
+                if p != ends[g, 0] and p != ends[g, 1]:
+                    continue
+                a = ends[h, 0] + ends[h, 1] - p
+                b = ends[g, 0] + ends[g, 1] - p
+                if _orient(Y, p, a, b) == 0:
+                    continue
+                for k in range(nh):
+                    if ends[k, 0] != p and ends[k, 1] != p and \
+                            sgn[k] * _orient(Y, ends[k, 0], ends[k, 1], p) > 0:
+                        return -1
+                return p
+    return -1
 
 
 @njit(cache=True, nogil=True)
@@ -121,12 +219,49 @@ def _meet(g, a0, a1, c, aerr, cerr, A, C, Aerr, Cerr, box, out):
 
 
 @njit(cache=True, nogil=True)
-def _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL):
-    """Clip the convex polygon P[:nv] (errors E; PT[v] = data point v equals exactly, or
-    −1; EL[v] = line of the edge v → v+1, −1 for the box) by line h into Q/QE/QPT/QEL.
-    A vertex equal to an endpoint of h is exactly on it; an intersection of h with an
-    edge whose line shares an endpoint with h is exactly that data point. Returns the
-    new vertex count, or −1 when a sign is too close to call."""
+def _line_of(g, Y, ends, box, base, u):
+    """Line g as base point and direction with two-term components: a data line through
+    its two points, or box side −1−g (0 bottom, 1 right, 2 top, 3 left)."""
+    if g >= 0:
+        i, j = ends[g, 0], ends[g, 1]
+        base[0], base[1] = Y[i, 0], Y[i, 1]
+        difference(Y[j, 0], Y[i, 0], u[0])
+        difference(Y[j, 1], Y[i, 1], u[1])
+        return
+    side = -1 - g
+    base[0] = box[1] if side == 1 else box[0]
+    base[1] = box[3] if side == 2 else box[2]
+    u[:, :] = 0.0
+    u[side % 2, 1] = 1.0  # along x for the bottom and top, along y for the sides
+
+
+@njit(cache=True, nogil=True)
+def _exact_side(h, v, P, E, VA, VB, Y, ends, box):
+    """Exact sign of orient(h's points, vertex v) for a computed vertex: from its float
+    coordinates when they are exact (E = 0, the box corners), else from the two lines
+    it lies on. PARALLEL when those lines are parallel."""
+    i0, i1 = ends[h, 0], ends[h, 1]
+    if E[v] == 0.0:
+        return orient(Y[i0, 0], Y[i0, 1], Y[i1, 0], Y[i1, 1], P[v, 0], P[v, 1])
+    b1, b2, b5 = np.empty(2), np.empty(2), np.empty(2)
+    u1, u2, u5 = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2))
+    _line_of(VA[v], Y, ends, box, b1, u1)
+    _line_of(VB[v], Y, ends, box, b2, u2)
+    _line_of(h, Y, ends, box, b5, u5)
+    return side_of_meet(b1, u1, b2, u2, b5, u5)
+
+
+@njit(cache=True, nogil=True)
+def _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
+          Q, QE, QPT, QEL, QVA, QVB):
+    """Clip the convex polygon P[:nv] (errors E; PT[v] = the data point (representative)
+    v equals exactly, or −1; EL[v] = line of the edge v → v+1, −1−k for box side k;
+    VA[v], VB[v] = the two lines a computed vertex lies on) by line h into Q….
+    Every sign is exact: the float value when its error bound decides it, else an
+    orientation of data points or of a meeting point of two lines (expansions). An
+    intersection of h with an edge whose line shares an endpoint with h is exactly that
+    data point. Returns the new vertex count, or −1 when a meeting point cannot be
+    bounded (nearly parallel lines in floats)."""
     a0, a1, c = A[h, 0], A[h, 1], C[h]
     aerr, cerr = Aerr[h], Cerr[h]
     i0, i1 = ends[h, 0], ends[h, 1]
@@ -135,12 +270,19 @@ def _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL):
         if PT[v] == i0 or PT[v] == i1:
             s[v] = 0.0
             continue
+        if PT[v] >= 0:
+            s[v] = sgn[h] * _orient(Y, i0, i1, PT[v])
+            continue
         val = a0 * P[v, 0] + a1 * P[v, 1] - c
         bound = (abs(a0) + abs(a1)) * E[v] + aerr * (abs(P[v, 0]) + abs(P[v, 1])) + cerr \
             + 4.0 * EPS * (abs(a0 * P[v, 0]) + abs(a1 * P[v, 1]) + abs(c))
-        if abs(val) <= bound:
+        if abs(val) > bound:
+            s[v] = val
+            continue
+        o = _exact_side(h, v, P, E, VA, VB, Y, ends, box)
+        if o == PARALLEL:
             return -1
-        s[v] = val
+        s[v] = sgn[h] * o
     nq = 0
     for v in range(nv):
         w = (v + 1) % nv
@@ -151,6 +293,8 @@ def _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL):
             QPT[nq] = PT[v]
             # the edge leaving v: still on its line if w is kept or cut, else on h
             QEL[nq] = EL[v] if s[w] <= 0 or s[v] < 0 else h
+            QVA[nq] = VA[v]
+            QVB[nq] = VB[v]
             nq += 1
         if (s[v] < 0 and s[w] > 0) or (s[v] > 0 and s[w] < 0):
             g = EL[v]
@@ -177,6 +321,8 @@ def _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL):
                     return -1
                 QE[nq] = e
                 QPT[nq] = -1
+            QVA[nq] = g
+            QVB[nq] = h
             # entering (v out, w in): the new edge continues on g; leaving: it runs on h
             QEL[nq] = g if s[v] > 0 else h
             nq += 1
@@ -236,23 +382,6 @@ def _project(P, E, nv, m0, m1, merr, out):
 
 
 @njit(cache=True, nogil=True)
-def _orient(Y, i, j, k):
-    """Sign of the orientation of (p_i, p_j, p_k) when the float filter decides it, else 0
-    (then the caller falls back: 0 is not claimed to be exact)."""
-    a0 = Y[j, 0] - Y[i, 0]
-    a1 = Y[j, 1] - Y[i, 1]
-    b0 = Y[k, 0] - Y[i, 0]
-    b1 = Y[k, 1] - Y[i, 1]
-    det = a0 * b1 - a1 * b0
-    bound = 8.0 * EPS * (abs(a0 * b1) + abs(a1 * b0))
-    if det > bound:
-        return 1
-    if det < -bound:
-        return -1
-    return 0
-
-
-@njit(cache=True, nogil=True)
 def _radon4(Y, out):
     """Ψ(Y, 1) for 4 points in general position is one point: the crossing of the
     diagonals (convex position) or the point inside the triangle of the others.
@@ -299,9 +428,18 @@ def _inside(Y, k):
 
 
 @njit(cache=True, nogil=True)
+def _in_range(Y):
+    for v in Y.ravel():
+        a = abs(v)
+        if a != 0.0 and not TINY <= a <= HUGE:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
 def project_small_2d(Ys, F, out, err, status):
     """For each problem b: the point of Ψ(Ys[b], F) nearest to mean(Ys[b]) into out[b],
-    its error bound into err[b], status OK or FALLBACK (compute exactly)."""
+    its error bound into err[b], status OK or the reason to compute it exactly."""
     B, m, _ = Ys.shape
     H = m * (m - 1)
     A = np.empty((H, 2))
@@ -309,6 +447,8 @@ def project_small_2d(Ys, F, out, err, status):
     Aerr = np.empty(H)
     Cerr = np.empty(H)
     ends = np.empty((H, 2), dtype=np.int64)
+    sgn = np.empty(H, dtype=np.int64)
+    rep = np.empty(m, dtype=np.int64)
     cap = 4 + 2 * H + 4
     P = np.empty((cap, 2))
     E = np.empty(cap)
@@ -318,22 +458,43 @@ def project_small_2d(Ys, F, out, err, status):
     QE = np.empty(cap)
     QPT = np.empty(cap, dtype=np.int64)
     QEL = np.empty(cap, dtype=np.int64)
+    VA = np.empty(cap, dtype=np.int64)
+    VB = np.empty(cap, dtype=np.int64)
+    QVA = np.empty(cap, dtype=np.int64)
+    QVB = np.empty(cap, dtype=np.int64)
     for b in range(B):
         Y = Ys[b]
-        if m == 4 and F == 1:  # Ψ is a single (Radon) point
+        if not _in_range(Y):
+            status[b] = OUT_OF_RANGE
+            continue
+        if m == 4 and F == 1:  # in general position Ψ is one (Radon) point
             e = _radon4(Y, out[b])
-            status[b] = OK if e >= 0 else FLAT
-            err[b] = max(e, 0.0)
-            continue
-        status[b] = LINES_UNDECIDED
-        nh = _lines(Y, F, A, C, Aerr, Cerr, ends)
-        if nh <= 0:
-            continue
+            if e >= 0:
+                err[b] = e
+                status[b] = OK
+                continue
         status[b] = FLAT
+        merr = 2.0 * m * EPS * np.abs(Y).max()  # the float mean vs the exact one
+        if _representatives(Y, rep) == 1:  # every point the same: Ψ is that point
+            out[b, 0], out[b, 1] = Y[0, 0], Y[0, 1]
+            err[b] = 0.0
+            status[b] = OK
+            continue
+        e = _collinear(Y, F, rep, merr, out[b])
+        if e != -2.0:
+            if e >= 0:
+                err[b] = e
+                status[b] = OK
+            continue
+        nh = _lines(Y, F, rep, A, C, Aerr, Cerr, ends, sgn)
+        p = _pinned(Y, rep, nh, ends, sgn)
+        if p >= 0:
+            out[b, 0], out[b, 1] = Y[p, 0], Y[p, 1]
+            err[b] = 0.0
+            status[b] = OK
+            continue
         lo0, hi0 = Y[:, 0].min(), Y[:, 0].max()
         lo1, hi1 = Y[:, 1].min(), Y[:, 1].max()
-        if lo0 == hi0 or lo1 == hi1:
-            continue  # collinear along an axis: exact path
         P[0, 0], P[0, 1] = lo0, lo1
         P[1, 0], P[1, 1] = hi0, lo1
         P[2, 0], P[2, 1] = hi0, hi1
@@ -343,30 +504,48 @@ def project_small_2d(Ys, F, out, err, status):
         for k in range(4):  # a corner may be a data point (extreme in x and in y)
             for q in range(m):
                 if Y[q, 0] == P[k, 0] and Y[q, 1] == P[k, 1]:
-                    PT[k] = q
+                    PT[k] = rep[q]
         for k in range(4):
             EL[k] = -1 - k  # box side k: edge k → k+1 (bottom, right, top, left)
+            VA[k] = -1 - k
+            VB[k] = -1 - (k + 3) % 4  # corner k is on sides k and k − 1
         box = np.array([lo0, hi0, lo1, hi1])
         nv = 4
         for h in range(nh):
-            nq = _clip(P, E, PT, EL, nv, h, A, C, Aerr, Cerr, ends, Y, box, Q, QE, QPT, QEL)
+            nq = _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
+                       Q, QE, QPT, QEL, QVA, QVB)
             if nq < 0:
                 status[b] = CLIP_UNDECIDED
-            if nq < 3:
-                nv = -1  # undecided, or degenerate / empty: exact path
+                nv = -1
                 break
-            for v in range(nq):
-                P[v, 0] = Q[v, 0]
-                P[v, 1] = Q[v, 1]
-                E[v] = QE[v]
-                PT[v] = QPT[v]
-                EL[v] = QEL[v]
-            nv = nq
+            nv = 0
+            for v in range(nq):  # copy, merging runs of the same data point
+                w = (v + 1) % nq
+                if QPT[v] >= 0 and QPT[v] == QPT[w] and v != w:
+                    continue
+                P[nv, 0] = Q[v, 0]
+                P[nv, 1] = Q[v, 1]
+                E[nv] = QE[v]
+                PT[nv] = QPT[v]
+                EL[nv] = QEL[v]
+                VA[nv] = QVA[v]
+                VB[nv] = QVB[v]
+                nv += 1
+            if nv == 0 and nq > 0:  # all one data point
+                P[0, 0], P[0, 1], E[0], PT[0], EL[0] = Q[0, 0], Q[0, 1], 0.0, QPT[0], QEL[0]
+                nv = 1
+            if nv == 2 or nv == 0:
+                nv = -1  # a segment or empty: exact path
+                break
+        if nv == 1:  # Ψ is a single data point (only data points are merged)
+            out[b, 0], out[b, 1] = P[0, 0], P[0, 1]
+            err[b] = 0.0
+            status[b] = OK
+            continue
         if nv < 3:
             continue
         m0 = Y[:, 0].mean()
         m1 = Y[:, 1].mean()
-        merr = 2.0 * m * EPS * np.abs(Y).max()  # the float mean vs the exact one
         e = _project(P, E, nv, m0, m1, merr, out[b])
         if e < 0:
             status[b] = NEAREST_UNDECIDED

@@ -1,0 +1,82 @@
+"""Exact planar predicates by floating-point expansions, against Fractions."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rescon.geometry._expansions import PARALLEL, orient, side_of_meet
+
+
+def sign(x):
+    return (x > 0) - (x < 0)
+
+
+def exact_orient(a, b, c):
+    a, b, c = ([Fraction(v) for v in p] for p in (a, b, c))
+    return sign((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+
+def exact_side_of_meet(b1, u1, b2, u2, b5, u5):
+    """Meeting point by Cramer's rule in Fractions, then its side of line 5."""
+    b1, u1, b2, u2, b5, u5 = ([Fraction(v) for v in p] for p in (b1, u1, b2, u2, b5, u5))
+    D = u1[0] * u2[1] - u1[1] * u2[0]
+    if D == 0:
+        return PARALLEL
+    t = ((b2[0] - b1[0]) * u2[1] - (b2[1] - b1[1]) * u2[0]) / D
+    v = [b1[k] + t * u1[k] for k in range(2)]
+    return sign(u5[0] * (v[1] - b5[1]) - u5[1] * (v[0] - b5[0]))
+
+
+def as_expansion(p, q):
+    """Direction q − p with two-term components, as the planar path builds it."""
+    from rescon.geometry._expansions import difference
+
+    u = np.empty((2, 2))
+    difference(q[0], p[0], u[0])
+    difference(q[1], p[1], u[1])
+    return u
+
+
+coords = st.one_of(st.integers(-4, 4).map(float),
+                   st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False),
+                   st.integers(-4, 4).map(lambda k: 1.0 + k * 2.0**-52))
+point = st.tuples(coords, coords)
+
+
+@settings(max_examples=400, deadline=None)
+@given(point, point, point)
+def test_orient_is_exact(a, b, c):
+    assert orient(*a, *b, *c) == exact_orient(a, b, c)
+
+
+@settings(max_examples=300, deadline=None)
+@given(point, point, point, point, point, point)
+def test_side_of_meet_is_exact(p1, q1, p2, q2, p5, q5):
+    args = (np.array(p1), as_expansion(p1, q1), np.array(p2), as_expansion(p2, q2),
+            np.array(p5), as_expansion(p5, q5))
+    def direction(p, q):
+        return [Fraction(q[k]) - Fraction(p[k]) for k in range(2)]
+
+    want = exact_side_of_meet(p1, direction(p1, q1), p2, direction(p2, q2),
+                              p5, direction(p5, q5))
+    assert side_of_meet(*args) == want
+
+
+@pytest.mark.parametrize("eps", [0.0, 2.0**-50, -(2.0**-50)])
+def test_meeting_point_on_a_third_line(eps):
+    """Lines y = x and y = 1 − x meet at (½, ½); the line x = ½ (+eps) passes through
+    it (or just misses it): the sign is 0 (or the exact side)."""
+    args = (np.array([0.0, 0.0]), as_expansion((0.0, 0.0), (1.0, 1.0)),
+            np.array([0.0, 1.0]), as_expansion((0.0, 1.0), (1.0, 0.0)),
+            np.array([0.5 + eps, 0.0]), as_expansion((0.5 + eps, 0.0), (0.5 + eps, 1.0)))
+    assert side_of_meet(*args) == sign(eps)  # (0, 1) × (v − b5) = −(½ − (½ + eps))
+
+
+def test_parallel_lines_have_no_meeting_point():
+    u = as_expansion((0.0, 0.0), (1.0, 2.0))
+    assert side_of_meet(np.zeros(2), u, np.array([1.0, 0.0]), u, np.zeros(2), u) == PARALLEL
