@@ -370,3 +370,21 @@ def test_casadi_keeps_stdout_clean(backend, capfd):
 def test_docstring_examples():
     result = doctest.testmod(km, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_project_batch_reports_failures_as_nan_on_request():
+    """An infeasible problem: a SolverError naming it, or a NaN row with on_failure="nan"."""
+    from rescon.errors import SolverError
+    from rescon.models.kernel_models import project_batch
+
+    good = (np.array([[1.0, 0], [-1, 0], [0, 1], [0, -1]]), np.ones(4), np.zeros(2), np.eye(2),
+            np.array([3.0, 0.0]))
+    bad = (np.array([[1.0, 0], [-1, 0]]), np.array([-1.0, -1.0]), np.zeros(2), np.eye(2),
+           np.zeros(2))
+    for backend in ("clarabel", "proxsuite"):
+        with pytest.raises(SolverError, match=r"problems\[1\]"):
+            project_batch([good, bad], backend=backend)
+        out = project_batch([good, bad], backend=backend, on_failure="nan")
+        assert np.allclose(out[0], [1.0, 0.0], atol=1e-7) and np.isnan(out[1]).all()
+    with pytest.raises(ValueError, match="on_failure"):
+        project_batch([good], on_failure="skip")

@@ -192,8 +192,9 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     return aux, starved
 
 
-#: largest point sets the planar batch path takes (it holds m(m−1) lines per set)
-SMALL_BATCH_MAX = 64
+#: largest point sets the batch paths take, by dimension (they hold m(m−1) lines,
+#: m(m−1)(m−2)/3 planes per set)
+SMALL_BATCH_MAX = {2: 64, 3: 24}
 
 
 def _kernel_points(problems: list[np.ndarray], F: int, method: str,
@@ -202,25 +203,32 @@ def _kernel_points(problems: list[np.ndarray], F: int, method: str,
 
     "project" in the plane goes through the numba batch path
     (:mod:`rescon.geometry._small2d`: exact decisions, float geometry, certified error
-    bound); the sets it declines (some flat kernels) and every other case are computed
-    exactly, once per distinct set in a run (``cache``: held values and converged
-    states repeat the same sets). "project-exact" computes everything exactly."""
+    bound), in space through :mod:`rescon.geometry._small3d` (exact halfspaces, one
+    batched QP, a KKT polish checked to 1e-11 of the set's scale); the sets they
+    decline and every other case are computed exactly, once per distinct set in a run
+    (``cache``: held values and converged states repeat the same sets).
+    "project-exact" computes everything exactly."""
     from ..geometry._small2d import OK, project_small_2d
+    from ..geometry._small3d import project_small_3d
 
     out: list[np.ndarray | None] = [None] * len(problems)
     if method == "project":
-        sizes: dict[int, list[int]] = {}
+        groups: dict[tuple[int, int], list[int]] = {}
         for k, X in enumerate(problems):
-            if X.shape[1] == 2 and len(X) <= SMALL_BATCH_MAX:
-                sizes.setdefault(len(X), []).append(k)
-        for idx in sizes.values():
+            if len(X) <= SMALL_BATCH_MAX.get(X.shape[1], 0):
+                groups.setdefault(X.shape, []).append(k)
+        for (_, d), idx in groups.items():
             Ys = np.ascontiguousarray(np.stack([problems[k] for k in idx]), dtype=np.float64)
-            pts = np.empty((len(idx), 2))
-            err = np.empty(len(idx))
-            status = np.empty(len(idx), dtype=np.int64)
-            project_small_2d(Ys, F, pts, err, status)
-            for k, p, st in zip(idx, pts, status, strict=True):
-                if st == OK:
+            if d == 2:
+                pts = np.empty((len(idx), 2))
+                err = np.empty(len(idx))
+                status = np.empty(len(idx), dtype=np.int64)
+                project_small_2d(Ys, F, pts, err, status)
+                found = status == OK
+            else:
+                pts, found = project_small_3d(Ys, F)
+            for k, p, ok in zip(idx, pts, found, strict=True):
+                if ok:
                     out[k] = p
     exact = "project" if method == "project-exact" else method
     for k, X in enumerate(problems):

@@ -249,7 +249,8 @@ def chebyshev(A, b, origin, basis, *, backend="highs", solver=None) -> tuple[np.
     return hull.lift(t), float(rho)
 
 
-def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None) -> np.ndarray:
+def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None,
+                  on_failure: str = "raise") -> np.ndarray:
     """:func:`project` for many polytopes at once.
 
     Parameters
@@ -260,6 +261,9 @@ def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None
         As for :func:`project`. A backend with the ``"batch"`` capability (proxsuite)
         solves all QPs in one parallel call (``proxqp.dense.solve_in_parallel`` over a
         ``BatchQP`` of QPs of their own sizes); any other backend solves them in a loop.
+    on_failure : {"raise", "nan"}
+        What a problem the solver does not solve gives: a SolverError naming its index
+        (default), or a row of NaN (the caller then decides that problem otherwise).
 
     Returns
     -------
@@ -273,6 +277,8 @@ def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None
     SolverNotFound, SolverError
         As for :func:`project`; a failure names the problem's index.
     """
+    if on_failure not in ("raise", "nan"):
+        raise InputError(f"on_failure must be 'raise' or 'nan', got {on_failure!r}")
     name, solver = _resolve(backend, solver, "QP")
     hulls, targets = _validate_batch(problems)
     out = np.zeros((len(hulls), hulls[0].origin.size if hulls else 0))
@@ -281,11 +287,12 @@ def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None
     todo = [i for i, h in enumerate(hulls) if h.k > 0]
     cs = [_target_t(hulls[i], targets[i]) for i in todo]
     if name in _BATCH_QP:
-        ts = _BATCH_QP[name]([hulls[i] for i in todo], cs, todo)
+        ts = _BATCH_QP[name]([hulls[i] for i in todo], cs, todo, on_failure)
     else:
-        ts = [_indexed(i, _SOLVE_QP[name], hulls[i], c, solver) for i, c in zip(todo, cs)]
+        ts = [_indexed(i, on_failure, _SOLVE_QP[name], hulls[i], c, solver)
+              for i, c in zip(todo, cs)]
     for i, t in zip(todo, ts):
-        out[i] = hulls[i].lift(t)
+        out[i] = np.nan if t is None else hulls[i].lift(t)
     return out
 
 
@@ -451,13 +458,16 @@ def _variants(capability: str) -> list[str]:
     return out
 
 
-def _indexed(i: int, fn, *args):
-    """``fn(*args)``, with a SolverError naming the batch index ``i``."""
+def _indexed(i: int, on_failure: str, fn, *args):
+    """``fn(*args)``; a SolverError is raised naming the batch index ``i``, or gives
+    None with ``on_failure="nan"``."""
     try:
         return fn(*args)
     except SolverNotFound:
         raise
     except SolverError as exc:
+        if on_failure == "nan":
+            return None
         raise SolverError(f"problems[{i}]: {exc}") from exc
 
 
@@ -487,20 +497,44 @@ def _lp_form(hull: _Hull) -> _Standard:
     return _Standard(np.zeros((k + 1, k + 1)), q, G, np.append(hull.h, 0.0))
 
 
-def _clarabel(s: _Standard) -> np.ndarray:
-    """Clarabel's native API: P upper triangle and G as CSC, G z + slack = h, slack ≥ 0."""
-    import clarabel
+def _dense_csc(M: np.ndarray):
+    """A small dense matrix as CSC with its nonzeros, built directly (the generic
+    conversions cost more than clarabel's solve on kernel-sized problems)."""
     import scipy.sparse as sps
+
+    rows, cols = np.nonzero(M.T)  # column-major order: (column, row) pairs
+    indptr = np.searchsorted(rows, np.arange(M.shape[1] + 1))
+    return sps.csc_matrix((M.T[rows, cols], cols, indptr), shape=M.shape)
+
+
+def _clarabel_settings():
+    import clarabel
 
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = IPM_TOL
+    return settings
+
+
+def _clarabel(s: _Standard, settings=None) -> np.ndarray:
+    """Clarabel's native API: P upper triangle and G as CSC, G z + slack = h, slack ≥ 0."""
+    import clarabel
+
     cones = [clarabel.NonnegativeConeT(s.h.size)] if s.h.size else []
-    P = sps.triu(sps.csc_matrix(s.P), format="csc")
-    sol = clarabel.DefaultSolver(P, s.q, sps.csc_matrix(s.G), s.h, cones, settings).solve()
+    sol = clarabel.DefaultSolver(_dense_csc(np.triu(s.P)), s.q, _dense_csc(s.G), s.h, cones,
+                                 settings or _clarabel_settings()).solve()
     if str(sol.status) != "Solved":
         raise _fail("clarabel", sol.status)
     return np.array(sol.x)
+
+
+def _clarabel_batch(hulls: list[_Hull], cs: list[np.ndarray], index: list[int],
+                    on_failure: str) -> list:
+    """The QPs one after another, sharing one settings object (clarabel has no
+    parallel batch; this only saves the per-problem set-up)."""
+    settings = _clarabel_settings()
+    return [_indexed(i, on_failure, _clarabel, _qp_form(hull, c), settings)
+            for hull, c, i in zip(hulls, cs, index, strict=True)]
 
 
 def _proxsuite_setup(qp, s: _Standard) -> None:
@@ -535,7 +569,8 @@ def _proxsuite(s: _Standard) -> np.ndarray:
     return _proxsuite_result(qp)
 
 
-def _proxsuite_batch(hulls: list[_Hull], cs: list[np.ndarray], index: list[int]) -> list:
+def _proxsuite_batch(hulls: list[_Hull], cs: list[np.ndarray], index: list[int],
+                     on_failure: str) -> list:
     """All QPs in one ``BatchQP`` (each with its own n, n_in), solved in parallel."""
     import proxsuite
 
@@ -544,7 +579,8 @@ def _proxsuite_batch(hulls: list[_Hull], cs: list[np.ndarray], index: list[int])
     for hull, c in zip(hulls, cs):
         _proxsuite_setup(batch.init_qp_in_place(hull.k, 0, hull.h.size), _qp_form(hull, c))
     dense.solve_in_parallel(batch)
-    return [_indexed(i, _proxsuite_result, batch.get(j)) for j, i in enumerate(index)]
+    return [_indexed(i, on_failure, _proxsuite_result, batch.get(j))
+            for j, i in enumerate(index)]
 
 
 def _highs(s: _Standard) -> np.ndarray:
@@ -689,4 +725,4 @@ _SOLVE_LP = {
     "cvxpy": _cvxpy_lp,
     "casadi": _casadi_lp,
 }
-_BATCH_QP = {"proxsuite": _proxsuite_batch}
+_BATCH_QP = {"proxsuite": _proxsuite_batch, "clarabel": _clarabel_batch}
