@@ -330,7 +330,8 @@ def test_fast_path_falls_back_on_flat_kernels():
     assert fast is None and slow.dim() == 0
 
 
-@pytest.mark.parametrize("cloud", ["gaussian", "near_collinear", "duplicates"])
+@pytest.mark.parametrize("cloud", ["gaussian", "near_collinear", "duplicates", "small_grid",
+                                   "line_and_grid", "halves"])
 def test_angular_sweep_equals_direct_scan(cloud, monkeypatch):
     """n ≥ SWEEP_MIN_POINTS in the plane uses the angular sweep; it must give the same
     exact kernel as the direct O(n³) scan, also with (near-)collinear points and ties."""
@@ -344,8 +345,22 @@ def test_angular_sweep_equals_direct_scan(cloud, monkeypatch):
         t = rng.uniform(-1, 1, size=n) * 0.1
         X = np.column_stack([t, 0.3 * t + 0.7])  # floats: collinear only up to rounding
         X[: n // 3] = rng.normal(size=(n // 3, 2)) * 0.1
+    elif cloud == "small_grid":  # integers: collinear triples decided by the separation
+        X = rng.integers(0, 30, size=(n, 2)).astype(float)
+    elif cloud == "line_and_grid":
+        X = rng.integers(-40, 40, size=(n, 2)).astype(float)
+        X[: n // 2, 1] = 3 * X[: n // 2, 0] + 1
+    elif cloud == "halves":  # dyadic rationals: exact floats, scaled integers
+        X = rng.integers(0, 60, size=(n, 2)) / 4.0
     else:
         X = np.repeat(rng.normal(size=(n // 3, 2)) / 3, 3, axis=0)
+    for F in (0, 2, n // 8, n // 3):
+        swept = rescon.safe_kernel(X, F)
+        monkeypatch.setattr(halfspaces, "SWEEP_MIN_POINTS", 10**9)
+        direct = rescon.safe_kernel(X, F)
+        monkeypatch.undo()
+        assert set(swept.exact_vertices) == set(direct.exact_vertices)
+        assert swept.dim == direct.dim and swept.is_empty == direct.is_empty
     F = n // 8
     swept = rescon.safe_kernel(X, F)
     monkeypatch.setattr(halfspaces, "SWEEP_MIN_POINTS", 10**9)
@@ -417,3 +432,26 @@ def test_project_survives_a_failing_guide(monkeypatch):
     assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
     with pytest.raises(SolverError, match="AlmostSolved"):
         K.point("project", backend="clarabel")
+
+
+@pytest.mark.parametrize("F", [0, 2, 40])
+def test_sweep_on_small_integers_finds_the_scans_halfspaces(F, monkeypatch):
+    """On small integers the sweep counts points inside its angle window as on the
+    line (distinct directions are further apart than the window): the valid halfspaces
+    — lines, sides and numbers of points outside — are exactly the direct scan's."""
+    from rescon.geometry import halfspaces
+
+    rng = np.random.default_rng(F)
+    Y = np.unique(rng.integers(-20, 21, size=(400, 2)), axis=0)[:200].astype(float)
+    Y[:40, 1] = 2 * Y[:40, 0] + 1  # many collinear points
+    Y = np.unique(Y, axis=0)
+    assert len(Y) >= halfspaces.SWEEP_MIN_POINTS
+    Yi = [tuple(int(v) for v in row) for row in Y]
+    W = np.ones(len(Y), dtype=np.int64)
+
+    def rows(H):
+        return {(tuple(H.through[h]), int(H.sign[h]), int(H.outside[h])) for h in range(len(H))}
+
+    swept = rows(halfspaces.valid_halfspaces(Y, Yi, W, F))
+    monkeypatch.setattr(halfspaces, "SWEEP_MIN_POINTS", 10**9)
+    assert swept == rows(halfspaces.valid_halfspaces(Y, Yi, W, F))

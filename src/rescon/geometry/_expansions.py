@@ -10,6 +10,10 @@ are the fallbacks the float filters of :mod:`._small2d` call when they cannot de
 
 Lines are given by a base point b (two doubles) and a direction u whose components
 are two-term expansions (the exact difference of two data points, or a unit vector).
+
+Exact as long as no product underflows or overflows: for nonzero |coordinates| in
+[2^-120, 2^120] (the planar path checks this and declines other sets); subnormal
+inputs can make a sign wrong.
 """
 
 from __future__ import annotations

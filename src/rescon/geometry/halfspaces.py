@@ -143,7 +143,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
-    from ._candidates import classify, k_subsets, sweep_pairs_2d
+    from ._candidates import ANGLE_ERR, classify, k_subsets, sweep_pairs_2d
 
     m, k = Y.shape
     count = comb(m, k)
@@ -157,9 +157,17 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     exact_floats = k == 1 or bits <= _exact_float_bits(k)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
     subsets = k_subsets(m, k, count)
-    if k == 2 and not exact_floats and m >= SWEEP_MIN_POINTS:
+    # small integers in the plane: two distinct directions between data points differ
+    # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
+    # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
+    # window is exactly on the line
+    span = max(max(col) - min(col) for col in zip(*Yi)) if k == 2 else 0
+    separated = exact_floats and k == 2 and 16 * ANGLE_ERR * 2 * span * span < 1
+    if k == 2 and (separated or not exact_floats) and m >= SWEEP_MIN_POINTS:
         plus, minus, unc, degenerate, cof, cof_abs = sweep_pairs_2d(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
+        if separated:
+            unc[:] = 0  # on the line: on neither side
     else:
         plus, minus, unc, degenerate, cof, cof_abs = classify(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms,
