@@ -83,3 +83,35 @@ def test_meeting_point_on_a_third_line(eps):
 def test_parallel_lines_have_no_meeting_point():
     u = as_expansion((0.0, 0.0), (1.0, 2.0))
     assert side_of_meet(np.zeros(2), u, np.array([1.0, 0.0]), u, np.zeros(2), u) == PARALLEL
+
+
+def test_normals_and_side_counts_in_space_are_exact():
+    """Rounded exact normals (≤ 2 ulps per component, however close to collinear) and
+    exact side counts, on a cluster 1e-7 wide with far points, against Fractions."""
+    import itertools
+
+    from rescon.geometry._expansions import normals3, side_counts
+
+    rng = np.random.default_rng(0)
+    c = rng.uniform(-1, 1, 3)
+    Y = np.vstack([c + rng.uniform(-1e-7, 1e-7, (9, 3)), c + rng.normal(size=(3, 3)) * 5])
+    Y[3] = Y[1] + (Y[2] - Y[1]) * 0.5  # nearly collinear with 1 and 2 (rounded midpoint)
+    Y[4] = Y[1]  # a copy: triples through both are dependent
+    subsets = np.array(list(itertools.combinations(range(len(Y)), 3)), dtype=np.int32)
+    N = np.empty((len(subsets), 3))
+    normals3(Y, subsets, N)
+    plus, minus = np.zeros(len(subsets), np.int64), np.zeros(len(subsets), np.int64)
+    dependent = np.zeros(len(subsets), bool)
+    side_counts(Y, np.ones(len(Y), np.int64), subsets, plus, minus, dependent)
+    for t, (i, j, k) in enumerate(subsets):
+        P = [[Fraction(v) for v in Y[r]] for r in (i, j, k)]
+        u = [P[1][a] - P[0][a] for a in range(3)]
+        w = [P[2][a] - P[0][a] for a in range(3)]
+        C = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
+        for a in range(3):
+            assert abs(Fraction(N[t, a]) - C[a]) <= abs(C[a]) * Fraction(2, 2**53)
+        assert dependent[t] == (C == [0, 0, 0])
+        if not dependent[t]:
+            s = [sum(C[a] * (Fraction(Y[q, a]) - P[0][a]) for a in range(3))
+                 for q in range(len(Y)) if q not in (i, j, k)]
+            assert (plus[t], minus[t]) == (sum(v > 0 for v in s), sum(v < 0 for v in s))

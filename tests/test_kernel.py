@@ -455,3 +455,17 @@ def test_sweep_on_small_integers_finds_the_scans_halfspaces(F, monkeypatch):
     swept = rows(halfspaces.valid_halfspaces(Y, Yi, W, F))
     monkeypatch.setattr(halfspaces, "SWEEP_MIN_POINTS", 10**9)
     assert swept == rows(halfspaces.valid_halfspaces(Y, Yi, W, F))
+
+
+@pytest.mark.parametrize("seed,n,F", [(1, 40, 4), (2, 60, 12)])
+def test_fast_path_certifies_converged_clouds(seed, n, F):
+    """States that have nearly converged (a cluster 1e-7 wide, F points far away): the
+    rounded exact normals and the re-centred, rescaled proposal let the fast path
+    certify the tiny kernel, and it equals the exact clipping."""
+    rng = np.random.default_rng(seed)
+    c = rng.uniform(-1, 1, 3)
+    X = np.vstack([c + rng.uniform(-1e-7, 1e-7, (n - F, 3)),
+                   c + rng.uniform(1, 10, (F, 1)) * rng.normal(size=(F, 3))])
+    fast, slow, *_ = _both_paths(X, F)
+    assert fast is not None, "the fast path should certify a converged cloud"
+    assert set(fast.fraction_vertices()) == set(slow.fraction_vertices())

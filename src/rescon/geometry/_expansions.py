@@ -25,6 +25,20 @@ from numba import njit
 _SPLITTER = 134217729.0
 #: what :func:`side_of_meet` returns for parallel lines
 PARALLEL = 2
+EPS = 2.0**-53
+#: nonzero |coordinates| must lie in [TINY, HUGE] for the predicates here to be exact:
+#: then products of up to four differences neither underflow nor overflow
+TINY, HUGE = 2.0**-120, 2.0**120
+
+
+@njit(cache=True, nogil=True)
+def in_range(Y):
+    """Every nonzero |coordinate| in [TINY, HUGE]."""
+    for v in Y.ravel():
+        a = abs(v)
+        if a != 0.0 and not TINY <= a <= HUGE:
+            return False
+    return True
 
 
 @njit(cache=True, nogil=True)
@@ -150,3 +164,100 @@ def side_of_meet(b1, u1, b2, u2, b5, u5):
     n1 = product(D, nD, A, nA, S)
     n2 = product(N, nN, B, nB, S[n1:])
     return sign(S, compress(S, n1 + n2)) * sign(D, nD)
+
+
+@njit(cache=True, nogil=True)
+def _normal3(Y, i, j, k, C, nC):
+    """The cofactors of (p_j − p_i, p_k − p_i) — the normal (p_j − p_i) × (p_k − p_i)
+    — exactly, as three expansions C[c, :nC[c]] (16 slots each)."""
+    u = np.empty((3, 2))
+    w = np.empty((3, 2))
+    for c in range(3):
+        difference(Y[j, c], Y[i, c], u[c])
+        difference(Y[k, c], Y[i, c], w[c])
+    pair_u = np.empty((2, 2))
+    pair_w = np.empty((2, 2))
+    for c in range(3):  # component c from the other two coordinates, cyclically
+        a, b = (c + 1) % 3, (c + 2) % 3
+        pair_u[0], pair_u[1] = u[a], u[b]
+        pair_w[0], pair_w[1] = w[a], w[b]
+        nC[c] = cross(pair_u, pair_w, C[c])
+
+
+@njit(cache=True, nogil=True)
+def approximate(e, n):
+    """The value of an expansion, rounded (summed from its smallest component)."""
+    s = 0.0
+    for t in range(n):
+        s += e[t]
+    return s
+
+
+@njit(cache=True, nogil=True)
+def normals3(Y, subsets, out):
+    """For each triple of ``subsets``: its normal (p_j − p_i) × (p_k − p_i), each
+    component its exact value rounded (relative error a few ulps, however close to
+    collinear the triple is), into out."""
+    C = np.empty((3, 16))
+    nC = np.empty(3, dtype=np.int64)
+    for t in range(subsets.shape[0]):
+        _normal3(Y, subsets[t, 0], subsets[t, 1], subsets[t, 2], C, nC)
+        for c in range(3):
+            out[t, c] = approximate(C[c], nC[c])
+
+
+@njit(cache=True, nogil=True)
+def side_counts(Y, W, subsets, plus, minus, degenerate):
+    """Exact weighted numbers of points strictly on the + and − side of the plane (k = 3)
+    or line (k = 2) through each subset (+: the side of the cofactor normal), and
+    whether the subset is affinely dependent."""
+    k = Y.shape[1]
+    C = np.empty((3, 16))
+    nC = np.zeros(3, dtype=np.int64)
+    d = np.empty(2)
+    a = np.empty(3)
+    S = np.empty(3 * 2 * 2 * 16)
+    for t in range(subsets.shape[0]):
+        i = subsets[t, 0]
+        plus[t] = 0
+        minus[t] = 0
+        if k == 3:
+            _normal3(Y, i, subsets[t, 1], subsets[t, 2], C, nC)
+            degenerate[t] = nC[0] == 0 and nC[1] == 0 and nC[2] == 0
+            for c in range(3):
+                a[c] = approximate(C[c], nC[c])
+        else:
+            degenerate[t] = Y[subsets[t, 1], 0] == Y[i, 0] and Y[subsets[t, 1], 1] == Y[i, 1]
+        if degenerate[t]:
+            continue
+        for q in range(Y.shape[0]):
+            member = False
+            for r in range(k):
+                if subsets[t, r] == q:
+                    member = True
+            if member:
+                continue
+            if k == 2:
+                o = orient(Y[i, 0], Y[i, 1], Y[subsets[t, 1], 0], Y[subsets[t, 1], 1],
+                           Y[q, 0], Y[q, 1])
+            else:  # filter with the rounded exact normal (error ≤ ε|a_j|), else exactly
+                val = 0.0
+                bound = 0.0
+                for c in range(3):
+                    dc = Y[q, c] - Y[i, c]
+                    val += a[c] * dc
+                    bound += abs(a[c] * dc)
+                if val > 8.0 * EPS * bound:
+                    o = 1
+                elif val < -8.0 * EPS * bound:
+                    o = -1
+                else:
+                    n = 0
+                    for c in range(3):
+                        difference(Y[q, c], Y[i, c], d)
+                        n += product(C[c], nC[c], d, 2, S[n:])
+                    o = sign(S, compress(S, n))
+            if o > 0:
+                plus[t] += W[q]
+            elif o < 0:
+                minus[t] += W[q]

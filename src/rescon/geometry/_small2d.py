@@ -19,17 +19,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._expansions import PARALLEL, difference, orient, side_of_meet
+from ._expansions import PARALLEL, difference, in_range, orient, side_of_meet
 
 EPS = 2.0**-53
 OK = 0
 #: why a problem fell back to the exact path (status ≥ 1): a meeting point of nearly
 #: parallel lines, a flat kernel the path does not handle, the nearest feature
-#: undecided, coordinates outside the range where expansions cannot underflow/overflow
+#: undecided, coordinates outside the range where expansions are exact (in_range)
 CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED, OUT_OF_RANGE = 2, 3, 4, 5
-#: nonzero |coordinates| must lie in [2^-120, 2^120]: then degree-4 products of
-#: differences (the deepest predicate) neither underflow nor overflow
-TINY, HUGE = 2.0**-120, 2.0**120
+
 
 
 @njit(cache=True, nogil=True)
@@ -428,15 +426,6 @@ def _inside(Y, k):
 
 
 @njit(cache=True, nogil=True)
-def _in_range(Y):
-    for v in Y.ravel():
-        a = abs(v)
-        if a != 0.0 and not TINY <= a <= HUGE:
-            return False
-    return True
-
-
-@njit(cache=True, nogil=True)
 def project_small_2d(Ys, F, out, err, status):
     """For each problem b: the point of Ψ(Ys[b], F) nearest to mean(Ys[b]) into out[b],
     its error bound into err[b], status OK or the reason to compute it exactly."""
@@ -464,7 +453,7 @@ def project_small_2d(Ys, F, out, err, status):
     QVB = np.empty(cap, dtype=np.int64)
     for b in range(B):
         Y = Ys[b]
-        if not _in_range(Y):
+        if not in_range(Y):
             status[b] = OUT_OF_RANGE
             continue
         if m == 4 and F == 1:  # in general position Ψ is one (Radon) point

@@ -31,39 +31,67 @@ __all__ = ["certified_kernel"]
 
 _EPS = 2.0**-53
 MAX_ROUNDS = 4
+#: a Chebyshev radius below this fraction of the coordinates triggers the local pass
+LOCAL_RADIUS = 1e-4
+#: in the local pass, halfspaces farther than FAR kernel sizes from the centre are left out
+FAR = 1e4
 
 
-def _interior_point(A: np.ndarray, b: np.ndarray) -> np.ndarray | None:
-    """Centre of the largest ball in {x : A x ≤ b} (HiGHS LP), None if the ball is
-    tiny compared with the data (a flat or empty kernel)."""
+def _chebyshev(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """Centre and radius of the largest ball in {x : A x ≤ b} (unit rows; HiGHS LP),
+    None if the LP fails."""
     from scipy.optimize import linprog
 
     k = A.shape[1]
-    norms = np.linalg.norm(A, axis=1)
     c = np.zeros(k + 1)
     c[-1] = -1.0
-    res = linprog(c, A_ub=np.hstack([A, norms[:, None]]), b_ub=b,
+    res = linprog(c, A_ub=np.hstack([A, np.ones((len(A), 1))]), b_ub=b,
                   bounds=[(None, None)] * k + [(0, None)], method="highs")
     if res.status != 0:
         return None
-    x, r = res.x[:k], res.x[-1]
-    if r <= 1e-9 * (1.0 + np.abs(x).max()):
-        return None
-    return x
+    return res.x[:k], float(res.x[-1])
 
 
 def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
+    """Vertices and their defining halfspaces (indices into sel) of {A x ≤ b}, from
+    qhull around a Chebyshev centre. A kernel small against its coordinates (states
+    that have nearly converged) is re-centred and rescaled first: x = o + s y with o
+    the first centre, s the median distance from o to the halfspaces, so the LP and
+    qhull see it at unit size. None for a flat or empty kernel or a qhull failure."""
     from scipy.spatial import HalfspaceIntersection, QhullError
 
-    A, b = H.af[sel], H.bf[sel]
-    x0 = _interior_point(A, b)
-    if x0 is None:
+    norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
+    A, b = H.af[sel] / norms[:, None], H.bf[sel] / norms
+    rows = np.arange(len(sel))
+    found = _chebyshev(A, b)
+    if found is None:
+        return None
+    o, s = found[0], 1.0
+    x0, r = found
+    k = A.shape[1]
+    if r <= LOCAL_RADIUS * (1.0 + np.abs(o).max()):
+        # the kernel is tiny: measure it by the (k+1)-th nearest halfspace to o, and
+        # leave out the halfspaces far beyond that (they cannot cut it; the exact
+        # certificate checks every valid halfspace anyway)
+        b = b - A @ o
+        s = float(np.sort(np.abs(b))[k])
+        if not s > 0.0:
+            return None
+        rows = np.flatnonzero(b <= FAR * s)
+        A, b = A[rows], b[rows] / s
+        found = _chebyshev(A, b)
+        if found is None:
+            return None
+        x0, r = found
+    else:
+        o = np.zeros_like(o)
+    if r <= 1e-9 * (1.0 + np.abs(x0).max()):
         return None
     try:
         hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0, qhull_options="Qt")
     except (QhullError, ValueError):
         return None
-    return hs.intersections, [list(f) for f in hs.dual_facets]
+    return o + s * hs.intersections, [[int(rows[i]) for i in f] for f in hs.dual_facets]
 
 
 def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope | None:
@@ -137,7 +165,16 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         np.abs(H.af[rows]) @ absV + np.abs(H.bf[rows])[:, None])
     if (Sv > bound).any():
         return None
-    for r, vi in zip(*np.nonzero(np.abs(Sv) <= bound), strict=True):
+    near_r, near_v = np.nonzero(np.abs(Sv) <= bound)
+    slacks = _int64_slacks(H, scale, verts, rows[near_r], near_v)
+    if slacks is not None:  # small integers: all undecided pairs at once
+        if (slacks > 0).any():
+            return None
+        for h, vi in zip(rows[near_r][slacks == 0], near_v[slacks == 0], strict=True):
+            if int(h) in where:
+                tight[int(vi)] |= 1 << where[int(h)]
+        near_r = near_v = ()
+    for r, vi in zip(near_r, near_v, strict=True):
         h, vi = int(rows[r]), int(vi)
         if h in where and tight[vi] >> where[h] & 1:
             continue
@@ -167,6 +204,24 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     P.verts = verts
     P.tight = tight
     return P
+
+
+def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
+                  vs: np.ndarray) -> np.ndarray | None:
+    """a_h·y − b_h·w for the pairs (hs[i], vs[i]) in int64 — when the float normals are
+    exact integers (integer data, exact float arithmetic: c_err = 0, scale 1) and every
+    term provably fits — else None (the caller works in Python integers)."""
+    if H.c_err != 0.0 or scale != 1 or not len(hs):
+        return None
+    A, b = H.af[hs], H.bf[hs]
+    if not (np.all(A == np.round(A)) and np.all(b == np.round(b))):
+        return None
+    top = max(max(abs(c) for c in v) for v in verts)
+    reach = (np.abs(A).sum(axis=1).max() + np.abs(b).max()) * float(top)
+    if not reach < 2.0**62:
+        return None
+    V = np.array(verts, dtype=np.int64)[vs]
+    return (A.astype(np.int64) * V[:, 1:]).sum(axis=1) - b.astype(np.int64) * V[:, 0]
 
 
 def _solve(H, T: list[int]) -> tuple[int, ...] | None:

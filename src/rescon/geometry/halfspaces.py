@@ -31,6 +31,9 @@ _EPS = 2.0**-53
 #: from this many distinct points on, lines in the plane are counted by the angular
 #: sweep (O(n² log n)) instead of the direct scan (O(n³))
 SWEEP_MIN_POINTS = 150
+#: float cofactors with |C|₁ below this fraction of their permanent are replaced by the
+#: rounded exact normal (their relative error would exceed ~1e-12)
+ILL_CONDITIONED = 1e-3
 
 
 @dataclass
@@ -144,6 +147,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
     from ._candidates import ANGLE_ERR, classify, k_subsets, sweep_pairs_2d
+    from ._expansions import in_range, normals3
 
     m, k = Y.shape
     count = comb(m, k)
@@ -183,26 +187,34 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         rows += ts.tolist()
         sides += [side] * len(ts)
         outside += cnt[ts].tolist()
-    maybe = live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus))
-    for t in np.flatnonzero(maybe):  # undecided by the filter: count exactly
-        n_plus, n_minus = _exact_counts(Yi, W, subsets[t])
-        if n_plus is None:
-            continue
-        if n_plus <= F and not sure_plus[t]:
-            rows.append(int(t))
-            sides.append(1)
-            outside.append(n_plus)
-        if n_minus <= F and not sure_minus[t]:
-            rows.append(int(t))
-            sides.append(-1)
-            outside.append(n_minus)
+    maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
+    n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe])  # exactly
+    for side, sure, cnt in ((1, sure_plus, n_plus), (-1, sure_minus, n_minus)):
+        add = ~dependent & (cnt <= F) & ~sure[maybe]
+        rows += maybe[add].tolist()
+        sides += [side] * int(add.sum())
+        outside += cnt[add].tolist()
     idx = np.array(rows, dtype=np.int64)
     sign = np.array(sides, dtype=np.int64)
     through = subsets[idx].astype(np.int64)
-    af = cof[idx] * sign[:, None]
     p0 = Y[through[:, 0]] if len(idx) else np.zeros((0, k))
-    bf = np.einsum("ij,ij->i", af, p0)
+    af = cof[idx] * sign[:, None]
     af_abs = cof_abs[idx]
+    if k == 3 and not exact_floats and in_range(Y):
+        # nearly collinear triples: their float cofactors' error (relative to the
+        # permanents) can exceed a tiny kernel, so take the exact normals, rounded
+        # (error ≤ ε|a_j|); the others keep their cofactors with the permanents scaled
+        # to the smaller c_err
+        c_new = 8 * _EPS  # |af − a| ≤ ε|a|; |bf − b| ≤ ~4.1ε Σ|a_j p0_j|
+        af_abs = af_abs * (1.1 * c_err / c_new)
+        c_err = c_new
+        ill = np.flatnonzero(np.abs(af).sum(axis=1) < ILL_CONDITIONED * cof_abs[idx].sum(axis=1))
+        if len(ill):
+            exact = np.empty((len(ill), 3))
+            normals3(np.ascontiguousarray(Y, dtype=np.float64), through[ill], exact)
+            af[ill] = exact * sign[ill, None]
+            af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
+    bf = np.einsum("ij,ij->i", af, p0)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
     out = np.array(outside, dtype=np.int64)
     hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err)
@@ -214,6 +226,27 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
                         b_abs[keep], out[keep], c_err)
     return hs
+
+
+def _exact_side_counts(Y, Yi, W, subsets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Exact weighted numbers of points strictly on the + and − side of the hyperplane
+    through each subset, and whether the subset is affinely dependent: by
+    floating-point expansions in numba for k ≤ 3 (data in range), else in integers."""
+    from ._expansions import in_range, side_counts
+
+    k = Y.shape[1]
+    plus = np.zeros(len(subsets), dtype=np.int64)
+    minus = np.zeros(len(subsets), dtype=np.int64)
+    dependent = np.zeros(len(subsets), dtype=np.bool_)
+    if k in (2, 3) and in_range(Y):
+        side_counts(np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64),
+                    np.ascontiguousarray(subsets), plus, minus, dependent)
+        return plus, minus, dependent
+    for t, subset in enumerate(subsets):
+        n_plus, n_minus = _exact_counts(Yi, W, subset)
+        dependent[t] = n_plus is None
+        plus[t], minus[t] = (0, 0) if n_plus is None else (n_plus, n_minus)
+    return plus, minus, dependent
 
 
 def _exact_counts(Yi, W, subset) -> tuple[int | None, int]:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .emptiness import empty_certificate
 from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
@@ -218,6 +219,13 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     Xa = check_points(X)
     n, d = Xa.shape
     F = check_F(F, n)
+    quick = empty_certificate(Xa, F) if n <= (d + 1) * F else None
+    if quick is not None:  # a few directional halfspaces already prove Ψ = ∅
+        cert, halfspaces = quick
+        return SafeKernel(Xa, F, -1, np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), None,
+                          np.zeros((0, d)), np.zeros((0, d)), np.zeros(0),
+                          time.perf_counter() - t0, (), _Exact((), tuple(halfspaces), ()),
+                          lambda: cert)
     P = exact_points(Xa)
     hull = affine_hull(P)
     eqs = tuple(hull.equalities(P))

@@ -1,0 +1,106 @@
+"""Fast emptiness certificates for Ψ(X, F) from a few directional halfspaces.
+
+For a direction u, the halfspace H_u = {x : u·x ≤ β_u}, β_u the (F+1)-th largest of
+the values u·x_i (points counted with multiplicity), has at most F points strictly
+outside, so Ψ(X, F) ⊆ H_u (fact (a) of certificates/FORMAT.md). When the halfspaces of
+a few small-integer directions already have an empty intersection, Farkas
+multipliers prove Ψ = ∅ without enumerating the candidate hyperplanes:
+
+1. floats choose β_u, the value of one data point: for small-integer data the values
+   are exact (at most F lie strictly above β_u); otherwise a direction whose
+   (F+1)-th value is not separated from its neighbours by more than the rounding
+   error is skipped, so exactly F points lie strictly above it;
+2. the LP max t s.t. u·x + t ≤ β_u (HiGHS) with t* < 0 proposes the directions that
+   matter — the support of its dual solution, at most d + 1 of them;
+3. exact multipliers λ ≥ 0 with Σ λ_u u = 0, Σ λ_u = 1 are solved in rationals on
+   that support, and Σ λ_u β_u < 0 is checked exactly.
+
+Anything else (a kernel that is not empty, or not clearly so for these directions)
+returns None and the full algorithm decides. Worth trying only when n ≤ (d+1)F:
+above that, Helly's theorem makes Ψ nonempty.
+"""
+
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction
+from math import gcd
+from typing import Any
+
+import numpy as np
+
+from .exact import solve_exact
+
+_EPS = 2.0**-53
+#: component range of the directions tried: {−R..R}^d (primitive vectors), by dimension
+_RANGE = {1: 1, 2: 3, 3: 2, 4: 1, 5: 1}
+
+
+def _directions(d: int) -> np.ndarray:
+    """Primitive integer vectors with components in {−R..R}, one per ray. (Adding
+    pseudo-random directions was measured: slower, and it certified nothing more on
+    the benchmark clouds — the kernels it misses are barely empty.)"""
+    R = _RANGE.get(d, 1)
+    out = [u for u in itertools.product(range(-R, R + 1), repeat=d)
+           if any(u) and gcd(*map(abs, u)) == 1]
+    return np.array(out, dtype=np.float64)
+
+
+def empty_certificate(X: np.ndarray, F: int
+                      ) -> tuple[dict[str, Any], list[tuple[tuple[Fraction, ...], Fraction]]] | None:
+    """A ``kernel_empty`` certificate for Ψ(X, F) from directional halfspaces and those
+    halfspaces (a, b) exactly, or None.
+
+    X: (n, d) finite floats, 0 ≤ F < n."""
+    n, d = X.shape
+    if n > (d + 1) * F:
+        return None
+    U = _directions(d)
+    V = X @ U.T  # (n, m)
+    err = 4.0 * d * _EPS * (np.abs(U).sum(axis=1) * np.abs(X).max())  # per direction
+    if np.all(X == np.round(X)) and np.abs(X).max() * np.abs(U).sum(axis=1).max() < 2.0**52:
+        err[:] = 0.0  # small integers: the values are exact, ties are real ties
+    order = np.argsort(-V, axis=0, kind="stable")
+    ranked = np.take_along_axis(V, order, axis=0)
+    beta = ranked[F]
+    above = ranked[F - 1] - beta if F > 0 else np.full(len(U), np.inf)
+    below = beta - ranked[F + 1] if F + 1 < n else np.full(len(U), np.inf)
+    keep = np.flatnonzero(((above > 2 * err) & (below > 2 * err)) | (err == 0.0))
+    if len(keep) < d + 1:
+        return None
+    support = _lp_support(U[keep], beta[keep])
+    if support is None:
+        return None
+    rows = keep[support]
+    pts = [tuple(Fraction(v) for v in X[order[F, r]]) for r in rows]
+    normals = [tuple(Fraction(v) for v in U[r]) for r in rows]
+    b = [sum((a * x for a, x in zip(u, p, strict=True)), Fraction(0))
+         for u, p in zip(normals, pts, strict=True)]
+    M = [[u[j] for u in normals] for j in range(d)] + [[Fraction(1)] * len(rows)]
+    lam = solve_exact(M, [Fraction(0)] * d + [Fraction(1)])
+    if lam is None or any(v < 0 for v in lam) or sum(v * bb for v, bb in zip(lam, b)) >= 0:
+        return None
+    from .kernel import _q
+
+    cert = {"rescon_certificate": 1, "kind": "kernel_empty", "points": X.tolist(), "F": F,
+            "halfspaces": [{"a": [_q(v) for v in u], "b": _q(bb)} for u, bb in zip(normals, b)],
+            "multipliers": [_q(v) for v in lam], "equalities": [], "eq_multipliers": []}
+    return cert, list(zip(normals, b))
+
+
+def _lp_support(U: np.ndarray, beta: np.ndarray) -> np.ndarray | None:
+    """Rows with a positive dual in max t s.t. U x + t ≤ β, when t* < 0 (the
+    halfspaces have no common point), else None."""
+    from scipy.optimize import linprog
+
+    d = U.shape[1]
+    c = np.zeros(d + 1)
+    c[-1] = -1.0
+    scale = np.linalg.norm(U, axis=1)
+    res = linprog(c, A_ub=np.hstack([U, scale[:, None]]), b_ub=beta,
+                  bounds=[(None, None)] * (d + 1), method="highs")
+    if res.status != 0 or res.x[-1] >= 0:
+        return None
+    duals = -res.ineqlin.marginals
+    support = np.flatnonzero(duals > 1e-12 * duals.max())
+    return support if 0 < len(support) <= d + 1 else None
