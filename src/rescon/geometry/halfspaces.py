@@ -217,6 +217,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     bf = np.einsum("ij,ij->i", af, p0)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
     out = np.array(outside, dtype=np.int64)
+    if c_err == 0.0 and k >= 3:  # exact rows: drop repeats (coplanar data: one plane many times)
+        keep = _distinct_rows(af, bf)
+        through, sign, af, bf, af_abs, b_abs, out = (
+            v[keep] for v in (through, sign, af, bf, af_abs, b_abs, out))
     hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err)
     # an affinely dependent subset has every other point within the rounding bound,
     # so only subsets with no point surely off their hyperplane can be degenerate
@@ -226,6 +230,21 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
                         b_abs[keep], out[keep], c_err)
     return hs
+
+
+def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
+    """Indices (in order) of the first of each set of equal halfspaces a·x ≤ b, for
+    exact integral rows that fit in int64 (compared in lowest terms); all rows
+    otherwise."""
+    rows = np.arange(len(bf))
+    M = np.column_stack([af, bf])
+    if not len(bf) or not np.all(M == np.round(M)) or np.abs(M).max() >= 2.0**62:
+        return rows
+    M = M.astype(np.int64)
+    g = np.gcd.reduce(np.abs(M), axis=1)
+    g[g == 0] = 1
+    _, first = np.unique(M // g[:, None], axis=0, return_index=True)
+    return np.sort(first)
 
 
 def _exact_side_counts(Y, Yi, W, subsets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -227,9 +227,19 @@ class ExactPolytope:
         return [tuple(Fraction(yi, v[0]) for yi in v[1:]) for v in self.verts]
 
     def dim(self) -> int:
-        """Affine dimension of the vertex set (−1 if empty)."""
+        """Affine dimension of the vertex set (−1 if empty): k when the smallest
+        singular value of the float differences exceeds a bound on their error and the
+        SVD's (σ moves by at most the perturbation's norm, so the exact rank is full
+        too), else exactly (Bareiss)."""
         if not self.verts:
             return -1
+        if len(self.verts) > self.k:
+            V = self._float_array()
+            D = V[1:] - V[0]
+            # entries off by ≤ 4ε max|V|; the SVD's own error ≤ a few ε ‖D‖ (margin 8)
+            err = np.sqrt(D.size) * _EPS * (4.0 * np.abs(V).max() + 8.0 * np.linalg.norm(D))
+            if np.linalg.svd(D, compute_uv=False)[-1] > 2.0 * err:
+                return self.k
         w0, *y0 = self.verts[0]
         rows = [[yi * w0 - y0i * v[0] for yi, y0i in zip(v[1:], y0, strict=True)]
                 for v in self.verts[1:]]
