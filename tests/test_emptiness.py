@@ -70,7 +70,7 @@ def test_nonempty_kernels_are_left_to_the_full_algorithm():
 @given(st.integers(2, 3), st.integers(5, 24), st.integers(0, 10**6), st.booleans())
 def test_a_quick_certificate_agrees_with_the_full_algorithm(d, n, seed, integer):
     """Whenever the directions prove Ψ = ∅, the candidate-hyperplane algorithm (run on
-    the data as given, bypassing the quick path) finds it empty too."""
+    the data as given, bypassing both quick paths) finds it empty too."""
     from rescon.geometry import kernel as km
 
     rng = np.random.default_rng(seed)
@@ -80,9 +80,24 @@ def test_a_quick_certificate_agrees_with_the_full_algorithm(d, n, seed, integer)
     if found is None:
         return
     assert rescon.check_certificate(found[0]).valid
-    original = km.empty_certificate
-    try:
-        km.empty_certificate = lambda *a: None
+    originals = km.empty_certificate, km.empty_from_halfspaces
+    try:  # the double-description clipping alone
+        km.empty_certificate = km.empty_from_halfspaces = lambda *a: None
         assert rescon.safe_kernel(X, F).is_empty
     finally:
-        km.empty_certificate = original
+        km.empty_certificate, km.empty_from_halfspaces = originals
+
+
+@pytest.mark.parametrize("d,n,F", [(4, 20, 6), (3, 20, 6), (2, 14, 5), (5, 10, 2)])
+def test_farkas_from_the_valid_halfspaces(d, n, F, monkeypatch):
+    """With the directional path off, an LP over the valid halfspaces proposes the
+    Farkas support before any clipping; its certificate checks, and the clipping
+    agrees on emptiness."""
+    from rescon.geometry import kernel as km
+
+    X = np.random.default_rng(d * 100 + n).normal(size=(n, d))
+    monkeypatch.setattr(km, "empty_certificate", lambda *a: None)
+    K = rescon.safe_kernel(X, F)
+    assert rescon.check_certificate(K.certificate).valid
+    monkeypatch.setattr(km, "empty_from_halfspaces", lambda *a: None)
+    assert rescon.safe_kernel(X, F).is_empty == K.is_empty

@@ -104,3 +104,30 @@ def _lp_support(U: np.ndarray, beta: np.ndarray) -> np.ndarray | None:
     duals = -res.ineqlin.marginals
     support = np.flatnonzero(duals > 1e-12 * duals.max())
     return support if 0 < len(support) <= d + 1 else None
+
+
+def empty_from_halfspaces(H, k: int):
+    """Ψ = ∅ from the valid halfspaces H (:class:`.halfspaces.Halfspaces`, k
+    coordinates) before any clipping: the LP proposes at most k + 1 of them, exact
+    multipliers on their integer rows make the Farkas certificate. Returns an empty
+    :class:`.polytope.ExactPolytope` carrying it, or None (the LP finds a common point,
+    or the exact check fails)."""
+    from .polytope import ExactPolytope, Farkas
+
+    if len(H) < 2:
+        return None
+    norms = np.linalg.norm(H.af, axis=1)
+    support = _lp_support(H.af / norms[:, None], H.bf / norms)
+    if support is None:
+        return None
+    rows = [H.exact(int(h)) for h in support]
+    M = [[Fraction(a[j]) for a, _ in rows] for j in range(k)] + [[Fraction(1)] * len(rows)]
+    lam = solve_exact(M, [Fraction(0)] * k + [Fraction(1)])
+    if lam is None or any(v < 0 for v in lam) or \
+            sum(v * b for v, (_, b) in zip(lam, rows, strict=True)) >= 0:
+        return None
+    P = ExactPolytope(k)
+    P.a = [a for a, _ in rows]
+    P.b = [b for _, b in rows]
+    P.farkas = Farkas(tuple(range(len(rows))), tuple(lam))
+    return P

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .emptiness import empty_certificate
+from .emptiness import empty_certificate, empty_from_halfspaces
 from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
@@ -283,6 +283,10 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     lo = [min(y[j] for y in rows) for j in range(hull.dim)]
     hi = [max(y[j] for y in rows) for j in range(hull.dim)]
     first = np.flatnonzero(H.outside == F)
+    if sum(weights) <= (hull.dim + 1) * F:  # Ψ may be empty: try the LP's Farkas first
+        empty = empty_from_halfspaces(H, hull.dim)
+        if empty is not None:
+            return empty
     if hull.dim >= 2 and len(H) >= FAST_PATH_MIN_HALFSPACES:
         fast = certified_kernel(H, hull.dim, P.scale, first)
         if fast is not None:
