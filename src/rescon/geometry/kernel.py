@@ -283,7 +283,10 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     lo = [min(y[j] for y in rows) for j in range(hull.dim)]
     hi = [max(y[j] for y in rows) for j in range(hull.dim)]
     first = np.flatnonzero(H.outside == F)
-    if sum(weights) <= (hull.dim + 1) * F:  # Ψ may be empty: try the LP's Farkas first
+    # Ψ may be empty (n ≤ (k+1)F) and clipping is costly (k ≥ 4, where the fast path
+    # does not apply): the LP's Farkas first (for k ≤ 3 the LP over a large H costs
+    # more than it saves when Ψ turns out nonempty)
+    if hull.dim >= 4 and sum(weights) <= (hull.dim + 1) * F:
         empty = empty_from_halfspaces(H, hull.dim)
         if empty is not None:
             return empty
