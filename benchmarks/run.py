@@ -380,8 +380,14 @@ def run_robustness(cfg: Config, log: Any = sys.stderr) -> int:
             interrupted = True
             print("interrupted: writing the partial summary", file=log, flush=True)
     md = summarise(rows, cfg, cand, cand_desc, time.perf_counter() - started, interrupted)
+    return _finish(md, md_path, csv_path, n_err, "instance(s)", interrupted, log)
+
+
+def _finish(md: str, md_path, csv_path, n_err: int, unit: str, interrupted: bool,
+            log) -> int:
+    """Write the summary; exit code 130 if interrupted, 1 with errors, else 0."""
     md_path.write_text(md)
-    print(f"wrote {csv_path} and {md_path}; {n_err} instance(s) with errors", file=log)
+    print(f"wrote {csv_path} and {md_path}; {n_err} {unit} with errors", file=log)
     if interrupted:
         return 130
     return 1 if n_err else 0
@@ -975,12 +981,8 @@ def run_kernels(cfg: KernelConfig, log: Any = sys.stderr) -> int:
         finally:
             checker.close()
     md = summarise_kernels(recs, cfg, desc, time.perf_counter() - started, interrupted)
-    md_path.write_text(md)
     n_err = sum(1 for r in recs if r.errors)
-    print(f"wrote {csv_path} and {md_path}; {n_err} cloud(s) with errors", file=log)
-    if interrupted:
-        return 130
-    return 1 if n_err else 0
+    return _finish(md, md_path, csv_path, n_err, "cloud(s)", interrupted, log)
 
 
 # --------------------------------------------------------------------------- kernels summary

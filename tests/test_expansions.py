@@ -115,3 +115,23 @@ def test_normals_and_side_counts_in_space_are_exact():
             s = [sum(C[a] * (Fraction(Y[q, a]) - P[0][a]) for a in range(3))
                  for q in range(len(Y)) if q not in (i, j, k)]
             assert (plus[t], minus[t]) == (sum(v > 0 for v in s), sum(v < 0 for v in s))
+
+
+def test_side_counts_in_the_plane_are_exact():
+    """Collinear triples and copies on a small grid, and a point a few ulps off a line."""
+    import itertools
+
+    from rescon.geometry._expansions import side_counts
+
+    rng = np.random.default_rng(5)
+    Y = rng.integers(0, 4, size=(14, 2)).astype(float) / 3.0  # thirds: rounded, near-collinear
+    Y[13] = Y[0] + (Y[1] - Y[0]) * 0.5 + np.array([2.0**-52, 0.0])
+    subsets = np.array(list(itertools.combinations(range(len(Y)), 2)), dtype=np.int32)
+    plus, minus = np.zeros(len(subsets), np.int64), np.zeros(len(subsets), np.int64)
+    dependent = np.zeros(len(subsets), bool)
+    side_counts(Y, np.ones(len(Y), np.int64), subsets, plus, minus, dependent)
+    for t, (i, j) in enumerate(subsets):
+        s = [exact_orient(Y[i], Y[j], Y[q]) for q in range(len(Y)) if q not in (i, j)]
+        assert dependent[t] == (tuple(Y[i]) == tuple(Y[j]))
+        if not dependent[t]:
+            assert (plus[t], minus[t]) == (s.count(1), s.count(-1))

@@ -76,7 +76,7 @@ def test_active_set_and_qp_agree():
     H = 9 * 8 * 7 // 3
     normals, offsets = np.empty((40, H, 3)), np.empty((40, H))
     count, status = np.zeros(40, dtype=np.int64), np.empty(40, dtype=np.int64)
-    halfspaces_3d(Ys, 2, normals, offsets, count, status)
+    halfspaces_3d(Ys, 2, normals, offsets, count, status, np.empty((40, 3)), np.empty(40))
     local, solved = np.zeros((40, 3)), np.zeros(40, dtype=bool)
     nearest_points(normals, offsets, count, status, local, solved)
     assert solved[status == OK].all()

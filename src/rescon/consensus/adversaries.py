@@ -39,6 +39,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError
+from ._config import check_keys
 
 __all__ = [
     "Bait",
@@ -694,18 +695,6 @@ class NonFinite(Behaviour):
 # --------------------------------------------------------------------------- #
 
 
-def _keys(what: str, d: Mapping[str, Any], required: tuple[str, ...],
-          optional: tuple[str, ...] = ()) -> None:
-    unknown = sorted(set(d) - set(required) - set(optional) - {"kind"})
-    if unknown:
-        raise InputError(
-            f"{what} has unknown key(s) {unknown}; allowed: {sorted(required + optional)}"
-        )
-    missing = [k for k in required if k not in d]
-    if missing:
-        raise InputError(f"{what} is missing key(s) {missing}")
-
-
 _KINDS = ("bait", "constant", "crash", "function_of_time", "nonfinite", "own_state",
           "random_in_box", "two_faced")
 
@@ -750,7 +739,7 @@ def behaviour_from_dict(d: Mapping[str, Any]) -> Behaviour:
     if kind not in _KINDS:
         raise InputError(f"behaviour kind must be one of {list(_KINDS)}; got {kind!r}")
     if kind == "constant":
-        _keys("constant behaviour", d, ("value",))
+        check_keys("constant behaviour", d, ("value",))
         return Constant(d["value"])
     if kind == "function_of_time":
         if "preset" not in d:
@@ -758,23 +747,23 @@ def behaviour_from_dict(d: Mapping[str, Any]) -> Behaviour:
         params = {k: v for k, v in d.items() if k not in ("kind", "preset")}
         return FunctionOfTime(TimePreset(d["preset"], **params))
     if kind == "two_faced":
-        _keys("two_faced behaviour", d, (), ("values", "default", "cycle"))
+        check_keys("two_faced behaviour", d, (), ("values", "default", "cycle"))
         return TwoFaced(TwoFacedTable(values=d.get("values"), default=d.get("default"),
                                       cycle=d.get("cycle")))
     if kind == "random_in_box":
-        _keys("random_in_box behaviour", d, (), ("scale",))
+        check_keys("random_in_box behaviour", d, (), ("scale",))
         return RandomInBox(d.get("scale", 1.0))
     if kind == "bait":
-        _keys("bait behaviour", d, (), ("direction", "strength"))
+        check_keys("bait behaviour", d, (), ("direction", "strength"))
         return Bait(d.get("direction"), d.get("strength", 1.0))
     if kind == "crash":
-        _keys("crash behaviour", d, ("at_step",), ("before",))
+        check_keys("crash behaviour", d, ("at_step",), ("before",))
         before = behaviour_from_dict(d["before"]) if "before" in d else OwnState()
         return Crash(d["at_step"], before)
     if kind == "nonfinite":
-        _keys("nonfinite behaviour", d, ("value",))
+        check_keys("nonfinite behaviour", d, ("value",))
         return NonFinite(d["value"])
-    _keys("own_state behaviour", d, ())
+    check_keys("own_state behaviour", d, ())
     return OwnState()
 
 

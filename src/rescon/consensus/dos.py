@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ._config import check_keys
 
 __all__ = [
     "PAPER_MU_D",
@@ -102,19 +103,6 @@ def _positive(name: str, value: Any) -> float:
     if not math.isfinite(v) or v <= 0:
         raise InputError(f"{name} must be a finite number > 0; got {value!r}")
     return v
-
-
-def _check_keys(what: str, d: Mapping[str, Any], required: Iterable[str],
-                optional: Iterable[str] = ()) -> None:
-    required, optional = tuple(required), tuple(optional)
-    unknown = sorted(set(d) - set(required) - set(optional) - {"kind"})
-    if unknown:
-        raise InputError(
-            f"{what} has unknown key(s) {unknown}; allowed: {sorted(required + optional)}"
-        )
-    missing = [k for k in required if k not in d]
-    if missing:
-        raise InputError(f"{what} is missing key(s) {missing}")
 
 
 def _merge(windows: Iterable[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
@@ -419,7 +407,7 @@ def schedule_from_dict(d: Mapping[str, Any]) -> Schedule:
             f"schedule kind must be one of {sorted(_SCHEDULE_KEYS)}; got {kind!r}"
         )
     cls, required, optional = _SCHEDULE_KEYS[kind]
-    _check_keys(f"{kind} schedule", d, required, optional)
+    check_keys(f"{kind} schedule", d, required, optional)
     kwargs = {k: d[k] for k in required + optional if k in d}
     return cls(**kwargs)  # type: ignore[no-any-return]
 
@@ -495,13 +483,7 @@ def attack_from_dict(d: Mapping[str, Any]) -> DoSAttack:
     """
     if not isinstance(d, Mapping):
         raise InputError(f"attack must be a dict; got {type(d).__name__}")
-    unknown = sorted(set(d) - {"name", "links", "schedule"})
-    if unknown:
-        raise InputError(f"attack has unknown key(s) {unknown}; allowed: "
-                         "['links', 'name', 'schedule']")
-    missing = [k for k in ("name", "links", "schedule") if k not in d]
-    if missing:
-        raise InputError(f"attack is missing key(s) {missing}")
+    check_keys("attack", d, ("name", "links", "schedule"), tag=None)
     links = [tuple(v) if isinstance(v, list) else v for v in d["links"]]
     return DoSAttack(d["name"], frozenset(links), schedule_from_dict(d["schedule"]))
 

@@ -223,11 +223,16 @@ def side_counts(Y, W, subsets, plus, minus, degenerate):
         minus[t] = 0
         if k == 3:
             _normal3(Y, i, subsets[t, 1], subsets[t, 2], C, nC)
-            degenerate[t] = nC[0] == 0 and nC[1] == 0 and nC[2] == 0
-            for c in range(3):
-                a[c] = approximate(C[c], nC[c])
-        else:
-            degenerate[t] = Y[subsets[t, 1], 0] == Y[i, 0] and Y[subsets[t, 1], 1] == Y[i, 1]
+        else:  # the normal (−(y_j − y_i), x_j − x_i)
+            j = subsets[t, 1]
+            difference(Y[i, 1], Y[j, 1], C[0])
+            difference(Y[j, 0], Y[i, 0], C[1])
+            nC[0] = compress(C[0], 2)
+            nC[1] = compress(C[1], 2)
+        degenerate[t] = True
+        for c in range(k):
+            a[c] = approximate(C[c], nC[c])
+            degenerate[t] = degenerate[t] and nC[c] == 0
         if degenerate[t]:
             continue
         for q in range(Y.shape[0]):
@@ -237,26 +242,23 @@ def side_counts(Y, W, subsets, plus, minus, degenerate):
                     member = True
             if member:
                 continue
-            if k == 2:
-                o = orient(Y[i, 0], Y[i, 1], Y[subsets[t, 1], 0], Y[subsets[t, 1], 1],
-                           Y[q, 0], Y[q, 1])
-            else:  # filter with the rounded exact normal (error ≤ ε|a_j|), else exactly
-                val = 0.0
-                bound = 0.0
-                for c in range(3):
-                    dc = Y[q, c] - Y[i, c]
-                    val += a[c] * dc
-                    bound += abs(a[c] * dc)
-                if val > 8.0 * EPS * bound:
-                    o = 1
-                elif val < -8.0 * EPS * bound:
-                    o = -1
-                else:
-                    n = 0
-                    for c in range(3):
-                        difference(Y[q, c], Y[i, c], d)
-                        n += product(C[c], nC[c], d, 2, S[n:])
-                    o = sign(S, compress(S, n))
+            # filter with the rounded exact normal (error ≤ ε|a_j|), else exactly
+            val = 0.0
+            bound = 0.0
+            for c in range(k):
+                dc = Y[q, c] - Y[i, c]
+                val += a[c] * dc
+                bound += abs(a[c] * dc)
+            if val > 8.0 * EPS * bound:
+                o = 1
+            elif val < -8.0 * EPS * bound:
+                o = -1
+            else:
+                n = 0
+                for c in range(k):
+                    difference(Y[q, c], Y[i, c], d)
+                    n += product(C[c], nC[c], d, 2, S[n:])
+                o = sign(S, compress(S, n))
             if o > 0:
                 plus[t] += W[q]
             elif o < 0:

@@ -47,10 +47,11 @@ BACKEND = "clarabel"
 
 
 @njit(cache=True, nogil=True)
-def halfspaces_3d(Ys, F, normals, offsets, count, status):
+def halfspaces_3d(Ys, F, normals, offsets, count, status, origin, scale):
     """For each set b: its valid halfspaces n·(x − o) ≤ c, in coordinates centred at
     o = mean(Ys[b]) and scaled by s = max |Ys[b] − o| (so c is in units of s; n unit),
-    into normals[b, :count[b]], offsets[b, :count[b]]; status OK or DECLINED."""
+    into normals[b, :count[b]], offsets[b, :count[b]]; o and s into origin[b],
+    scale[b]; status OK or DECLINED."""
     B, m, _ = Ys.shape
     rep = np.empty(m, dtype=np.int64)
     for b in range(B):
@@ -61,6 +62,8 @@ def halfspaces_3d(Ys, F, normals, offsets, count, status):
         s = 0.0
         for q in range(m):
             s = max(s, abs(Y[q, 0] - o0), abs(Y[q, 1] - o1), abs(Y[q, 2] - o2))
+        origin[b, 0], origin[b, 1], origin[b, 2] = o0, o1, o2
+        scale[b] = s
         if s == 0.0:
             continue  # one point: the exact path
         for q in range(m):
@@ -236,7 +239,9 @@ def project_small_3d(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray]:
     offsets = np.empty((B, H))
     count = np.zeros(B, dtype=np.int64)
     status = np.empty(B, dtype=np.int64)
-    halfspaces_3d(Ys, F, normals, offsets, count, status)
+    origin = np.empty((B, 3))
+    scale = np.empty(B)
+    halfspaces_3d(Ys, F, normals, offsets, count, status, origin, scale)
     local = np.zeros((B, 3))
     solved = np.zeros(B, dtype=bool)
     nearest_points(normals, offsets, count, status, local, solved)
@@ -250,9 +255,7 @@ def project_small_3d(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray]:
         polished.update(by_qp(normals, offsets, count, retry))
     for b, y in polished.items():
         if y is not None:
-            o = Ys[b].mean(axis=0)
-            s = np.abs(Ys[b] - o).max()
-            out[b] = o + s * y
+            out[b] = origin[b] + scale[b] * y
             found[b] = True
     return out, found
 

@@ -56,8 +56,9 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
     """Vertices and their defining halfspaces (indices into sel) of {A x ≤ b}, from
     qhull around a Chebyshev centre. A kernel small against its coordinates (states
     that have nearly converged) is re-centred and rescaled first: x = o + s y with o
-    the first centre, s the median distance from o to the halfspaces, so the LP and
-    qhull see it at unit size. None for a flat or empty kernel or a qhull failure."""
+    the first centre, s the distance from o to its (k+1)-th nearest halfspace, so the
+    LP and qhull see it at unit size. None for a flat or empty kernel or a qhull
+    failure."""
     from scipy.spatial import HalfspaceIntersection, QhullError
 
     norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
@@ -66,13 +67,14 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
     found = _chebyshev(A, b)
     if found is None:
         return None
-    o, s = found[0], 1.0
     x0, r = found
     k = A.shape[1]
-    if r <= LOCAL_RADIUS * (1.0 + np.abs(o).max()):
+    o, s = np.zeros(k), 1.0
+    if r <= LOCAL_RADIUS * (1.0 + np.abs(x0).max()):
         # the kernel is tiny: measure it by the (k+1)-th nearest halfspace to o, and
         # leave out the halfspaces far beyond that (they cannot cut it; the exact
         # certificate checks every valid halfspace anyway)
+        o = x0
         b = b - A @ o
         s = float(np.sort(np.abs(b))[k])
         if not s > 0.0:
@@ -83,8 +85,6 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
         if found is None:
             return None
         x0, r = found
-    else:
-        o = np.zeros_like(o)
     if r <= 1e-9 * (1.0 + np.abs(x0).max()):
         return None
     try:

@@ -165,9 +165,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
     # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
     # window is exactly on the line
-    span = max(max(col) - min(col) for col in zip(*Yi)) if k == 2 else 0
-    separated = exact_floats and k == 2 and 16 * ANGLE_ERR * 2 * span * span < 1
-    if k == 2 and (separated or not exact_floats) and m >= SWEEP_MIN_POINTS:
+    sweep = k == 2 and m >= SWEEP_MIN_POINTS
+    separated = sweep and exact_floats and 16 * ANGLE_ERR * 2 * max(
+        max(col) - min(col) for col in zip(*Yi)) ** 2 < 1
+    if sweep and (separated or not exact_floats):
         plus, minus, unc, degenerate, cof, cof_abs = sweep_pairs_2d(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
         if separated:
