@@ -102,7 +102,7 @@ def test_normals_and_side_counts_in_space_are_exact():
     normals3(Y, subsets, N)
     plus, minus = np.zeros(len(subsets), np.int64), np.zeros(len(subsets), np.int64)
     dependent = np.zeros(len(subsets), bool)
-    side_counts(Y, np.ones(len(Y), np.int64), subsets, plus, minus, dependent)
+    side_counts(Y, np.ones(len(Y), np.int64), subsets, len(Y), plus, minus, dependent)
     for t, (i, j, k) in enumerate(subsets):
         P = [[Fraction(v) for v in Y[r]] for r in (i, j, k)]
         u = [P[1][a] - P[0][a] for a in range(3)]
@@ -129,7 +129,7 @@ def test_side_counts_in_the_plane_are_exact():
     subsets = np.array(list(itertools.combinations(range(len(Y)), 2)), dtype=np.int32)
     plus, minus = np.zeros(len(subsets), np.int64), np.zeros(len(subsets), np.int64)
     dependent = np.zeros(len(subsets), bool)
-    side_counts(Y, np.ones(len(Y), np.int64), subsets, plus, minus, dependent)
+    side_counts(Y, np.ones(len(Y), np.int64), subsets, len(Y), plus, minus, dependent)
     for t, (i, j) in enumerate(subsets):
         s = [exact_orient(Y[i], Y[j], Y[q]) for q in range(len(Y)) if q not in (i, j)]
         assert dependent[t] == (tuple(Y[i]) == tuple(Y[j]))

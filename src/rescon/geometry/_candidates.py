@@ -128,7 +128,8 @@ def _tally(side, w, np_, nm, nu):
 
 @njit(cache=True, nogil=True, inline="always")
 def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
-    """The point scan of _classify_range for k = 3 with scalars (the hot loop)."""
+    """The point scan of _classify_range for k = 3 with scalars (the hot loop; the
+    counts are accumulated without branches on the side, which is unpredictable)."""
     c0, c1, c2 = C[0], C[1], C[2]
     a0, a1, a2 = Cabs[0], Cabs[1], Cabs[2]
     x0, x1, x2 = Y[i0, 0], Y[i0, 1], Y[i0, 2]
@@ -141,10 +142,15 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
         d2 = Y[q, 2] - x2
         s = d0 * c0 + d1 * c1 + d2 * c2
         bound = coarse
-        if abs(s) <= coarse:
+        if c_err != 0.0 and abs(s) <= coarse:
             bound = c_err * (abs(d0) * a0 + abs(d1) * a1 + abs(d2) * a2)
-        side = _side(s, bound, c_err)
-        np_, nm, nu = _tally(side, W[q], np_, nm, nu)
+        pos = s > bound
+        neg = s < -bound
+        w = W[q]
+        np_ += w * pos
+        nm += w * neg
+        if c_err != 0.0:
+            nu += w * (not (pos or neg))
         if np_ > F and nm > F:
             break
     return np_, nm, nu

@@ -19,7 +19,7 @@ inputs can make a sign wrong.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 #: Dekker's splitter for doubles: 2^27 + 1
 _SPLITTER = 134217729.0
@@ -207,17 +207,15 @@ def normals3(Y, subsets, out):
 
 
 @njit(cache=True, nogil=True)
-def side_counts(Y, W, subsets, plus, minus, degenerate):
-    """Exact weighted numbers of points strictly on the + and − side of the plane (k = 3)
-    or line (k = 2) through each subset (+: the side of the cofactor normal), and
-    whether the subset is affinely dependent."""
+def _side_counts_range(Y, W, subsets, F, t0, t1, plus, minus, degenerate):
+    """side_counts for the subsets t0 ≤ t < t1."""
     k = Y.shape[1]
     C = np.empty((3, 16))
     nC = np.zeros(3, dtype=np.int64)
     d = np.empty(2)
     a = np.empty(3)
     S = np.empty(3 * 2 * 2 * 16)
-    for t in range(subsets.shape[0]):
+    for t in range(t0, t1):
         i = subsets[t, 0]
         plus[t] = 0
         minus[t] = 0
@@ -263,3 +261,30 @@ def side_counts(Y, W, subsets, plus, minus, degenerate):
                 plus[t] += W[q]
             elif o < 0:
                 minus[t] += W[q]
+            if plus[t] > F and minus[t] > F:
+                break
+
+
+@njit(cache=True, parallel=True)
+def _side_counts_parallel(Y, W, subsets, F, plus, minus, degenerate):
+    count = subsets.shape[0]
+    chunks = 64
+    for c in prange(chunks):
+        _side_counts_range(Y, W, subsets, F, count * c // chunks, count * (c + 1) // chunks,
+                           plus, minus, degenerate)
+
+
+#: from this many subsets on, the exact side counts run on all threads
+PARALLEL_MIN_SUBSETS = 200
+
+
+def side_counts(Y, W, subsets, F, plus, minus, degenerate):
+    """Exact weighted numbers of points strictly on the + and − side of the plane (k = 3)
+    or line (k = 2) through each subset (+: the side of the cofactor normal), and
+    whether the subset is affinely dependent. A subset's scan stops once both sides
+    hold more than F (it bounds no valid halfspace), so counts above F are lower
+    bounds; counts ≤ F are exact."""
+    if len(subsets) >= PARALLEL_MIN_SUBSETS:
+        _side_counts_parallel(Y, W, subsets, F, plus, minus, degenerate)
+    else:
+        _side_counts_range(Y, W, subsets, F, 0, len(subsets), plus, minus, degenerate)

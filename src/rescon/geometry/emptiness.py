@@ -68,7 +68,8 @@ def empty_certificate(X: np.ndarray, F: int
     keep = np.flatnonzero(((above > 2 * err) & (below > 2 * err)) | (err == 0.0))
     if len(keep) < d + 1:
         return None
-    support = _lp_support(U[keep], beta[keep])
+    support = _lp_support(U[keep], beta[keep], X.min(axis=0), X.max(axis=0),
+                          np.median(X, axis=0))
     if support is None:
         return None
     rows = keep[support]
@@ -88,22 +89,22 @@ def empty_certificate(X: np.ndarray, F: int
     return cert, list(zip(normals, b))
 
 
-def _lp_support(U: np.ndarray, beta: np.ndarray) -> np.ndarray | None:
-    """Rows with a positive dual in max t s.t. U x + t ≤ β, when t* < 0 (the
-    halfspaces have no common point), else None."""
-    from scipy.optimize import linprog
+def _lp_support(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                centre: np.ndarray) -> np.ndarray | None:
+    """Rows with a positive dual in max t s.t. a_i·x + ‖a_i‖ t ≤ b_i, when t* < 0 (the
+    halfspaces have no common point), else None. lo, hi: the data's box, which
+    (widened) bounds x; centre: a deep point, whose nearest rows start the row
+    generation (:mod:`._lp`)."""
+    from ._lp import max_margin
 
-    d = U.shape[1]
-    c = np.zeros(d + 1)
-    c[-1] = -1.0
-    scale = np.linalg.norm(U, axis=1)
-    res = linprog(c, A_ub=np.hstack([U, scale[:, None]]), b_ub=beta,
-                  bounds=[(None, None)] * (d + 1), method="highs")
-    if res.status != 0 or res.x[-1] >= 0:
+    norms = np.linalg.norm(A, axis=1)  # cofactor rows can be ~1e-14: unit rows
+    reach = max(float((hi - lo).max()), 1e-300)
+    found = max_margin(A / norms[:, None], b / norms, np.ones(len(b)), lo - reach,
+                       hi + reach, centre=centre, stop_below=0.0)
+    if found is None or found.t >= 0 or found.bounded_by_box:
         return None
-    duals = -res.ineqlin.marginals
-    support = np.flatnonzero(duals > 1e-12 * duals.max())
-    return support if 0 < len(support) <= d + 1 else None
+    support = np.flatnonzero(found.duals > 1e-12 * found.duals.max())
+    return support if 0 < len(support) <= A.shape[1] + 1 else None
 
 
 def empty_from_halfspaces(H, k: int):
@@ -116,8 +117,7 @@ def empty_from_halfspaces(H, k: int):
 
     if len(H) < 2:
         return None
-    norms = np.linalg.norm(H.af, axis=1)
-    support = _lp_support(H.af / norms[:, None], H.bf / norms)
+    support = _lp_support(H.af, H.bf, *H.box)
     if support is None:
         return None
     rows = [H.exact(int(h)) for h in support]

@@ -37,19 +37,17 @@ LOCAL_RADIUS = 1e-4
 FAR = 1e4
 
 
-def _chebyshev(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float] | None:
-    """Centre and radius of the largest ball in {x : A x ≤ b} (unit rows; HiGHS LP),
-    None if the LP fails."""
-    from scipy.optimize import linprog
+def _chebyshev(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+               centre: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """Centre and radius of the largest ball in {x : A x ≤ b} (unit rows) whose centre
+    lies in the box [lo, hi] (which contains the kernel), by the margin LP started
+    from the rows nearest ``centre``; None if the LP fails (e.g. the set is empty)."""
+    from ._lp import max_margin
 
-    k = A.shape[1]
-    c = np.zeros(k + 1)
-    c[-1] = -1.0
-    res = linprog(c, A_ub=np.hstack([A, np.ones((len(A), 1))]), b_ub=b,
-                  bounds=[(None, None)] * k + [(0, None)], method="highs")
-    if res.status != 0:
+    found = max_margin(A, b, np.ones(len(b)), lo, hi, centre=centre, t_min=0.0)
+    if found is None:
         return None
-    return res.x[:k], float(res.x[-1])
+    return found.x, found.t
 
 
 def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
@@ -64,7 +62,8 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
     norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
     A, b = H.af[sel] / norms[:, None], H.bf[sel] / norms
     rows = np.arange(len(sel))
-    found = _chebyshev(A, b)
+    lo, hi, median = H.box
+    found = _chebyshev(A, b, lo, hi, median)
     if found is None:
         return None
     x0, r = found
@@ -81,15 +80,18 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
             return None
         rows = np.flatnonzero(b <= FAR * s)
         A, b = A[rows], b[rows] / s
-        found = _chebyshev(A, b)
+        found = _chebyshev(A, b, (lo - o) / s, (hi - o) / s, np.zeros(k))
         if found is None:
             return None
         x0, r = found
     if r <= 1e-9 * (1.0 + np.abs(x0).max()):
         return None
-    try:
-        hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0, qhull_options="Qt")
+    try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
+        with np.errstate(divide="ignore", invalid="ignore"):
+            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0, qhull_options="Qt")
     except (QhullError, ValueError):
+        return None
+    if not np.isfinite(hs.intersections).all():
         return None
     return o + s * hs.intersections, [[int(rows[i]) for i in f] for f in hs.dual_facets]
 
@@ -192,7 +194,11 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
             members.setdefault(h, []).append(vi)
     for vi in range(len(verts)):
         T = list(_bits(tight[vi]))
-        for Z in _extreme_rays(normals, T, k):
+        # a simple vertex (k independent tight rows) has a simplicial tangent cone: its
+        # extreme rays keep all but one row tight
+        rays = ([tight[vi] ^ (1 << h) for h in T] if len(T) == k
+                else _extreme_rays(normals, T, k))
+        for Z in rays:
             fewest = min((members[h] for h in _bits(Z)), key=len)
             if not any((tight[u] & Z) == Z for u in fewest if u != vi):
                 return None

@@ -56,6 +56,7 @@ class Halfspaces:
     b_abs: np.ndarray  # (h,) the same for bf
     outside: np.ndarray  # (h,) points surely strictly outside (at most F)
     c_err: float
+    box: tuple[np.ndarray, np.ndarray, np.ndarray]  # the points' (min, max, median), floats
     _cache: dict[int, Any] = field(default_factory=dict)
 
     def __len__(self) -> int:
@@ -109,6 +110,9 @@ def _int_det(rows: list[list[int]]) -> int:
         return rows[0][0]
     if m == 2:
         return rows[0][0] * rows[1][1] - rows[0][1] * rows[1][0]
+    if m == 3:
+        (a, b, c), (d, e, f), (g, h, i) = rows
+        return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
     total = 0
     for j in range(m):
         if rows[0][j]:
@@ -189,7 +193,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         sides += [side] * len(ts)
         outside += cnt[ts].tolist()
     maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
-    n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe])  # exactly
+    n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F)  # exactly
     for side, sure, cnt in ((1, sure_plus, n_plus), (-1, sure_minus, n_minus)):
         add = ~dependent & (cnt <= F) & ~sure[maybe]
         rows += maybe[add].tolist()
@@ -222,14 +226,15 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         keep = _distinct_rows(af, bf)
         through, sign, af, bf, af_abs, b_abs, out = (
             v[keep] for v in (through, sign, af, bf, af_abs, b_abs, out))
-    hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err)
+    box = (Y.min(axis=0), Y.max(axis=0), np.median(Y, axis=0))
+    hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err, box)
     # an affinely dependent subset has every other point within the rounding bound,
     # so only subsets with no point surely off their hyperplane can be degenerate
     suspect = [h for h in np.flatnonzero(plus[idx] + minus[idx] == 0) if not any(hs.exact(h)[0])]
     if suspect:
         keep = np.setdiff1d(np.arange(len(hs)), suspect)
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
-                        b_abs[keep], out[keep], c_err)
+                        b_abs[keep], out[keep], c_err, box)
     return hs
 
 
@@ -244,14 +249,27 @@ def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
     M = M.astype(np.int64)
     g = np.gcd.reduce(np.abs(M), axis=1)
     g[g == 0] = 1
-    _, first = np.unique(M // g[:, None], axis=0, return_index=True)
-    return np.sort(first)
+    M //= g[:, None]
+    lo = M.min(axis=0)
+    span = M.max(axis=0) - lo + 1
+    if np.prod(span.astype(np.float64)) < 2.0**62:  # one mixed-radix int64 key per row
+        key = np.zeros(len(M), dtype=np.int64)
+        for j in range(M.shape[1]):
+            key = key * span[j] + (M[:, j] - lo[j])
+        _, first = np.unique(key, return_index=True)
+        return np.sort(first)
+    order = np.lexsort(M.T[::-1])  # stable: each run of equal rows starts at its first
+    S = M[order]
+    starts = np.ones(len(S), dtype=np.bool_)
+    starts[1:] = np.any(S[1:] != S[:-1], axis=1)
+    return np.sort(order[starts])
 
 
-def _exact_side_counts(Y, Yi, W, subsets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _exact_side_counts(Y, Yi, W, subsets, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Exact weighted numbers of points strictly on the + and − side of the hyperplane
-    through each subset, and whether the subset is affinely dependent: by
-    floating-point expansions in numba for k ≤ 3 (data in range), else in integers."""
+    through each subset (those above F may be lower bounds), and whether the subset is
+    affinely dependent: by floating-point expansions in numba for k ≤ 3 (data in
+    range), else in integers."""
     from ._expansions import in_range, side_counts
 
     k = Y.shape[1]
@@ -260,7 +278,7 @@ def _exact_side_counts(Y, Yi, W, subsets) -> tuple[np.ndarray, np.ndarray, np.nd
     dependent = np.zeros(len(subsets), dtype=np.bool_)
     if k in (2, 3) and in_range(Y):
         side_counts(np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64),
-                    np.ascontiguousarray(subsets), plus, minus, dependent)
+                    np.ascontiguousarray(subsets), F, plus, minus, dependent)
         return plus, minus, dependent
     for t, subset in enumerate(subsets):
         n_plus, n_minus = _exact_counts(Yi, W, subset)

@@ -30,7 +30,7 @@ __all__ = ["SafeKernel", "check_F", "check_points", "kernel_point", "kernel_poin
 
 #: below this many valid halfspaces exact clipping is faster than the fast path's
 #: LP + qhull set-up (and tiny kernels are often flat, which the fast path declines)
-FAST_PATH_MIN_HALFSPACES = 400
+FAST_PATH_MIN_HALFSPACES = 60
 
 
 def check_points(X: Any, name: str = "X") -> np.ndarray:
@@ -235,10 +235,10 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         constraints: tuple = ()
     else:
         poly = _clip(P, hull, F)
-        verts = tuple(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
-                      for y in poly.fraction_vertices())
-        used = sorted(poly.incidence())
-        constraints = tuple(_ambient(hull, d, poly.a[h], poly.b[h], P.scale) for h in used)
+        verts = _lifted_vertices(poly, hull, P)
+        ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
+                   for h in sorted(poly.incidence())}
+        constraints = tuple(ambient.values())
     if not verts:
         exact = _Exact(verts, constraints, eqs)
         return SafeKernel(Xa, F, -1, np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), None,
@@ -247,7 +247,7 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
                           lambda: _empty_certificate(Xa, F, hull, poly, P.scale, d))
     full = poly is not None and hull.dim == d and poly.dim() == d
     dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d, full)
-    facets = _relative_facets(poly, hull, P.scale, d, dim) if poly is not None else []
+    facets = _relative_facets(poly, ambient, dim) if poly is not None else []
     A, b = _unit_rows(facets, d)
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
 
@@ -261,6 +261,16 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     V = np.array([[float(v) for v in x] for x in verts])
     return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq,
                       time.perf_counter() - t0, verts, exact, certificate)
+
+
+def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
+                     ) -> tuple[tuple[Fraction, ...], ...]:
+    """The vertices of Ψ in the original coordinates, exactly (from the homogeneous
+    scaled-integer vertices (w, y) of the clipped polytope: x = y / (w · scale))."""
+    if hull.dim == len(P.ints[0]):  # the pivot coordinates are all of x
+        return tuple(tuple(Fraction(y, w * P.scale) for y in ys) for w, *ys in poly.verts)
+    return tuple(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
+                 for y in poly.fraction_vertices())
 
 
 def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
@@ -328,9 +338,10 @@ def _affine_of(verts, d: int, full: bool):
     return dim, origin, basis, Aeq, beq, kernel_eqs
 
 
-def _relative_facets(poly: ExactPolytope, hull: AffineHull, scale: int, d: int, dim: int):
+def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
     """Constraints whose tight vertices span a (dim − 1)-face: the facets of Ψ relative
-    to its affine hull (implicit equalities, tight everywhere, are left out)."""
+    to its affine hull (implicit equalities, tight everywhere, are left out), as
+    ``ambient[h]`` (the constraint h in the original coordinates)."""
     if dim == 0:
         return []
     nv = len(poly.verts)
@@ -340,7 +351,7 @@ def _relative_facets(poly: ExactPolytope, hull: AffineHull, scale: int, d: int, 
         # facet iff its dimension is at least dim − 1
         if len(members) >= dim and len(members) < nv and (
                 poly.clear_rank(members) >= dim - 1 or poly.face_dim(members) == dim - 1):
-            out.append(_ambient(hull, d, poly.a[h], poly.b[h], scale))
+            out.append(ambient[h])
     return out
 
 
