@@ -469,3 +469,49 @@ def test_fast_path_certifies_converged_clouds(seed, n, F):
     fast, slow, *_ = _both_paths(X, F)
     assert fast is not None, "the fast path should certify a converged cloud"
     assert set(fast.fraction_vertices()) == set(slow.fraction_vertices())
+
+
+@pytest.mark.parametrize("huge", [False, True])
+def test_distinct_rows_keeps_the_first_of_each_plane(huge):
+    """Repeated exact planes (equal up to a positive factor) are dropped, first kept;
+    with entries too wide for one packed key the lexicographic branch does the same."""
+    from rescon.geometry.halfspaces import _distinct_rows
+
+    rng = np.random.default_rng(int(huge))
+    base = rng.integers(-3, 4, size=(40, 4))
+    if huge:
+        base[:, 0] *= 2**40  # spans multiply past 2^62
+        base[:, 1] *= 2**30
+    rows = base[rng.integers(0, 40, 300)] * rng.integers(1, 4, size=(300, 1))
+    af, bf = rows[:, :3].astype(float), rows[:, 3].astype(float)
+    seen, expect = set(), []
+    for i, r in enumerate(rows.tolist()):
+        g = np.gcd.reduce(np.abs(r)) or 1
+        key = tuple(v // g for v in r)
+        if key not in seen:
+            seen.add(key)
+            expect.append(i)
+    assert _distinct_rows(af, bf).tolist() == expect
+
+
+def test_exact_side_counts_stop_above_F_but_are_exact_up_to_F():
+    import itertools
+
+    from rescon.geometry._expansions import side_counts
+
+    rng = np.random.default_rng(11)
+    Y = rng.standard_normal((30, 3))
+    W = np.ones(30, np.int64)
+    subsets = np.array(list(itertools.combinations(range(30), 3)), dtype=np.int32)
+    full = [np.zeros(len(subsets), np.int64) for _ in range(2)]
+    dep = np.zeros(len(subsets), bool)
+    side_counts(Y, W, subsets, 30, *full, dep)
+    cut = [np.zeros(len(subsets), np.int64) for _ in range(2)]
+    side_counts(Y, W, subsets, 4, *cut, dep)
+    for f, c in zip(full, cut):
+        small = f <= 4
+        assert np.array_equal(c[small], f[small])
+        assert np.all(c[~small] <= f[~small])
+    # a subset is cut short only when both sides already exceed F
+    short = (cut[0] != full[0]) | (cut[1] != full[1])
+    assert short.any() and np.all((cut[0][short] > 4) & (cut[1][short] > 4))
