@@ -10,6 +10,7 @@ Every certificate is checked by the standalone checker.
 from __future__ import annotations
 
 import itertools
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -427,11 +428,17 @@ def test_project_survives_a_failing_guide(monkeypatch):
     def broken(*args, **kwargs):
         raise SolverError("clarabel: solver status 'AlmostSolved' is not optimal")
 
-    monkeypatch.setattr(points, "_float_guide", broken)
-    x, cert = K.point("project")
+    from rescon.models import kernel_models
+
+    monkeypatch.setattr(kernel_models, "project", broken)
+    x, cert = K.point("project")  # the vertex guide takes over
     assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
     with pytest.raises(SolverError, match="AlmostSolved"):
         K.point("project", backend="clarabel")
+    # no usable guide at all: the exhaustive exact search still answers
+    monkeypatch.setattr(points, "_vertex_guide", lambda K, m: np.full(K.dim, np.nan))
+    x, cert = K.point("project")
+    assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
 
 
 @pytest.mark.parametrize("F", [0, 2, 40])
@@ -515,3 +522,30 @@ def test_exact_side_counts_stop_above_F_but_are_exact_up_to_F():
     # a subset is cut short only when both sides already exceed F
     short = (cut[0] != full[0]) | (cut[1] != full[1])
     assert short.any() and np.all((cut[0][short] > 4) & (cut[1][short] > 4))
+
+
+@pytest.mark.parametrize("n,seed", [(10, 2), (20, 1), (50, 1), (100, 0), (100, 2)])
+def test_projection_onto_a_tiny_far_kernel_is_guided(n, seed, monkeypatch):
+    """Benign states within 1e-7 and one far outlier: Ψ is ~1e-7 wide, 0.05–0.2 away
+    from the mean, and the projection lands on a vertex where more than 3 facets are
+    tight up to rounding. Clarabel stops at "almost solved" there, so the guide falls
+    back to HiGHS, and every facet about as near as the dim + 1 nearest is tried: the
+    exact KKT point is found among the first candidate active sets, not by trying
+    all of them (thousands; beyond the 200 000 limit for (100, 2), which failed)."""
+    from rescon.geometry import points
+
+    rng = np.random.default_rng(n + 1000 * seed)
+    X = rng.uniform(-1, 1, 3) + rng.uniform(-1e-7, 1e-7, (n, 3))
+    X[0] += rng.normal(size=3) * 5
+    K = rescon.safe_kernel(X, 1)
+    calls = []
+    kkt = points._kkt
+    monkeypatch.setattr(points, "_kkt", lambda *a: calls.append(a) or kkt(*a))
+    x, cert = K.point("project")
+    assert rescon.check_certificate(cert).valid
+    assert len(calls) <= 50, len(calls)
+    # the answer is the exact projection: no vertex of Ψ is nearer to the mean
+    exact = [Fraction(v) for v in cert["x"]]
+    m = [sum(Fraction(v) for v in col) / n for col in zip(*X.tolist())]
+    dist = sum((a - b) ** 2 for a, b in zip(exact, m))
+    assert all(sum((a - b) ** 2 for a, b in zip(v, m)) >= dist for v in K.exact_vertices)

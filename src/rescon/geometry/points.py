@@ -81,6 +81,10 @@ def _target(K: SafeKernel, target: Any) -> Vec:
 
 #: up to this many vertices, "auto" guides a projection in dimension ≤ 2 geometrically
 GEOMETRIC_GUIDE_VERTICES = 64
+#: facets within this fraction of the kernel's size from a guide count as near it
+#: (at most MAX_NEAR of them; their subsets are tried first)
+NEAR_SLACK = 1e-6
+MAX_NEAR = 10
 
 
 def _geometric_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
@@ -101,44 +105,80 @@ def _geometric_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
     return C[np.argmin(np.linalg.norm(C - m, axis=1))]
 
 
-def _float_guide(K: SafeKernel, m: Vec, backend: str) -> np.ndarray:
+def _vertex_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
+    """Nearest point of conv(V) to m in floats, as min ‖Vᵀλ − m‖ over λ ≥ 0 with
+    Σλ = 1 weighted in (Lawson–Hanson NNLS, scipy), at the kernel's own scale: a
+    kernel 1e-7 wide a million sizes away from m, where the QP solvers stop short of
+    optimal, still gives the face it lands on."""
+    from scipy.optimize import nnls
+
+    V = K.vertices
+    o = V.mean(axis=0)
+    s = float(np.abs(V - o).max()) or 1.0
+    U, c = (V - o) / s, (m - o) / s
+    w = max(1.0, float(np.abs(c).max()))
+    lam, _ = nnls(np.vstack([U.T, np.full(len(U), w)]), np.r_[c, w])
+    total = lam.sum()
+    return o + s * (U.T @ lam) / total if total > 0 else o
+
+
+def _guides(K: SafeKernel, m: Vec, backend: str):
+    """Float points near the projection, best first. An explicit backend is the only
+    guide (its failure is the user's answer); "auto" tries the geometric guide (dim ≤
+    2) or Clarabel, then the vertex guide."""
     from ..models.kernel_models import project
 
     mf = np.array([float(v) for v in m])
+    if backend not in ("auto", "exact"):
+        yield project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend=backend)
+        return
     if backend == "auto" and K.dim <= 2 and len(K.vertices) <= GEOMETRIC_GUIDE_VERTICES:
-        return _geometric_guide(K, mf)
-    name = "clarabel" if backend in ("auto", "exact") else backend
-    return project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend=name)
+        yield _geometric_guide(K, mf)
+    else:
+        try:
+            guess = project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend="clarabel")
+        except SolverError:  # a hint only: the next guide and the exact search decide
+            guess = None
+        if guess is not None:
+            yield guess
+    yield _vertex_guide(K, mf)
+
+
+def _near_active_sets(K: SafeKernel, guess: np.ndarray) -> list[tuple[int, ...]]:
+    """Subsets of ≤ dim facets near the guide, most plausible first: the dim + 1 nearest
+    and every facet about as near (at a degenerate vertex more than dim are tight up
+    to rounding, in any order)."""
+    slack = K.b - K.A @ guess  # unit rows: distances
+    reach = NEAR_SLACK * float(np.ptp(K.vertices, axis=0).max())
+    order = np.argsort(slack, kind="stable")
+    ranked = slack[order]
+    close = int(np.searchsorted(ranked, ranked[min(K.dim, len(ranked) - 1)] + reach,
+                                side="right"))
+    near = sorted(order[: min(max(K.dim + 1, close), MAX_NEAR)].tolist())
+    tight = slack <= reach  # a hint only: the KKT check decides
+
+    def plausibility(S: tuple[int, ...]) -> tuple[int, int]:
+        return (sum(not tight[i] for i in S) + sum(tight[i] for i in near if i not in S),
+                len(S))
+
+    sets = [S for size in range(K.dim + 1) for S in itertools.combinations(near, size)]
+    return sorted(sets, key=plausibility)
 
 
 def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:
-    """Exact projection: active sets from the float guide first (subsets of the dim + 1
-    facets with the smallest slack at the guide's point), then all of them."""
+    """Exact projection: active sets near each float guide first, then all of them."""
     ex = K._exact
     if K.dim == 0:
         return ex.vertices[0]
     facets = list(ex.facets)
-    try:
-        guess = _float_guide(K, m, backend)
-    except SolverError:
-        if backend not in ("auto", "exact"):
-            raise  # the backend the user asked for failed: say so
-        guess = None  # "auto": the guide is only a hint; the exact search decides
-    candidates: list[tuple[int, ...]] = []
-    if guess is not None and len(facets):
-        slack = (K.b - K.A @ guess) / (1.0 + np.abs(K.b))
-        near = sorted(np.argsort(slack)[: K.dim + 1].tolist())
-        for size in range(K.dim + 1):
-            candidates += [tuple(sorted(c)) for c in itertools.combinations(near, size)]
-        tight = slack <= 1e-9  # a hint only: the KKT check below decides
 
-        def plausibility(S: tuple[int, ...]) -> tuple[int, int]:
-            return (sum(not tight[i] for i in S) + sum(tight[i] for i in near if i not in S),
-                    len(S))
+    def near_sets():
+        for guess in _guides(K, m, backend):
+            if len(facets) and np.isfinite(guess).all():
+                yield from _near_active_sets(K, guess)
 
-        candidates.sort(key=plausibility)
     tried = set()
-    for S in itertools.chain(candidates, _active_sets(len(facets), K.dim)):
+    for S in itertools.chain(near_sets(), _active_sets(len(facets), K.dim)):
         if S in tried or len(S) > K.dim:
             continue
         tried.add(S)
