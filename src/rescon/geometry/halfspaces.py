@@ -184,23 +184,15 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     live = ~degenerate
     sure_plus = live & (plus + unc <= F)
     sure_minus = live & (minus + unc <= F)
-    rows: list[int] = []
-    sides: list[int] = []
-    outside: list[int] = []
-    for side, sure, cnt in ((1, sure_plus, plus), (-1, sure_minus, minus)):
-        ts = np.flatnonzero(sure)
-        rows += ts.tolist()
-        sides += [side] * len(ts)
-        outside += cnt[ts].tolist()
+    sure_p, sure_m = np.flatnonzero(sure_plus), np.flatnonzero(sure_minus)
     maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
     n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F)  # exactly
-    for side, sure, cnt in ((1, sure_plus, n_plus), (-1, sure_minus, n_minus)):
-        add = ~dependent & (cnt <= F) & ~sure[maybe]
-        rows += maybe[add].tolist()
-        sides += [side] * int(add.sum())
-        outside += cnt[add].tolist()
-    idx = np.array(rows, dtype=np.int64)
-    sign = np.array(sides, dtype=np.int64)
+    add_p = ~dependent & (n_plus <= F) & ~sure_plus[maybe]
+    add_m = ~dependent & (n_minus <= F) & ~sure_minus[maybe]
+    idx = np.concatenate([sure_p, sure_m, maybe[add_p], maybe[add_m]])
+    sign = np.repeat(np.array([1, -1, 1, -1], dtype=np.int64),
+                     [len(sure_p), len(sure_m), int(add_p.sum()), int(add_m.sum())])
+    out = np.concatenate([plus[sure_p], minus[sure_m], n_plus[add_p], n_minus[add_m]])
     through = subsets[idx].astype(np.int64)
     p0 = Y[through[:, 0]] if len(idx) else np.zeros((0, k))
     af = cof[idx] * sign[:, None]
@@ -211,9 +203,9 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         # (error ≤ ε|a_j|); the others keep their cofactors with the permanents scaled
         # to the smaller c_err
         c_new = 8 * _EPS  # |af − a| ≤ ε|a|; |bf − b| ≤ ~4.1ε Σ|a_j p0_j|
+        ill = np.flatnonzero(np.abs(af).sum(axis=1) < ILL_CONDITIONED * af_abs.sum(axis=1))
         af_abs = af_abs * (1.1 * c_err / c_new)
         c_err = c_new
-        ill = np.flatnonzero(np.abs(af).sum(axis=1) < ILL_CONDITIONED * cof_abs[idx].sum(axis=1))
         if len(ill):
             exact = np.empty((len(ill), 3))
             normals3(np.ascontiguousarray(Y, dtype=np.float64), through[ill], exact)
@@ -221,11 +213,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
             af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
     bf = np.einsum("ij,ij->i", af, p0)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
-    out = np.array(outside, dtype=np.int64)
     if c_err == 0.0 and k >= 3:  # exact rows: drop repeats (coplanar data: one plane many times)
         keep = _distinct_rows(af, bf)
-        through, sign, af, bf, af_abs, b_abs, out = (
-            v[keep] for v in (through, sign, af, bf, af_abs, b_abs, out))
+        idx, through, sign, af, bf, af_abs, b_abs, out = (
+            v[keep] for v in (idx, through, sign, af, bf, af_abs, b_abs, out))
     box = (Y.min(axis=0), Y.max(axis=0), np.median(Y, axis=0))
     hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err, box)
     # an affinely dependent subset has every other point within the rounding bound,
