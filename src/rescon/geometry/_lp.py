@@ -28,8 +28,11 @@ __all__ = ["Margin", "max_margin"]
 #: rows in the first partial LP, and at most this many added per round
 FIRST_ROWS = 50
 ADD_ROWS = 50
-#: a row counts as violated when it is off by more than this (relative to 1 + |b_i|)
-VIOLATION = 1e-9
+#: a row counts as violated when it is off by more than this (relative to 1 + |b_i|):
+#: HiGHS's own primal feasibility tolerance — a smaller violation would not move its
+#: solution, and adding such rows only costs rounds (a kernel 1e-7 wide has
+#: thousands; the caller re-solves tiny kernels at their own scale)
+VIOLATION = 1e-7
 
 
 @dataclass(frozen=True)
