@@ -440,6 +440,13 @@ def test_project_survives_a_failing_guide(monkeypatch):
     x, cert = K.point("project")
     assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
 
+    def nnls_limit(K, m):
+        raise RuntimeError("Maximum number of iterations reached.")
+
+    monkeypatch.setattr(points, "_vertex_guide", nnls_limit)  # scipy's NNLS giving up
+    x, cert = K.point("project")
+    assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
+
 
 @pytest.mark.parametrize("F", [0, 2, 40])
 def test_sweep_on_small_integers_finds_the_scans_halfspaces(F, monkeypatch):

@@ -98,6 +98,8 @@ def _lp_support(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     from ._lp import max_margin
 
     norms = np.linalg.norm(A, axis=1)  # cofactor rows can be ~1e-14: unit rows
+    if not norms.all():  # a float row rounded to zero: no proposal
+        return None
     reach = max(float((hi - lo).max()), 1e-300)
     found = max_margin(A / norms[:, None], b / norms, np.ones(len(b)), lo - reach,
                        hi + reach, centre=centre, stop_below=0.0)

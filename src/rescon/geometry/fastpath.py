@@ -60,6 +60,8 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
     from scipy.spatial import HalfspaceIntersection, QhullError
 
     norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
+    if not norms.all():  # a float row rounded to zero: no proposal
+        return None
     A, b = H.af[sel] / norms[:, None], H.bf[sel] / norms
     rows = np.arange(len(sel))
     lo, hi, median = H.box

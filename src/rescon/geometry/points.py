@@ -141,7 +141,10 @@ def _guides(K: SafeKernel, m: Vec, backend: str):
             guess = None
         if guess is not None:
             yield guess
-    yield _vertex_guide(K, mf)
+    try:
+        yield _vertex_guide(K, mf)
+    except (RuntimeError, ValueError):  # scipy's NNLS at its iteration limit: no hint
+        return
 
 
 def _near_active_sets(K: SafeKernel, guess: np.ndarray) -> list[tuple[int, ...]]:
