@@ -548,7 +548,7 @@ def test_projection_onto_a_tiny_far_kernel_is_guided(n, seed, monkeypatch):
     calls = []
     kkt = points._kkt
     monkeypatch.setattr(points, "_kkt", lambda *a: calls.append(a) or kkt(*a))
-    x, cert = K.point("project")
+    _, cert = K.point("project")
     assert rescon.check_certificate(cert).valid
     assert len(calls) <= 50, len(calls)
     # the answer is the exact projection: no vertex of Ψ is nearer to the mean

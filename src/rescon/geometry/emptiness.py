@@ -77,9 +77,8 @@ def empty_certificate(X: np.ndarray, F: int
     normals = [tuple(Fraction(v) for v in U[r]) for r in rows]
     b = [sum((a * x for a, x in zip(u, p, strict=True)), Fraction(0))
          for u, p in zip(normals, pts, strict=True)]
-    M = [[u[j] for u in normals] for j in range(d)] + [[Fraction(1)] * len(rows)]
-    lam = solve_exact(M, [Fraction(0)] * d + [Fraction(1)])
-    if lam is None or any(v < 0 for v in lam) or sum(v * bb for v, bb in zip(lam, b)) >= 0:
+    lam = _farkas(normals, b, d)
+    if lam is None:
         return None
     from .kernel import _q
 
@@ -87,6 +86,18 @@ def empty_certificate(X: np.ndarray, F: int
             "halfspaces": [{"a": [_q(v) for v in u], "b": _q(bb)} for u, bb in zip(normals, b)],
             "multipliers": [_q(v) for v in lam], "equalities": [], "eq_multipliers": []}
     return cert, list(zip(normals, b))
+
+
+def _farkas(normals, offsets, k: int) -> list[Fraction] | None:
+    """Exact multipliers λ ≥ 0 with Σ λ_i a_i = 0, Σ λ_i = 1 and Σ λ_i b_i < 0 for the
+    halfspaces a_i·x ≤ b_i (integers or Fractions) — a proof that they have no common
+    point — or None."""
+    M = [[Fraction(a[j]) for a in normals] for j in range(k)] + [[Fraction(1)] * len(normals)]
+    lam = solve_exact(M, [Fraction(0)] * k + [Fraction(1)])
+    if lam is None or any(v < 0 for v in lam) or \
+            sum(v * b for v, b in zip(lam, offsets, strict=True)) >= 0:
+        return None
+    return lam
 
 
 def _lp_support(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -123,10 +134,8 @@ def empty_from_halfspaces(H, k: int):
     if support is None:
         return None
     rows = [H.exact(int(h)) for h in support]
-    M = [[Fraction(a[j]) for a, _ in rows] for j in range(k)] + [[Fraction(1)] * len(rows)]
-    lam = solve_exact(M, [Fraction(0)] * k + [Fraction(1)])
-    if lam is None or any(v < 0 for v in lam) or \
-            sum(v * b for v, (_, b) in zip(lam, rows, strict=True)) >= 0:
+    lam = _farkas([a for a, _ in rows], [b for _, b in rows], k)
+    if lam is None:
         return None
     P = ExactPolytope(k)
     P.a = [a for a, _ in rows]

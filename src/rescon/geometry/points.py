@@ -138,13 +138,14 @@ def _guides(K: SafeKernel, m: Vec, backend: str):
         try:
             guess = project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend="clarabel")
         except SolverError:  # a hint only: the next guide and the exact search decide
-            guess = None
-        if guess is not None:
+            pass
+        else:
             yield guess
     try:
-        yield _vertex_guide(K, mf)
+        guess = _vertex_guide(K, mf)
     except (RuntimeError, ValueError):  # scipy's NNLS at its iteration limit: no hint
         return
+    yield guess
 
 
 def _near_active_sets(K: SafeKernel, guess: np.ndarray) -> list[tuple[int, ...]]:
