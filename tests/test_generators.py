@@ -190,12 +190,12 @@ def test_construction_orders_pass_the_independent_checker(monkeypatch):
 @pytest.mark.parametrize(
     ("call", "pattern"),
     [
-        (lambda: ba_robust(4, 3), r"n must be an integer >= 5; got n=4"),
-        (lambda: ba_robust(10, 0), r"m must be an integer >= 1; got m=0"),
+        (lambda: ba_robust(4, 3), r"n must be an integer >= 5; got 4"),
+        (lambda: ba_robust(10, 0), r"m must be an integer >= 1; got 0"),
         (lambda: ba_robust(10, True), r"m must be an integer >= 1; got True"),
         (lambda: ba_robust(10, 2, seed=-1), r"seed must be None, a nonnegative int"),
         (lambda: ba_robust(10, 2, seed="x"), r"seed must be None"),
-        (lambda: directed_growth(1, 1), r"n must be an integer >= 2; got n=1"),
+        (lambda: directed_growth(1, 1), r"n must be an integer >= 2; got 1"),
         (lambda: directed_growth(10, 2.0), r"k must be an integer >= 1; got 2.0"),
         (lambda: circulant(5, 5), r"k must be an integer with 1 <= k <= n - 1 = 4; got k=5"),
         (lambda: circulant(1, 1), r"n must be an integer >= 2"),

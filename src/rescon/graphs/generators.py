@@ -23,6 +23,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from .._validate import integer
 from ..errors import InputError
 
 __all__ = ["ba_robust", "circulant", "directed_growth", "two_cliques"]
@@ -67,9 +68,9 @@ def ba_robust(n: int, m: int, *, seed: Seed = None) -> nx.Graph:
     is not 2-robust (upper bound). The default networkx seed, a star, is *not*
     m-robust.
     """
-    m = _int_arg("m", m, 1)
+    m = integer("m", m, low=1)
     size = max(2, 2 * m - 1)
-    n = _int_arg("n", n, size)
+    n = integer("n", n, low=size)
     G = nx.barabasi_albert_graph(n, m, seed=_rng(seed), initial_graph=nx.complete_graph(size))
     return _annotate(G, rho=m, order=list(range(n)), seed_size=size)
 
@@ -106,8 +107,8 @@ def directed_growth(n: int, k: int, *, seed: Seed = None) -> nx.DiGraph:
     in-degree k and no out-edges, so the pair ({v}, V \\ {v}) has
     max(e(S1), e(S2)) = max(k, 0) = k.
     """
-    k = _int_arg("k", k, 1)
-    n = _int_arg("n", n, max(2, 2 * k - 1))
+    k = integer("k", k, low=1)
+    n = integer("n", n, low=max(2, 2 * k - 1))
     rng = _rng(seed)
     G = nx.complete_graph(2 * k - 1, create_using=nx.DiGraph)
     for v in range(2 * k - 1, n):
@@ -161,8 +162,8 @@ def circulant(n: int, k: int, *, directed: bool = False) -> nx.Graph:
     odd n. At n = k + 1 the directed formula gives :math:`\\lceil n/2 \\rceil`, the
     value of the complete digraph.
     """
-    n = _int_arg("n", n, 2)
-    k = _int_arg("k", k, 1)
+    n = integer("n", n, low=2)
+    k = integer("k", k, low=1)
     if k > n - 1:
         raise InputError(f"k must be an integer with 1 <= k <= n - 1 = {n - 1}; got k={k}")
     complete = k >= n // 2 if not directed else k == n - 1
@@ -224,8 +225,8 @@ def two_cliques(m: int, b: int, *, seed: Seed = None) -> nx.Graph:
     :math:`|B \\setminus Q_1| + 1 \\ge |P_1| + 2` matched neighbours in
     :math:`P_1`, impossible. Brute force confirms it for m ≤ 8.
     """
-    m = _int_arg("m", m, 1)
-    b = _int_arg("b", b, 0)
+    m = integer("m", m, low=1)
+    b = integer("b", b, low=0)
     if b > m:
         raise InputError(f"b must be an integer with 0 <= b <= m = {m}; got b={b}")
     rng = _rng(seed)
@@ -251,14 +252,6 @@ def _annotate(G: Any, *, rho: int, order: list[int] | None = None,
         G.graph["construction_order"] = order
         G.graph["seed_size"] = seed_size
     return G
-
-
-def _int_arg(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InputError(f"{name} must be an integer >= {minimum}; got {value!r}")
-    if value < minimum:
-        raise InputError(f"{name} must be an integer >= {minimum}; got {name}={value}")
-    return int(value)
 
 
 def _rng(seed: Any) -> np.random.Generator:

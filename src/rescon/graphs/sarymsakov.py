@@ -27,6 +27,7 @@ from scipy.sparse.csgraph import (
     maximum_flow,
 )
 
+from .._validate import positive
 from ..errors import InputError
 
 __all__ = ["SarymsakovResult", "is_sarymsakov"]
@@ -128,7 +129,8 @@ def is_sarymsakov(A: Any, *, time_limit: float | None = None) -> SarymsakovResul
     S = _support(A)
     deadline = None
     if time_limit is not None:
-        deadline = time.monotonic() + _positive("time_limit", time_limit)
+        deadline = time.monotonic() + positive("time_limit", time_limit,
+                                                      what="number of seconds")
     sigma = maximum_bipartite_matching(csr_matrix(S), perm_type="column")
     if (sigma >= 0).all():
         witness, exact, method = _source_components(S, sigma), True, "matching"
@@ -166,13 +168,6 @@ def _support(A: Any) -> np.ndarray:
             f"got row {bad[0]} summing to {float(sums[bad[0]])!r}"
         )
     return M > 0
-
-
-def _positive(name: str, value: Any) -> float:
-    real = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
-    if not (real and value > 0):
-        raise InputError(f"{name} must be a positive number of seconds; got {value!r}")
-    return float(value)
 
 
 def _source_components(S: np.ndarray, sigma: np.ndarray) -> _Pair | None:
