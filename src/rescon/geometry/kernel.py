@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import InputError
 from .emptiness import empty_certificate, empty_from_halfspaces
-from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact
+from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact, solve_exact
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .polytope import ExactPolytope, clip_to_fixpoint
@@ -176,10 +176,35 @@ def _ambient(hull: AffineHull, d: int, a: tuple[int, ...], b: int, scale: int
     return tuple(full), Fraction(b, scale)
 
 
+def _along_hull(rows: list[tuple[tuple[Fraction, ...], Fraction]], eqs, v0
+                ) -> list[tuple[tuple[Fraction, ...], Fraction]]:
+    """Each row a·x ≤ b rewritten on aff Ψ = {x : E x = f} as a'·x ≤ b' with a' the
+    orthogonal projection of a onto the directions of aff Ψ, exactly:
+    a' = a − Eᵀc, (E Eᵀ) c = E a, b' = b − (a − a')·v0 (v0 ∈ aff Ψ), so a·x − b =
+    a'·x − b' on aff Ψ. A facet relative to a flat Ψ may have a normal nearly
+    orthogonal to Ψ; its float rounding would then no longer bound Ψ, a' does."""
+    if not eqs or not rows:
+        return rows
+    E = [a for a, _ in eqs]
+    gram = [[sum(map(operator.mul, g, h)) for h in E] for g in E]
+    out = []
+    for a, b in rows:
+        c = solve_exact(gram, [sum(map(operator.mul, g, a)) for g in E])
+        assert c is not None, "the kernel's equalities are independent"
+        p = tuple(aj - sum(ci * g[j] for ci, g in zip(c, E, strict=True))
+                  for j, aj in enumerate(a))
+        out.append((p, b - sum((aj - pj) * vj for aj, pj, vj in zip(a, p, v0, strict=True))))
+    return out
+
+
 def _unit_rows(rows: list[tuple[tuple[Fraction, ...], Fraction]], d: int
                ) -> tuple[np.ndarray, np.ndarray]:
+    """Float rows a/‖a‖, b/‖a‖ (each row first divided exactly by its largest |a_j|, so
+    the float conversion cannot overflow in a)."""
     if not rows:
         return np.zeros((0, d)), np.zeros(0)
+    rows = [(tuple(v / top for v in a), bb / top)
+            for a, bb in rows for top in (max(map(abs, a)),)]
     A = np.array([[float(v) for v in a] for a, _ in rows])
     b = np.array([float(v) for _, v in rows])
     norm = np.linalg.norm(A, axis=1)
@@ -248,7 +273,7 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     full = poly is not None and hull.dim == d and poly.dim() == d
     dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d, full)
     facets = _relative_facets(poly, ambient, dim) if poly is not None else []
-    A, b = _unit_rows(facets, d)
+    A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts[0]), d)
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
 
     def certificate() -> dict[str, Any]:
