@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..models.backends import silent_highs
+
 __all__ = ["Margin", "max_margin"]
 
 #: rows in the first partial LP, and at most this many added per round
@@ -55,8 +57,7 @@ def max_margin(A: np.ndarray, b: np.ndarray, w: np.ndarray, lo: np.ndarray,
 
     m, k = A.shape
     inf = highspy.kHighsInf
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
+    h = silent_highs()
     h.setOptionValue("presolve", "off")
     cost = np.zeros(k + 1)
     cost[k] = -1.0

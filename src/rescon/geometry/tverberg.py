@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, SolverError, TimeLimitReached
-from ..models.backends import require_backend
+from ..models.backends import require_backend, silent_highs
 
 __all__ = ["TverbergPartition", "tverberg_partition"]
 
@@ -257,8 +257,7 @@ def _model(X: np.ndarray, q: int):
 
     n, d = X.shape
     nz = n * q
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
+    h = silent_highs()
     # z_{i,p} = 0 for p > i (0-based: group p starts after the first indices of 0..p−1)
     upper = np.array([1.0 if p <= i else 0.0 for i in range(n) for p in range(q)])
     lower = np.zeros(nz)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SolverError
-from ..models.backends import require_backend
+from ..models.backends import require_backend, silent_highs
 from .indexed import IndexedGraph
 
 __all__ = ["MilpOutcome", "RobustnessMilp", "milp_min_cost"]
@@ -101,8 +101,7 @@ class RobustnessMilp:
         rows = _rows(ig, r, self.with_y)
         if self.with_y:
             rows.append((float(lower), float(upper - 1), {2 * n + i: 1.0 for i in range(2 * n)}))
-        h = highspy.Highs()
-        h.setOptionValue("output_flag", False)
+        h = silent_highs()
         h.setOptionValue("mip_rel_gap", 0.0)
         if time_limit is not None:
             h.setOptionValue("time_limit", float(max(time_limit, 0.01)))

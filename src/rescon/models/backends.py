@@ -8,12 +8,15 @@ naming the backends that would do.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 from dataclasses import dataclass
+from typing import Any
 
 from ..errors import SolverNotFound
 
-__all__ = ["Backend", "BACKENDS", "STATUSES", "available_backends", "require_backend"]
+__all__ = ["BACKENDS", "STATUSES", "Backend", "available_backends", "require_backend",
+           "silent_highs"]
 
 #: The shared status set every backend's native statuses map onto.
 STATUSES = ("optimal", "infeasible", "time_limit", "error")
@@ -77,3 +80,31 @@ def require_backend(name: str, capability: str) -> Backend:
             f"{ok or 'none'}"
         )
     return b
+
+
+def silent_highs() -> Any:
+    """A new ``highspy.Highs`` that never writes to stdout: every HiGHS model rescon
+    builds comes from here.
+
+    HiGHS logs its banner ("Running HiGHS …", C-level stdout) at the first method call
+    on an instance while ``output_flag`` is true; in highspy 1.16 that call is the
+    wrapper's own ``enableCallbacks()`` inside ``Highs.__init__``, so setting the option
+    after construction is too late. The subclass turns the output off inside that
+    first call, before anything is logged; the option is set again afterwards in case
+    a highspy version constructs differently.
+    """
+    h = _silent_highs_class()()
+    h.setOptionValue("output_flag", False)
+    return h
+
+
+@functools.cache
+def _silent_highs_class() -> type:
+    import highspy
+
+    class SilentHighs(highspy.Highs):  # type: ignore[misc]
+        def enableCallbacks(self) -> None:
+            self.setOptionValue("output_flag", False)
+            super().enableCallbacks()
+
+    return SilentHighs

@@ -42,7 +42,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import InputError, SolverError, SolverNotFound
-from .backends import available_backends, require_backend
+from .backends import available_backends, require_backend, silent_highs
 
 __all__ = ["chebyshev", "lp_backends", "project", "project_batch", "qp_backends"]
 
@@ -589,8 +589,8 @@ def _highs(s: _Standard) -> np.ndarray:
     import scipy.sparse as sps
 
     n, m = s.q.size, s.h.size
-    h = highspy.Highs()
-    for option, value in (("output_flag", False), ("primal_feasibility_tolerance", TOL),
+    h = silent_highs()
+    for option, value in (("primal_feasibility_tolerance", TOL),
                           ("dual_feasibility_tolerance", TOL), ("qp_regularization_value", 0.0)):
         h.setOptionValue(option, value)
     h.addVars(n, np.full(n, -highspy.kHighsInf), np.full(n, highspy.kHighsInf))

@@ -1,0 +1,69 @@
+"""The output contract (issue 10 §6): stdout carries results only.
+
+HiGHS prints its banner once per process, so every check runs a fresh interpreter.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+#: one API call per place a HiGHS model is built (each in its own process)
+API_CALLS = {
+    "margin LP (empty kernel)":
+        "rescon.safe_kernel(np.random.default_rng(0).normal(size=(6, 2)), 3)",
+    "robustness MILP":
+        "rescon.robustness(nx.gnp_random_graph(12, 0.5, seed=1, directed=True),"
+        " method='milp')",
+    "Tverberg MILP":
+        "rescon.tverberg_partition(np.random.default_rng(1).normal(size=(7, 2)), 3)",
+    "kernel QP on highs":
+        "rescon.safe_kernel([[0, 0], [1, 0], [1, 1], [0, 1], [0.3, 0.6]], 1)"
+        ".point('project', backend='highs')",
+}
+
+
+def _python(code: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], check=False,
+                          capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.parametrize("call", list(API_CALLS))
+def test_api_writes_nothing_to_stdout(call):
+    proc = _python(f"import numpy as np, networkx as nx, rescon\n{API_CALLS[call]}\n")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "", proc.stdout
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "rescon.cli", *args], check=False,
+                          capture_output=True, text=True, timeout=300)
+
+
+def _one_json_object(proc: subprocess.CompletedProcess) -> dict:
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert len(lines) == 1, proc.stdout
+    data = json.loads(lines[0])
+    assert isinstance(data, dict)
+    return data
+
+
+def test_cli_kernel_json_is_one_object(tmp_path):
+    pts = tmp_path / "p.csv"
+    pts.write_text("0,0\n1,0\n0,1\n1,1\n2,3\n-1,2\n")
+    assert _one_json_object(_cli("kernel", str(pts), "--F", "3", "--json"))["empty"] is True
+
+
+def test_cli_robustness_milp_json_is_one_object(tmp_path):
+    import networkx as nx
+
+    G = nx.gnp_random_graph(12, 0.5, seed=1, directed=True)
+    g = tmp_path / "g.edgelist"
+    g.write_text("".join(f"{u} {v}\n" for u, v in G.edges()))
+    data = _one_json_object(_cli("robustness", str(g), "--method", "milp", "--json"))
+    assert data["exact"] is True and data["method"] == "milp"
