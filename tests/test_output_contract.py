@@ -10,7 +10,12 @@ import subprocess
 import sys
 import textwrap
 
+import networkx as nx
+import numpy as np
 import pytest
+
+from rescon.consensus.adversaries import Behaviour
+from rescon.errors import InputError
 
 #: one API call per place a HiGHS model is built (each in its own process)
 API_CALLS = {
@@ -67,3 +72,35 @@ def test_cli_robustness_milp_json_is_one_object(tmp_path):
     g.write_text("".join(f"{u} {v}\n" for u, v in G.edges()))
     data = _one_json_object(_cli("robustness", str(g), "--method", "milp", "--json"))
     assert data["exact"] is True and data["method"] == "milp"
+
+
+# --------------------------------------------------------------------------- #
+# the engine checks what a behaviour returns
+# --------------------------------------------------------------------------- #
+
+
+class _Shaped(Behaviour):
+    """Returns one array of a given shape whatever the receivers."""
+
+    def __init__(self, shape):
+        self.shape = shape
+
+    def messages(self, sender, receivers, view):
+        return np.full(self.shape, 5.0)
+
+    def to_dict(self):
+        return {}
+
+
+@pytest.mark.parametrize("shape", [(1, 2), (2,), (3, 2, 1)])
+def test_engine_refuses_a_message_of_the_wrong_shape(shape):
+    from rescon.consensus.engine import simulate
+    from rescon.consensus.scenario import Scenario
+    from rescon.graphs.generators import circulant
+
+    G = nx.relabel_nodes(circulant(8, 4), {v: f"a{v}" for v in range(8)})
+    x0 = np.random.default_rng(0).uniform(0, 1, size=(8, 2))
+    sc = Scenario(graph=G, x0=x0, F=1, adversaries={"a3": _Shaped(shape)}, steps=3,
+                  check_robustness=False)
+    with pytest.raises(InputError, match=r"adversary 'a3'.*shape"):
+        simulate(sc)

@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry.kernel import safe_kernel
-from .adversaries import StepView
+from .adversaries import StepView, adversary_messages
 from .dos import blocked_mask
 from .metrics import ValidityMonitor, diameter, spread
 from .scenario import Scenario
@@ -47,7 +48,6 @@ class _Links:
         n = len(nodes)
         self.start = np.searchsorted(self.recv, np.arange(n + 1))
         self.in_nbrs = [self.send[self.start[i]:self.start[i + 1]] for i in range(n)]
-        self.out_nbrs = {j: self.recv[self.send == j] for j in range(n)}
 
 
 def simulate(scenario: Scenario, *, progress: bool | None = None) -> Trajectory:
@@ -122,11 +122,13 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
         view = StepView(k=k, t=t, states=x, benign=benign_mask, in_neighbours=links.in_nbrs,
                         rng=rng)
         for a in sorted(adv_idx):  # a fixed order: random draws do not depend on dicts
-            beh = adv_idx[a]
             rows = np.flatnonzero(links.send == a)
             if not len(rows):
                 continue
-            msgs = np.asarray(beh.messages(a, links.recv[rows], view), dtype=np.float64)
+            try:  # one (len(rows), d) array: never broadcast to every receiver
+                msgs = adversary_messages({a: adv_idx[a]}, {a: links.recv[rows]}, view)[a]
+            except InputError as exc:
+                raise InputError(f"adversary {sc.nodes[a]!r}: {exc}") from None
             values[rows] = msgs
             finite = msgs[np.isfinite(msgs).all(axis=1)]
             sent[a] = finite.mean(axis=0) if len(finite) else np.full(d, np.nan)
@@ -155,11 +157,9 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     starved: list[int] = []
     problems: list[np.ndarray] = []
     where: list[tuple[int, int, int]] = []  # (row, p, 0 = y / 1 = z)
-    received = []
     for r, i in enumerate(benign):
         sl = slice(links.start[i], links.start[i + 1])
         X = values[sl][usable[sl]]
-        received.append(X)
         if sc.algorithm in ("alg1", "kernel") and len(X) < m:
             starved.append(r)
             aux[r] = x[i]
