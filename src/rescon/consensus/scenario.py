@@ -4,8 +4,11 @@ Build one in Python (:class:`Scenario`), from a TOML file (:meth:`Scenario.from_
 format in the README) or take the paper's example (:meth:`Scenario.paper_example`,
 SPEC §5). Inputs are validated once, here; assumptions of the paper's theorems that
 the scenario violates (Assumption 2, the F-local / F-total model, ((d+1)F+1)-
-robustness) are reported as :class:`ScenarioWarning` with their witnesses — the
-run still goes ahead, because showing what happens then is the point.
+robustness for F-local and (dF+1, F+1)-robustness for F-total, Assumption 3 on the
+DoS attacks, benign agents whose in-links are all blocked for the whole run) are
+reported as :class:`ScenarioWarning` with their witnesses, and conditions that could
+not be decided are reported as such, with what is known — the run still goes ahead,
+because showing what happens then is the point.
 """
 
 from __future__ import annotations
@@ -31,6 +34,11 @@ POLICIES = ("hold", "zero", "drop")
 ALGORITHMS = ("alg1", "kernel", "wmsr", "mean")
 CENTRES = ("box", "mean")
 KERNEL_POINTS = ("project", "project-exact", "vertex-mean")
+#: seconds the robustness condition of the theorems may take before it is reported as
+#: not decided (with bounds)
+ROBUSTNESS_SECONDS = 5.0
+_BOUNDS_SECONDS = 0.01  # rescon.robustness past this: the polynomial bounds only
+_DOS_CHUNK = 4096  # update times per blocked-mask block in the cut-off check
 
 
 class ScenarioWarning(UserWarning):
@@ -206,7 +214,8 @@ class Scenario:
     # ------------------------------------------------------------------ #
 
     def assumptions(self) -> list[str]:
-        """The theorem assumptions this scenario violates, each with its witness."""
+        """The theorem assumptions this scenario violates, each with its witness, and
+        the ones that could not be decided, each with what is known."""
         from ..graphs.attacks import check_assumption2, check_attack_model
 
         out = []
@@ -218,15 +227,79 @@ class Scenario:
         if not am.holds:
             out.append(f"the adversaries are not F-{self.model} (F = {self.F}): "
                        f"{list(am.violations)[:5]}")
-        if self.check_robustness and self.graph.number_of_nodes() <= 64:
-            from ..graphs.robustness import is_r_robust
-
-            r = (self.d + 1) * self.F + 1
-            res = is_r_robust(self.graph, r, time_limit=5.0)
-            if res.holds is False:
-                out.append(f"the graph is not {r}-robust (= (d+1)F+1) as the theorems need; "
-                           f"witness S1 = {sorted(res.witness[0])}, S2 = {sorted(res.witness[1])}")
+        if self.check_robustness:
+            out.extend(self._robustness_problems())
+        if self.dos:
+            out.extend(self._dos_problems())
         return out
+
+    def _robustness_problems(self) -> list[str]:
+        """The graph condition of the theorems: ((d+1)F+1)-robust for the F-local model,
+        (dF+1, F+1)-robust for the F-total one. Decided by :func:`is_rs_robust` within
+        :data:`ROBUSTNESS_SECONDS` at any N; when that stops undecided, the polynomial
+        bounds r_lower ≤ ρ(G) ≤ r_upper of :func:`rescon.robustness` are reported
+        (r-robust ⇒ (r', s)-robust for r' + s − 1 ≤ r, so ρ ≥ r + s − 1 would settle it)."""
+        from ..graphs.robustness import is_rs_robust, robustness
+
+        d, F = self.d, self.F
+        if self.model == "local":
+            r, s, need = (d + 1) * F + 1, 1, f"{(d + 1) * F + 1}-robust (= (d+1)F+1)"
+        else:
+            r, s, need = d * F + 1, F + 1, f"({d * F + 1}, {F + 1})-robust (= (dF+1, F+1))"
+        res = is_rs_robust(self.graph, r, s, time_limit=ROBUSTNESS_SECONDS)
+        if res.holds:
+            return []
+        if res.holds is False:
+            return [(f"the graph is not {need} as the theorems need for the F-{self.model} "
+                     f"model; witness S1 = {sorted(res.witness[0])}, "
+                     f"S2 = {sorted(res.witness[1])}")]
+        rep = robustness(self.graph, time_limit=_BOUNDS_SECONDS, progress=False)
+        return [(f"not decided within {ROBUSTNESS_SECONDS:g} s whether the graph is {need} "
+                 f"as the theorems need for the F-{self.model} model: {rep.r_lower} <= "
+                 f"rho(G) <= {rep.r_upper} (rho >= {r + s - 1} suffices, rho < {r} fails)")]
+
+    def _dos_problems(self) -> list[str]:
+        """Assumption 3 for some T_d > 1, μ_d > 0 (it holds iff the long-run blocked
+        fraction of Π_D is below 1, :func:`check_assumption3`), and benign agents whose
+        in-links are all blocked at every update t_k = kT, k < steps."""
+        from .dos import check_assumption3
+
+        out = []
+        horizon = self.steps * self.T
+        a3 = check_assumption3(self.dos, horizon, T_d=math.inf)
+        if a3.any_T_d_works is False:
+            w = a3.witness
+            seen = (f"; on [0, {horizon:g}] s: [{w.t1:g}, {w.t2:g}] s holds {w.blocked:g} s "
+                    "blocked" if w is not None else "")
+            out.append("Assumption 3 fails: the DoS attacks block links for a long-run "
+                       f"fraction {a3.long_run_fraction} of the time, so no T_d > 1, "
+                       f"mu_d > 0 bound |Pi_D(t1, t2)| <= mu_d + (t2 - t1)/T_d{seen}")
+        elif a3.any_T_d_works is None:
+            out.append(f"Assumption 3 not decided: {' '.join(a3.notes)}")
+        cut = self._cut_off_agents()
+        if cut:
+            out.append("DoS blocks every in-link of benign agents at every update "
+                       f"(t_k = kT, k < {self.steps}): {cut[:5]}")
+        return out
+
+    def _cut_off_agents(self) -> list[Hashable]:
+        """Benign agents all of whose in-links are blocked at every update time."""
+        from .dos import blocked_mask_series
+
+        links = [(i, j) for j, i in self.graph.edges if i != j]
+        index = {link: k for k, link in enumerate(links)}
+        always = np.full(len(links), self.steps > 0)
+        for k0 in range(0, self.steps, _DOS_CHUNK):
+            ts = np.arange(k0, min(k0 + _DOS_CHUNK, self.steps)) * self.T
+            always &= blocked_mask_series(self.dos, index, ts).all(axis=0)
+            if not always.any():
+                return []
+        cut = []
+        for i in self.benign:
+            ins = [index[(i, j)] for j in self.graph.predecessors(i) if j != i]
+            if ins and always[ins].all():
+                cut.append(i)
+        return cut
 
     def warn(self) -> list[str]:
         """Issue a ScenarioWarning for every violated assumption; returns them."""
