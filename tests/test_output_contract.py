@@ -104,3 +104,49 @@ def test_engine_refuses_a_message_of_the_wrong_shape(shape):
                   check_robustness=False)
     with pytest.raises(InputError, match=r"adversary 'a3'.*shape"):
         simulate(sc)
+
+
+# --------------------------------------------------------------------------- #
+# time-limited robustness: r_max never poses as rho, method says what ran
+# --------------------------------------------------------------------------- #
+
+
+def _undecided(monkeypatch):
+    """Every exact decision of r-robustness stops at the time limit."""
+    import rescon.graphs.robustness as rb
+
+    monkeypatch.setattr(rb, "_decide_r", lambda *a, **kw: rb._Decision(None, method="search"))
+
+
+def test_unsettled_rho_is_not_reported_as_r_max(monkeypatch):
+    import rescon
+
+    G = nx.gnp_random_graph(30, 0.5, directed=True, seed=3)
+    _undecided(monkeypatch)
+    rep = rescon.robustness(G, time_limit=5)
+    assert not rep.exact and rep.r_lower < rep.r_upper
+    assert rep.r_max is None and rep.s_max is None
+    assert rep.method == "search"
+
+
+def test_cli_unsettled_rho_json(monkeypatch, tmp_path, capsys):
+    from rescon.cli import main
+
+    g = tmp_path / "er.edgelist"
+    G = nx.gnp_random_graph(30, 0.5, directed=True, seed=3)
+    g.write_text("".join(f"{u} {v}\n" for u, v in G.edges()))
+    _undecided(monkeypatch)
+    assert main(["robustness", str(g), "--time-limit", "5", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["exact"] is False and data["r_max"] is None and data["s_max"] is None
+    assert data["r_lower"] < data["r_upper"] and data["method"] == "search"
+
+
+def test_method_names_the_s_star_search_that_timed_out():
+    import rescon
+    from rescon.graphs.generators import circulant
+
+    rep = rescon.robustness(circulant(64, 6).to_directed(), time_limit=0.3)
+    assert rep.s_max is None and rep.s_lower < rep.s_upper  # s* cut by the time limit
+    assert rep.r_lower == rep.r_upper == rep.r_max == 6  # rho proven: r_max is rho
+    assert rep.method != "bounds", rep.method

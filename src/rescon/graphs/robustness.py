@@ -57,10 +57,11 @@ class RobustnessReport:
     Attributes
     ----------
     n : number of nodes.
-    r_max : ρ(G) when ``exact``; otherwise the proven lower bound ``r_lower``.
+    r_max : ρ(G) when it was proven (``r_lower == r_upper``); None when the time limit
+        stopped before ρ was settled (then ``r_lower ≤ ρ ≤ r_upper``).
     s_max : s*(r_max), or None when the time limit stopped before it was settled.
-    witness : (S1, S2) in node labels showing G is not (r_max + 1)-robust, or None
-        when r_max = ⌈n/2⌉ (no n-node graph is more robust).
+    witness : (S1, S2) in node labels showing G is not (r_upper + 1)-robust, or None
+        when r_upper = ⌈n/2⌉ (no n-node graph is more robust).
     s_witness : (S1, S2) showing G is not (r_max, s_max + 1)-robust, None if s_max = n;
         when only s* hit the time limit, the cheapest pair found (not (r_max, s_upper + 1)).
     lower_proof : how r_max was proven ("trivial", "degree", "complete",
@@ -68,14 +69,15 @@ class RobustnessReport:
     certificate : JSON-ready ``robustness`` certificate (certificates/FORMAT.md).
     exact : False only when ``time_limit`` cut the search; then ρ ∈ [r_lower, r_upper],
         and when ρ was settled but s*(ρ) was not, s*(ρ) ∈ [s_lower, s_upper].
-    method : the exact method that ran ("bounds" when the bounds met).
+    method : the exact methods that ran, whether or not they finished ("bounds" when
+        the bounds met; e.g. "search+milp": ρ by the search, s* by the MILP).
     seconds : wall time.
     s_lower, s_upper : proven bounds on s*(r_max) (both equal s_max when exact; None
         when ρ itself was not settled).
     """
 
     n: int
-    r_max: int
+    r_max: int | None
     s_max: int | None
     witness: LabelPair | None
     s_witness: LabelPair | None
@@ -537,7 +539,7 @@ def robustness(
     if not exact:
         cert = {**_head("robustness", ig), "exact": False, "r_lower": r_lower,
                 "r_upper": r_upper, "lower": lower, "upper_r": _upper_json(r_upper_pair)}
-        return RobustnessReport(n, r_lower, None, _labels(ig, r_upper_pair), None,
+        return RobustnessReport(n, None, None, _labels(ig, r_upper_pair), None,
                                 lower["method"], cert, False, r_lower, r_upper, used,
                                 time.perf_counter() - t0)
     rho = r_lower
@@ -545,6 +547,8 @@ def robustness(
         ss = _SStar(n, n, n, {"method": "trivial"}, None, "bounds")
     else:
         ss = _s_star(ig, rho, method, deadline, seeds, lower, candidates)
+    if ss.method != "bounds":
+        used = ss.method if used == "bounds" else f"{used}+{ss.method}"
     if ss.value is None:
         cert = {**_head("robustness", ig), "exact": False, "r_lower": rho, "r_upper": rho,
                 "lower": lower, "upper_r": _upper_json(r_upper_pair),
@@ -554,8 +558,6 @@ def robustness(
         return RobustnessReport(n, rho, None, _labels(ig, r_upper_pair), _labels(ig, ss.pair),
                                 lower["method"], cert, False, rho, rho, used,
                                 time.perf_counter() - t0, s_lower=ss.lower, s_upper=ss.upper)
-    if ss.method != "bounds":
-        used = ss.method if used == "bounds" else f"{used}+{ss.method}"
     cert = {**_head("robustness", ig), "exact": True, "r_max": rho, "s_max": ss.value,
             "lower": lower, "lower_s": None if ss.value == 1 else ss.proof,
             "upper_r": _upper_json(r_upper_pair),
