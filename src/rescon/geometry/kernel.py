@@ -18,9 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import EmptyKernel, InputError
 from .emptiness import empty_certificate, empty_from_halfspaces
-from .exact import AffineHull, ExactPoints, affine_hull, exact_points, nullspace_exact, solve_exact
+from .exact import (AffineHull, ExactPoints, affine_hull, exact_points, float_view,
+                    nullspace_exact, solve_exact)
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .polytope import ExactPolytope, clip_to_fixpoint
@@ -34,12 +35,24 @@ FAST_PATH_MIN_HALFSPACES = 60
 
 
 def check_points(X: Any, name: str = "X") -> np.ndarray:
-    """X as a finite float array (n, d), n ≥ 1, d ≥ 1, or InputError saying what came."""
+    """X as a finite float array (n, d), n ≥ 1, d ≥ 1, or InputError saying what came.
+
+    Every entry must be a float64 exactly: complex numbers, integers above 2^53 (or
+    Fractions, long doubles) that a float cannot hold are refused, not rounded — the
+    kernel is exact for the floats it is given, and its certificate states them."""
     try:
-        arr = np.array(X, dtype=np.float64)
+        raw = np.asarray(X)
+        complex_ = raw.dtype.kind == "c" or (raw.dtype == object and any(
+            isinstance(v, (complex, np.complexfloating)) for v in raw.flat))
+        arr = None if complex_ else np.array(raw, dtype=np.float64)
+    except OverflowError:
+        raise InputError(f"{name} has an entry outside the float64 range") from None
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name} must be a finite (n, d) array of numbers; got "
                          f"{type(X).__name__} that is not numeric ({exc})") from None
+    if arr is None:
+        raise InputError(f"{name} must be real; got complex entries")
+    _check_exact_floats(raw, arr, name)
     if arr.ndim != 2:
         raise InputError(f"{name} must be a finite (n, d) array; got shape {arr.shape}")
     n, d = arr.shape
@@ -52,6 +65,28 @@ def check_points(X: Any, name: str = "X") -> np.ndarray:
         raise InputError(f"{name} must be finite; got shape {arr.shape} with {nan} NaN and "
                          f"{int(bad.sum()) - nan} infinite entries")
     return arr
+
+
+def _check_exact_floats(raw: np.ndarray, arr: np.ndarray, name: str) -> None:
+    """InputError when a finite entry of ``raw`` is not exactly its float64 ``arr``
+    (integer dtypes: only |v| > 2^53 can differ; object: each entry as a Fraction)."""
+    kind = raw.dtype.kind
+    flat_raw, flat = raw.ravel(), arr.ravel()
+    if kind in "iu":
+        suspects = np.flatnonzero(np.abs(flat) >= 2.0**53)
+    elif kind == "f" and raw.dtype.itemsize > 8:
+        suspects = np.flatnonzero(np.isfinite(flat) & (flat.astype(raw.dtype) != flat_raw))
+    elif kind == "O":
+        suspects = np.flatnonzero(np.isfinite(flat))
+    else:
+        return
+    for i in suspects.tolist():
+        v = flat_raw[i]
+        if kind == "f" or Fraction(v) != Fraction(float(flat[i])):
+            text = str(v) if len(str(v)) <= 24 else f"{str(v)[:20]}… ({len(str(v))} chars)"
+            raise InputError(f"{name}[{i // arr.shape[-1]}, {i % arr.shape[-1]}] = {text} is "
+                             f"not exactly a float64 (it would be rounded); give floats, "
+                             f"or integers of magnitude at most 2^53")
 
 
 def check_F(F: Any, n: int) -> int:
@@ -300,7 +335,8 @@ def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
 
 def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     """Ψ in the pivot coordinates (scaled integers): the bounding box clipped by
-    every valid halfspace."""
+    every valid halfspace. The float filters see the points in units chosen by
+    :func:`.exact.float_view` (magnitudes ≤ 2^32 at any scale of the data)."""
     index: dict[tuple[int, ...], int] = {}
     weights: list[int] = []
     rows: list[tuple[int, ...]] = []
@@ -313,8 +349,8 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
             weights.append(0)
             first.append(i)
         weights[j] += 1
-    Yf = np.array([[float(r) / P.scale for r in y] for y in rows], dtype=np.float64)
-    H = valid_halfspaces(Yf, rows, np.array(weights), F)
+    Yf, unit, exact_view = float_view(rows, P.scale)
+    H = valid_halfspaces(Yf, rows, np.array(weights), F, exact_view)
     lo = [min(y[j] for y in rows) for j in range(hull.dim)]
     hi = [max(y[j] for y in rows) for j in range(hull.dim)]
     first = np.flatnonzero(H.outside == F)
@@ -326,11 +362,11 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
         if empty is not None:
             return empty
     if hull.dim >= 2 and len(H) >= FAST_PATH_MIN_HALFSPACES:
-        fast = certified_kernel(H, hull.dim, P.scale, first)
+        fast = certified_kernel(H, hull.dim, unit, first)
         if fast is not None:
             return fast
-    poly = ExactPolytope.box(lo, hi)
-    clip_to_fixpoint(poly, H, P.scale, first=first)
+    poly = ExactPolytope.box(lo, hi, unit)
+    clip_to_fixpoint(poly, H, unit, first=first)
     return poly
 
 
@@ -427,8 +463,40 @@ def kernel_point(X: Any, F: Any, *, method: str = "project", backend: str = "aut
     return safe_kernel(X, F).point(method, backend=backend, target=target)
 
 
-def kernel_points(batch: Any, F: Any, *, method: str = "project", backend: str = "auto"
-                  ) -> np.ndarray:
+#: what :func:`kernel_points` does with an empty kernel
+ON_EMPTY = ("raise", "nan")
+
+
+def kernel_points(batch: Any, F: Any, *, method: str = "project", backend: str = "auto",
+                  on_empty: str = "raise") -> np.ndarray:
     """:func:`kernel_point` for many point sets at once: ``batch`` is (B, n, d) or a
-    list of (n_i, d) arrays; returns the (B, d) points (certificates are dropped)."""
-    return np.array([kernel_point(X, F, method=method, backend=backend)[0] for X in batch])
+    list of (n_i, d) arrays of one dimension d; returns the (B, d) points (certificates
+    are dropped).
+
+    ``on_empty``: ``"raise"`` — an empty Ψ(batch[i], F) raises EmptyKernel naming i;
+    ``"nan"`` — its row is NaN and the others are computed (``np.isnan(out[:, 0])``
+    is the mask of the empty ones). A malformed item, or one whose dimension differs
+    from batch[0]'s, is an InputError naming it."""
+    if on_empty not in ON_EMPTY:
+        raise InputError(f"on_empty must be one of {', '.join(ON_EMPTY)}; got {on_empty!r}")
+    try:
+        items = list(batch)
+    except TypeError:
+        raise InputError(f"batch must be a (B, n, d) array or a list of (n, d) arrays; got "
+                         f"{type(batch).__name__}") from None
+    if not items:
+        raise InputError("batch must hold at least one point set; got none")
+    sets = [check_points(X, name=f"batch[{i}]") for i, X in enumerate(items)]
+    d = sets[0].shape[1]
+    for i, X in enumerate(sets):
+        if X.shape[1] != d:
+            raise InputError(f"batch[{i}] has dimension {X.shape[1]}, batch[0] has {d}: "
+                             f"every point set of a batch must have the same dimension")
+    out = np.full((len(sets), d), np.nan)
+    for i, X in enumerate(sets):
+        try:
+            out[i] = kernel_point(X, F, method=method, backend=backend)[0]
+        except EmptyKernel as exc:
+            if on_empty == "raise":
+                raise EmptyKernel(f"batch[{i}]: {exc}") from None
+    return out
