@@ -8,11 +8,15 @@ integer arithmetic.  Node sets are Python-int bitmasks (bit i = node i).
 Usage::
 
     python certificates/check.py CERT.json
-        exit 0  valid        (prints "valid", plus "accepted on trust: ..." if any)
-        exit 1  invalid      ("invalid: <reason>" on stderr)
+        exit 0  valid        every part verified (prints "valid")
+        exit 1  invalid      a part is refuted or malformed ("invalid: <reason>" on stderr)
         exit 2  unreadable   ("unreadable: <reason>" on stderr)
+        exit 3  unchecked    well-formed and nothing refuted, but some part was taken on
+                             trust or exceeds the checker's limits (prints "unchecked" and
+                             one "not checked: <part>" line per part)
 
-API: ``check(cert) -> CheckResult(valid, reason, trusted)`` and ``main(argv) -> int``.
+API: ``check(cert) -> CheckResult(valid, reason, trusted, unchecked)`` (``.verdict`` is
+"valid", "invalid" or "unchecked") and ``main(argv) -> int``.
 
 JSON arrays may also be given as Python tuples when ``check`` is called directly.
 """
@@ -20,30 +24,57 @@ JSON arrays may also be given as Python tuples when ``check`` is called directly
 from __future__ import annotations
 
 import json
-from fractions import Fraction
+import math
 import sys
+from fractions import Fraction
 from dataclasses import dataclass
 from typing import Any, Callable
 
-__all__ = ["CheckResult", "check", "main", "FORMAT_VERSION", "MAX_ENUM_N", "MAX_N"]
+__all__ = ["CheckResult", "check", "load", "main", "EXIT_CODES", "FORMAT_VERSION", "MAX_ENUM_N",
+           "MAX_N", "VERDICTS"]
 
 FORMAT_VERSION = 1
 MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
 MAX_N = 1_000_000  # resource limit on graph / matrix size
 
 
+VERDICTS = ("valid", "invalid", "unchecked")
+EXIT_CODES = {"valid": 0, "invalid": 1, "unchecked": 3}  # 2: unreadable
+
+
 @dataclass(frozen=True)
 class CheckResult:
-    """Outcome of :func:`check`.
+    """Outcome of :func:`check`: one of three verdicts (``.verdict``).
 
-    ``valid``: the certificate proves its claim (possibly relying on ``trusted``).
-    ``reason``: what was proved, or why the certificate is invalid.
-    ``trusted``: proof methods accepted without re-verification (e.g. ``("milp",)``).
+    * ``"valid"`` (``valid`` True, exit 0): every part of the certificate was verified
+      in exact arithmetic; ``trusted`` and ``unchecked`` are empty.
+    * ``"invalid"`` (exit 1): a part is malformed or refuted; ``reason`` says which.
+    * ``"unchecked"`` (exit 3): well-formed and nothing refuted, but some part was taken
+      on trust (e.g. a ``milp`` proof on n > 20 nodes) or exceeds the checker's limits
+      (size, work, bit size). ``unchecked`` names those parts and ``trusted`` their
+      short names (proof methods such as ``"milp"``, or limits such as
+      ``"vertex enumeration"``). Never reported as valid, never as invalid.
+
+    ``valid`` is True only for the first verdict, so ``bool(result)`` means "proved".
+    ``reason``: what was proved (valid), why not (invalid), or what was shown apart
+    from the unchecked parts.
     """
 
     valid: bool
     reason: str
     trusted: tuple[str, ...] = ()
+    unchecked: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.valid and (self.trusted or self.unchecked):
+            raise ValueError("a valid CheckResult has no trusted or unchecked parts")
+
+    @property
+    def verdict(self) -> str:
+        """"valid", "invalid" or "unchecked" (see the class docstring)."""
+        if self.valid:
+            return "valid"
+        return "unchecked" if self.unchecked else "invalid"
 
     def __bool__(self) -> bool:
         return self.valid
@@ -53,15 +84,29 @@ class Invalid(Exception):
     """Raised internally with the reason a certificate is invalid."""
 
 
+class Unchecked(Exception):
+    """Raised internally when a part that the rest depends on exceeds the checker's
+    limits: ``Unchecked(name, part)``; the verdict is "unchecked", never "invalid"."""
+
+    def __init__(self, name: str, part: str) -> None:
+        super().__init__(part)
+        self.name = name
+        self.part = part
+
+
 class _Ctx:
-    """Per-check state: proof methods accepted on trust."""
+    """Per-check state: the parts not verified (taken on trust or beyond a limit)."""
 
     def __init__(self) -> None:
         self.trusted: list[str] = []
+        self.unchecked: list[str] = []
 
-    def trust(self, method: str) -> None:
-        if method not in self.trusted:
-            self.trusted.append(method)
+    def trust(self, name: str, part: str) -> None:
+        """Record that ``part`` was not verified; ``name`` is its short name."""
+        if name not in self.trusted:
+            self.trusted.append(name)
+        if part not in self.unchecked:
+            self.unchecked.append(part)
 
 
 # --------------------------------------------------------------------------- #
@@ -200,9 +245,18 @@ class Graph:
         return Graph(len(nodes), inmask, m)
 
 
+def _size(x: Any, where: str) -> int:
+    """A graph / matrix size n >= 1; beyond MAX_N the certificate is not read (unchecked)."""
+    n = _int(x, where, 1)
+    if n > MAX_N:
+        raise Unchecked("size limit", f"{where} = {n} exceeds the checker's limit of {MAX_N} "
+                        "nodes: the certificate was not read further")
+    return n
+
+
 def _graph(x: Any, where: str = "graph") -> Graph:
     _obj(x, where, ("n", "edges"), ("nodes",))
-    n = _int(x["n"], f"{where}.n", 1, MAX_N)
+    n = _size(x["n"], f"{where}.n")
     if "nodes" in x:
         labels = _array(x["nodes"], f"{where}.nodes")
         if len(labels) != n:
@@ -538,9 +592,47 @@ def _enumerate_or_fail(where: str, g: Graph, r: int, s: int) -> None:
 def _proof_enumeration(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
     _obj(p, where, ("method",))
     if g.n > MAX_ENUM_N:
-        raise Invalid(f"{where}: too large to enumerate (n={g.n}>{MAX_ENUM_N})")
+        return _unreplayed("enumeration", where, g, r, s, ctx,
+                           f"too large to enumerate (n = {g.n} > {MAX_ENUM_N})")
     _enumerate_or_fail(where, g, r, s)
     return "enumeration"
+
+
+def _cheap_pairs(g: Graph) -> list[tuple[int, int]]:
+    """Candidate violating pairs found in linear time (n >= 2):
+
+    * ({i}, V \\ {i}) for a node i of least in-degree: for r >= 2, V \\ {i} has no
+      r-reachable node, so (r, s)-robust with r >= 2 needs r <= min in-degree;
+    * ({i}, {j}) for the two nodes of least in-degree;
+    * a balanced split (first floor(n/2) nodes, the rest): no node of either half has
+      more than ceil(n/2) in-neighbours outside it, so it violates (ceil(n/2) + 1, s)
+      for every s (rho <= ceil(n/2)).
+    """
+    n = g.n
+    low = sorted(range(n), key=lambda i: g.inmask[i].bit_count())[:2]
+    i, j = low
+    half = (1 << (n // 2)) - 1
+    return [(1 << i, g.full ^ (1 << i)), (1 << i, 1 << j), (half, g.full ^ half)]
+
+
+def _refute_cheaply(where: str, g: Graph, r: int, s: int) -> None:
+    """Raise Invalid if a pair of :func:`_cheap_pairs` violates (r, s)."""
+    if g.n < 2:
+        return
+    for S1, S2 in _cheap_pairs(g):
+        if _pair_failure(g, r, s, S1, S2) is None:
+            raise Invalid(f"{where}: graph is not ({r}, {s})-robust: S1 = {_fmt(S1)}, "
+                          f"S2 = {_fmt(S2)} violate it (the checker's linear-time witness "
+                          "pairs refute even a proof it cannot replay)")
+
+
+def _unreplayed(method: str, where: str, g: Graph, r: int, s: int, ctx: _Ctx,
+                why: str) -> str:
+    """A proof the checker does not replay: it must still survive the linear-time witness
+    pairs (a violating pair refutes the claim); then it is recorded as not checked."""
+    _refute_cheaply(where, g, r, s)
+    ctx.trust(method, f"{where}: '{method}' proof of ({r}, {s})-robustness not checked: {why}")
+    return f"{method} (not checked)"
 
 
 def _info(p: dict, where: str) -> None:
@@ -552,8 +644,9 @@ def _enumerate_or_trust(method: str, where: str, g: Graph, r: int, s: int, ctx: 
     """A proof the checker cannot replay: re-verified by enumeration when n ≤ 20,
     otherwise accepted on trust (and reported)."""
     if g.n > MAX_ENUM_N:
-        ctx.trust(method)
-        return f"{method} (trusted)"
+        return _unreplayed(method, where, g, r, s, ctx,
+                           f"accepted on trust (n = {g.n} > {MAX_ENUM_N}, beyond the "
+                           "checker's own enumeration)")
     _enumerate_or_fail(where, g, r, s)
     return f"{method} (re-verified by enumeration)"
 
@@ -595,8 +688,6 @@ def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) ->
     if s != 1:
         raise Invalid(f"{where}: method 'spectral' proves r-robustness only (s = 1), got s = {s}")
     n = g.n
-    if n > MAX_SPECTRAL_N:
-        raise Invalid(f"{where}: too large for the exact spectral check (n={n}>{MAX_SPECTRAL_N})")
     if not isinstance(p["c"], str) or len(p["c"]) > 64 or \
             not all(ch in "0123456789/" for ch in p["c"]):
         raise Invalid(f"{where}.c must be a nonnegative rational string like \"13/4\" "
@@ -611,6 +702,10 @@ def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) ->
         for j in _bits(mk):
             if not g.inmask[j] >> i & 1:
                 raise Invalid(f"{where}: graph is not undirected: edge [{j}, {i}] has no reverse")
+    if n > MAX_SPECTRAL_N:
+        return _unreplayed("spectral", where, g, r, s, ctx,
+                           f"too large for the exact spectral check (n = {n} > "
+                           f"{MAX_SPECTRAL_N})")
     off = c / n + 1
     M = [[off - (1 if g.inmask[i] >> j & 1 else 0) for j in range(n)] for i in range(n)]
     for i in range(n):
@@ -798,7 +893,7 @@ def _kind_robustness(c: dict, ctx: _Ctx) -> str:
 
 def _support_rows(c: dict) -> tuple[int, list[int]]:
     """(n, row) with row[i] = mask of the j with a_ij > 0, validated."""
-    n = _int(c["n"], "n", 1, MAX_N)
+    n = _size(c["n"], "n")
     sup = _array(c["support"], "support")
     row = [0] * n  # row[i] = mask of the j with a_ij > 0
     for k, e in enumerate(sup):
@@ -884,6 +979,22 @@ def _source_components(n: int, pred: list[int]) -> int:
 MAX_SARYMSAKOV_ENUM_N = 12
 
 
+def _sarymsakov_unchecked(method: str, n: int, row: list[int], ctx: _Ctx, why: str) -> str:
+    """A Sarymsakov claim the checker does not verify. The linear-time witness first: two
+    rows i, j with one support entry each, in different columns, fail the condition
+    (V1 = {i}, V2 = {j}: I(V1), I(V2) disjoint and |I(V1) u I(V2)| = 2 <= 2)."""
+    single: dict[int, int] = {}  # column -> a row whose only entry it is
+    for i in range(n):
+        if row[i].bit_count() == 1:
+            single.setdefault(row[i], i)
+            if len(single) == 2:
+                i1, i2 = single.values()
+                raise Invalid(f"V1 = {{{i1}}}, V2 = {{{i2}}} fail the Sarymsakov condition "
+                              "(rows with one entry each, in different columns)")
+    ctx.trust(method, f"method '{method}' not checked: {why}")
+    return f"Sarymsakov ({method}: not checked)"
+
+
 def _kind_sarymsakov(c: dict, ctx: _Ctx) -> str:
     """The matrix is Sarymsakov. Method ``matching``: a permutation sigma with
     a_{u,sigma(u)} > 0; then I(V) ⊇ sigma(V), so a failing pair needs I(V_k) = sigma(V_k),
@@ -914,7 +1025,9 @@ def _kind_sarymsakov(c: dict, ctx: _Ctx) -> str:
         _obj(c, "certificate", _HEAD + ("method", "n", "support"))
         n, row = _support_rows(c)
         if n > MAX_SARYMSAKOV_ENUM_N:
-            raise Invalid(f"too large to enumerate (n={n}>{MAX_SARYMSAKOV_ENUM_N})")
+            return _sarymsakov_unchecked(
+                "enumeration", n, row, ctx,
+                f"too large to enumerate (n = {n} > {MAX_SARYMSAKOV_ENUM_N})")
         infl = [0] * (1 << n)  # I(V) for every V
         for V in range(1, 1 << n):
             low = V & -V
@@ -932,9 +1045,8 @@ def _kind_sarymsakov(c: dict, ctx: _Ctx) -> str:
         return f"the {n}x{n} matrix is Sarymsakov (enumeration)"
     if m == "min_cut":
         _obj(c, "certificate", _HEAD + ("method", "n", "support"))
-        _support_rows(c)
-        ctx.trust("min_cut")
-        return "Sarymsakov (min_cut: trusted)"
+        n, row = _support_rows(c)
+        return _sarymsakov_unchecked("min_cut", n, row, ctx, "accepted on trust")
     raise Invalid(f"certificate: unknown method '{m}' for kind 'sarymsakov'")
 
 
@@ -961,7 +1073,7 @@ def _kernel_kinds() -> dict[str, Callable[[dict, _Ctx], str]]:
         kernels = importlib.util.module_from_spec(spec)
         sys.modules[spec.name] = kernels
         spec.loader.exec_module(kernels)
-    return kernels.install(Invalid, _obj, _int, _array, _tname)
+    return kernels.install(Invalid, _obj, _int, _array, _tname, unchecked=Unchecked)
 
 
 KINDS.update(_kernel_kinds())
@@ -987,10 +1099,16 @@ def check(cert: Any) -> CheckResult:
             raise Invalid(f"unknown kind {kind!r}")
         what = fn(cert, ctx)
     except Invalid as e:
-        return CheckResult(False, str(e), ())
+        return CheckResult(False, str(e))
+    except Unchecked as e:
+        ctx.trust(e.name, e.part)
+        what = e.part
     except RecursionError:
-        return CheckResult(False, "proof nested too deeply", ())
-    return CheckResult(True, what, tuple(ctx.trusted))
+        return CheckResult(False, "proof nested too deeply")
+    if ctx.unchecked:
+        return CheckResult(False, f"not fully checked: {what}", tuple(ctx.trusted),
+                           tuple(ctx.unchecked))
+    return CheckResult(True, what)
 
 
 # --------------------------------------------------------------------------- #
@@ -1011,12 +1129,22 @@ def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not JSON")
 
 
+def _finite_float(text: str) -> float:
+    """A JSON number with a fraction or exponent, as a double; one beyond the double range
+    (``1e400``) is unreadable, exactly like ``Infinity``."""
+    x = float(text)
+    if not math.isfinite(x):
+        raise ValueError(f"the number {text[:40]} overflows a double: like Infinity, "
+                         "it is not a finite JSON number")
+    return x
+
+
 def load(path: str) -> dict:
     """Read a certificate file; raises ValueError/OSError if unreadable."""
     with open(path, "rb") as f:
         data = f.read()
     obj = json.loads(data.decode("utf-8"), object_pairs_hook=_no_duplicate_keys,
-                     parse_constant=_no_constant)
+                     parse_constant=_no_constant, parse_float=_finite_float)
     if not isinstance(obj, dict):
         raise ValueError(f"top level is a JSON {_tname(obj)}, not an object")
     return obj
@@ -1034,13 +1162,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f"unreadable: {path}: {e}", file=sys.stderr)
         return 2
     res = check(cert)
-    if not res.valid:
+    if res.verdict == "invalid":
         print(f"invalid: {res.reason}", file=sys.stderr)
         return 1
-    print("valid")
-    if res.trusted:
-        print(f"accepted on trust: {', '.join(res.trusted)}")
-    return 0
+    print(res.verdict)
+    for part in res.unchecked:
+        print(f"not checked: {part}")
+    return EXIT_CODES[res.verdict]
 
 
 if __name__ == "__main__":

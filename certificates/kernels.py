@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import re
+from bisect import bisect_left, bisect_right
 from collections.abc import Callable
 from fractions import Fraction
 from itertools import combinations
@@ -39,8 +40,11 @@ MAX_DIM = 8  # largest dimension d
 MAX_CONSTRAINTS = 10_000  # halfspaces / equalities / facets per certificate
 MAX_EVAL_WORK = 20_000_000  # (#constraints) * n, evaluating constraints at the points
 MAX_RATIONAL_CHARS = 100_000  # longest "p/q" string (exact vertex means get long)
-MAX_HALFSPACE_WORK = 3_000_000  # C(u, k) * (u + #test points) for (b); beyond: trusted
-MAX_POLY_WORK = 3_000_000  # vertex / ray enumeration of P; beyond: invalid
+MAX_HALFSPACE_WORK = 3_000_000  # C(u, k) * (u + #test points) for (b); beyond: unchecked
+MAX_POLY_WORK = 3_000_000  # vertex / ray enumeration of P; beyond: unchecked
+MAX_NUMBER_BITS = 16_384  # numerator / denominator of one input rational; beyond: unchecked
+MAX_SCALE_BITS = 32_768  # a common denominator (all points, or one constraint); beyond: unchecked
+WORD_BITS = 1_024  # integers up to this size count as one unit of work
 
 _HEAD = ("rescon_certificate", "kind")
 _RATIONAL = re.compile(r"-?[0-9]+(/[0-9]+)?")
@@ -49,6 +53,7 @@ Vec = tuple  # a point: tuple of Fractions (or ints after scaling)
 
 # strict-JSON helpers, bound to check.py's by install()
 Invalid: Any = None
+Unchecked: Any = None
 _obj: Any = None
 _int: Any = None
 _array: Any = None
@@ -56,10 +61,10 @@ _tname: Any = None
 
 
 def install(invalid: type, obj: Callable, int_: Callable, array: Callable,
-            tname: Callable) -> dict[str, Callable]:
-    """Bind check.py's helpers and exception class; return the kinds defined here."""
-    global Invalid, _obj, _int, _array, _tname
-    Invalid, _obj, _int, _array, _tname = invalid, obj, int_, array, tname
+            tname: Callable, *, unchecked: type) -> dict[str, Callable]:
+    """Bind check.py's helpers and exception classes; return the kinds defined here."""
+    global Invalid, Unchecked, _obj, _int, _array, _tname
+    Invalid, Unchecked, _obj, _int, _array, _tname = invalid, unchecked, obj, int_, array, tname
     return {
         "kernel_point": kind_kernel_point,
         "kernel_empty": kind_kernel_empty,
@@ -74,32 +79,44 @@ def install(invalid: type, obj: Callable, int_: Callable, array: Callable,
 
 def _rat(x: Any, where: str) -> Fraction:
     """A rational: a JSON integer, a finite JSON float (its exact binary value), or a
-    string "p/q" / "p" (p, q decimal integers, q > 0, optional leading '-')."""
+    string "p/q" / "p" (p, q decimal integers, q > 0, optional leading '-').  Numerators
+    and denominators beyond MAX_NUMBER_BITS bits exceed the checker's limits (unchecked)."""
     if isinstance(x, bool):
         raise Invalid(f"{where} must be a rational number, got boolean")
     if isinstance(x, int):
-        return Fraction(x)
+        return _bounded(Fraction(x), where)
     if isinstance(x, float):
         if not math.isfinite(x):
             raise Invalid(f"{where} = {x!r} is not a finite number")
         return Fraction(x)
     if isinstance(x, str):
-        if len(x) > MAX_RATIONAL_CHARS:
-            raise Invalid(f"{where} is a string of {len(x)} characters "
-                          f"(at most {MAX_RATIONAL_CHARS})")
         if not _RATIONAL.fullmatch(x):
             raise Invalid(f"{where} = {_short(repr(x))} is not a rational string like "
                           "\"-3/4\" or \"5\"")
         p, _, q = x.partition("/")
+        if len(x) > MAX_RATIONAL_CHARS:
+            raise _too_big(where, f"a string of {len(x)} characters")
         try:
             num, den = int(p), int(q) if q else 1
         except ValueError:  # beyond Python's limit on int-from-string digits
-            raise Invalid(f"{where} = {_short(repr(x))} has too many digits") from None
+            raise _too_big(where, "more decimal digits than Python converts") from None
         if den == 0:
             raise Invalid(f"{where} = {_short(repr(x))} has denominator 0")
-        return Fraction(num, den)
+        return _bounded(Fraction(num, den), where)
     raise Invalid(f"{where} must be a rational number (integer, finite number or "
                   f"\"p/q\" string), got {_tname(x)}")
+
+
+def _too_big(where: str, what: str) -> Exception:
+    return Unchecked("number size", f"{where} ({what}) exceeds the checker's limit of "
+                     f"{MAX_NUMBER_BITS} bits per numerator / denominator")
+
+
+def _bounded(t: Fraction, where: str) -> Fraction:
+    bits = max(t.numerator.bit_length(), t.denominator.bit_length())
+    if bits > MAX_NUMBER_BITS:
+        raise _too_big(where, f"a number of {bits} bits")
+    return t
 
 
 def _vec(x: Any, where: str, d: int) -> Vec:
@@ -115,7 +132,8 @@ def _points(c: dict) -> tuple[list[Vec], int]:
     if not arr:
         raise Invalid("points is empty (n >= 1 is required)")
     if len(arr) > MAX_POINTS:
-        raise Invalid(f"too large to check: n = {len(arr)} > {MAX_POINTS} points")
+        raise Unchecked("size limit", f"points: n = {len(arr)} exceeds the checker's limit "
+                        f"of {MAX_POINTS} points")
     d = len(_array(arr[0], "points[0]"))
     if not 1 <= d <= MAX_DIM:
         raise Invalid(f"points[0] has {d} coordinates: the dimension d must be 1..{MAX_DIM}")
@@ -126,7 +144,8 @@ def _constraints(x: Any, where: str, d: int) -> list[tuple[Vec, Fraction]]:
     """A list of {"a": [d rationals], "b": rational}."""
     _array(x, where)
     if len(x) > MAX_CONSTRAINTS:
-        raise Invalid(f"too large to check: {where} has {len(x)} entries > {MAX_CONSTRAINTS}")
+        raise Unchecked("size limit", f"{where}: {len(x)} entries exceed the checker's "
+                        f"limit of {MAX_CONSTRAINTS}")
     out = []
     for i, h in enumerate(x):
         w = f"{where}[{i}]"
@@ -173,15 +192,48 @@ def _fmti(idx: list[int], limit: int = 8) -> str:
 # --------------------------------------------------------------------------- #
 
 
-def _den_lcm(vectors: list[Vec]) -> int:
-    """Least common denominator of all coordinates."""
+def _den_lcm(vectors: list[Vec], limit: int | None = None) -> int:
+    """Least common denominator of all coordinates; 0 as soon as it has more than
+    ``limit`` bits (distinct large denominators make it grow without bound)."""
     D = 1
     for v in vectors:
         for t in v:
             q = t.denominator
             if D % q:
                 D = D // math.gcd(D, q) * q
+                if limit is not None and D.bit_length() > limit:
+                    return 0
     return D
+
+
+def _bit_size(rows: list[list[int]]) -> int:
+    """Largest bit length of an entry."""
+    return max((abs(t).bit_length() for r in rows for t in r), default=0)
+
+
+def _cost(work: int, bits: int) -> int:
+    """``work`` arithmetic steps on integers of ``bits`` bits, counted in steps on
+    WORD_BITS-bit integers (a product costs about the square of the size)."""
+    return work * max(1, -(-bits // WORD_BITS)) ** 2
+
+
+def _scaled_points(pts: list[Vec], ctx: Any, part: str) -> tuple[list[list[int]], int] | None:
+    """(D * p for every point, D) for the points' common denominator D, or None (and
+    ``part`` recorded as unchecked) when D has more than MAX_SCALE_BITS bits."""
+    D = _den_lcm(pts, MAX_SCALE_BITS)
+    if not D:
+        ctx.trust("bit size", f"{part}: the points' common denominator exceeds the "
+                  f"checker's limit of {MAX_SCALE_BITS} bits")
+        return None
+    return _scaled(pts, D), D
+
+
+def _scaled_test(x: Vec, D: int) -> tuple[list[int], int]:
+    """(X, e) with integers X, e > 0 and D * x = X / e: a test point in the coordinates of
+    the points scaled by D, with a denominator of its own."""
+    y = [t * D for t in x]
+    e = _den_lcm([y])
+    return _scaled([y], e)[0], e
 
 
 def _scaled(vectors: list[Vec], D: int) -> list[list[int]]:
@@ -317,17 +369,35 @@ def _solve(rows: list[list[int]], rhs: list[int]) -> Vec | None:
 # --------------------------------------------------------------------------- #
 
 
-def _check_work(m: int, n: int) -> None:
-    if m * n > MAX_EVAL_WORK:
-        raise Invalid(f"too large to check: {m} constraints x {n} points > {MAX_EVAL_WORK}")
+def _valid_for_psi(E: list[tuple[Vec, Fraction]], ewhere: str, H: list[tuple[Vec, Fraction]],
+                   hwhere: str, pts: list[Vec], F: int, ctx: Any) -> None:
+    """Fact (a): every equality of E holds at every point and every halfspace of H has at
+    most F points strictly outside.  Costs #constraints x n products of scaled integers;
+    beyond MAX_EVAL_WORK (weighted by bit size, :func:`_cost`) or when the points' common
+    denominator is too large, the part is recorded as unchecked."""
+    part = f"{ewhere} and {hwhere} contain the kernel"
+    sp = _scaled_points(pts, ctx, part)
+    if sp is None:
+        return
+    P, D = sp
+    Ei = [_int_constraint(a, b) for a, b in E]
+    Hi = [_int_constraint(a, b) for a, b in H]
+    bits = max(_bit_size(P), _bit_size([a + [b] for a, b in Ei + Hi]) + D.bit_length())
+    work = _cost(len(Ei + Hi) * len(P), bits)
+    if work > MAX_EVAL_WORK:
+        ctx.trust("constraint evaluation", f"{part}: evaluating {len(Ei + Hi)} constraints "
+                  f"at {len(P)} points ({bits}-bit numbers) needs work {work} > "
+                  f"{MAX_EVAL_WORK}")
+        return
+    _check_equalities(Ei, ewhere, P, D)
+    _check_halfspaces(Hi, hwhere, P, D, F)
 
 
-def _check_halfspaces(H: list[tuple[Vec, Fraction]], where: str, P: list[list[int]], D: int,
+def _check_halfspaces(H: list[tuple[list[int], int]], where: str, P: list[list[int]], D: int,
                       F: int) -> None:
-    """Each halfspace a·x <= b has at most F points strictly outside (fact (a)).
-    ``P`` = the points scaled by D (integers)."""
-    for i, (a, b) in enumerate(H):
-        A, B = _int_constraint(a, b)
+    """Each halfspace A·x <= B (integer rows) has at most F points strictly outside (fact
+    (a)). ``P`` = the points scaled by D (integers)."""
+    for i, (A, B) in enumerate(H):
         BD = B * D
         out = [j for j, p in enumerate(P) if _dot(A, p) > BD]
         if len(out) > F:
@@ -335,16 +405,34 @@ def _check_halfspaces(H: list[tuple[Vec, Fraction]], where: str, P: list[list[in
                           f"{_fmti(out)}), more than F = {F}: it need not contain the kernel")
 
 
-def _check_equalities(E: list[tuple[Vec, Fraction]], where: str, P: list[list[int]],
+def _check_equalities(E: list[tuple[list[int], int]], where: str, P: list[list[int]],
                       D: int) -> None:
-    """Each equality a·x = b holds at every point (so it contains conv(X) ⊇ Psi)."""
-    for i, (a, b) in enumerate(E):
-        A, B = _int_constraint(a, b)
+    """Each equality A·x = B (integer rows) holds at every point (so it contains
+    conv(X) ⊇ Psi)."""
+    for i, (A, B) in enumerate(E):
         BD = B * D
         for j, p in enumerate(P):
             if _dot(A, p) != BD:
                 raise Invalid(f"{where}[{i}] does not hold at points[{j}] "
-                              f"(a·p != b = {_fq(b)})")
+                              f"(a·p != b = {_fq(Fraction(B, 1))} after scaling)")
+
+
+def _refute_by_axes(pts: list[Vec], F: int, tests: list[Vec], names: list[str]) -> None:
+    """A necessary condition for x ∈ Psi that costs one sort per coordinate: Tukey depth
+    >= F + 1, so each closed halfspace {y_j >= x_j}, {y_j <= x_j} holds >= F + 1 points.
+    Raises Invalid naming the first test point and coordinate that fail.  (Catches, e.g.,
+    a corner of the bounding box, or any x when F = n - 1 and the points differ.)"""
+    n = len(pts)
+    for j in range(len(pts[0])):
+        col = sorted(p[j] for p in pts)
+        for x, name in zip(tests, names):
+            above = n - bisect_left(col, x[j])  # points with y_j >= x_j
+            below = bisect_right(col, x[j])  # points with y_j <= x_j
+            for count, rel in ((above, ">="), (below, "<=")):
+                if count <= F:
+                    raise Invalid(f"{name} is not in the safe kernel: the closed halfspace "
+                                  f"y[{j}] {rel} {_fq(x[j])} holds only {count} <= F = {F} "
+                                  f"points, so its Tukey depth is at most {count}")
 
 
 # --------------------------------------------------------------------------- #
@@ -353,10 +441,11 @@ def _check_equalities(E: list[tuple[Vec, Fraction]], where: str, P: list[list[in
 
 
 def _violated_halfspace(Q: list[list[int]], W: list[int], F: int,
-                        T: list[list[int]]) -> tuple[tuple[int, ...], int, int] | None:
-    """First (subset, #outside, t) such that T[t] is strictly outside a halfspace bounded
-    by the hyperplane through the k affinely independent points Q[subset] with at most
-    F points (counted with multiplicity W) strictly outside; None if there is none."""
+                        T: list[tuple[list[int], int]]) -> tuple[tuple[int, ...], int, int] | None:
+    """First (subset, #outside, t) such that the test point T[t] = (X, e), i.e. X / e, is
+    strictly outside a halfspace bounded by the hyperplane through the k affinely
+    independent points Q[subset] with at most F points (counted with multiplicity W)
+    strictly outside; None if there is none."""
     k = len(Q[0])
     if k == 1:
         return _violated_interval(Q, W, F, T)
@@ -379,18 +468,18 @@ def _violated_halfspace(Q: list[list[int]], W: list[int], F: int,
             if plus > F and minus > F:
                 break
         if plus <= F:
-            for t, x in enumerate(T):
-                if _dot(a, x) > b:
+            for t, (x, e) in enumerate(T):
+                if _dot(a, x) > b * e:
                     return sub, plus, t
         if minus <= F:
-            for t, x in enumerate(T):
-                if _dot(a, x) < b:
+            for t, (x, e) in enumerate(T):
+                if _dot(a, x) < b * e:
                     return sub, minus, t
     return None
 
 
 def _violated_interval(Q: list[list[int]], W: list[int], F: int,
-                       T: list[list[int]]) -> tuple[tuple[int, ...], int, int] | None:
+                       T: list[tuple[list[int], int]]) -> tuple[tuple[int, ...], int, int] | None:
     """k = 1 of :func:`_violated_halfspace` in O(u log u): "y >= q" is valid iff at most F
     points are < q, and these q form a prefix of the sorted values, so all of them are
     implied by the largest, lo; likewise "y <= q" by the smallest valid q, hi."""
@@ -407,31 +496,42 @@ def _violated_interval(Q: list[list[int]], W: list[int], F: int,
             break
         hi, above = i, seen
         seen += W[i]
-    for t, (x,) in enumerate(T):
-        if x < Q[lo][0]:
+    for t, ((x,), e) in enumerate(T):
+        if x < Q[lo][0] * e:
             return (lo,), below, t
-        if x > Q[hi][0]:
+        if x > Q[hi][0] * e:
             return (hi,), above, t
     return None
 
 
 def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[str],
-                          ctx: Any) -> str:
+                          ctx: Any, what: str) -> str:
     """Fact (b) for every test point; raises Invalid naming the first one not in Psi.
 
-    Everything is scaled by one common denominator (an affine bijection, which maps
-    Psi to Psi).  The enumeration of the C(u, k) hyperplanes through the u distinct
-    projected points costs C(u, k) * (u + #tests) (k = 1: u + #tests, by sorting);
-    beyond MAX_HALFSPACE_WORK that part is accepted on trust (aff(X) membership is
-    always checked)."""
+    The points are scaled by their common denominator D (an affine bijection, which maps
+    Psi to Psi); each test point keeps a denominator of its own (:func:`_scaled_test`),
+    so distinct test denominators never multiply.  The affine-hull test costs n·d²
+    products, the enumeration of the C(u, k) hyperplanes through the u distinct
+    projected points C(u, k) * (u + #tests) (k = 1: u + #tests, by sorting), both
+    weighted by bit size (:func:`_cost`); beyond MAX_EVAL_WORK, MAX_HALFSPACE_WORK or
+    MAX_SCALE_BITS the part ``what`` is recorded as unchecked."""
     d = len(pts[0])
-    D = _den_lcm(pts + tests)
-    P = _scaled(pts, D)
-    T = _scaled(tests, D)
+    part = f"{what} in the safe kernel (proof 'halfspaces')"
+    sp = _scaled_points(pts, ctx, part)
+    if sp is None:
+        return "halfspaces: not checked"
+    P, D = sp
+    T = [_scaled_test(x, D) for x in tests]
+    bits = max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
+    work = _cost(len(P) * d * d, bits)
+    if work > MAX_EVAL_WORK:
+        ctx.trust("halfspaces", f"{part}: the affine-hull test on {len(P)} points "
+                  f"({bits}-bit numbers) needs work {work} > {MAX_EVAL_WORK}")
+        return "halfspaces: not checked"
     p0 = P[0]
     basis = _echelon([_sub(p, p0) for p in P], stop=d)
-    for x, name in zip(T, names):
-        if any(_reduce(_sub(x, p0), basis)):
+    for (x, e), name in zip(T, names):
+        if any(_reduce([t - e * c for t, c in zip(x, p0)], basis)):
             raise Invalid(f"{name} is not in the safe kernel: it is not in the affine hull "
                           f"of the points (dimension {len(basis)})")
     k = len(basis)
@@ -452,11 +552,14 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
             W[s] += 1
     Q = [list(q) for q in first]
     u = len(Q)
-    work = math.comb(u, k) * (u + len(T)) if k > 1 else u + len(T)
+    steps = math.comb(u, k) * (u + len(T)) if k > 1 else u + len(T)
+    work = _cost(steps, bits)
     if work > MAX_HALFSPACE_WORK:
-        ctx.trust("halfspaces")
-        return "halfspaces: trusted"
-    hit = _violated_halfspace(Q, W, F, [[x[j] for j in J] for x in T])
+        ctx.trust("halfspaces", f"{part}: enumerating the hyperplanes through {k} of the "
+                  f"{u} distinct points ({bits}-bit numbers) needs work {work} > "
+                  f"{MAX_HALFSPACE_WORK}")
+        return "halfspaces: not checked"
+    hit = _violated_halfspace(Q, W, F, [([x[j] for j in J], e) for x, e in T])
     if hit is not None:
         sub, out, t = hit
         raise Invalid(f"{names[t]} is not in the safe kernel: it is strictly outside a "
@@ -472,9 +575,22 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
 # --------------------------------------------------------------------------- #
 
 
-def _tverberg(parts: Any, where: str, pts: list[Vec], F: int, x: Vec, name: str) -> None:
+def _exact_sum(vectors: list[Vec], d: int) -> Vec | None:
+    """The coordinate sums of the vectors (length d each), added over one common
+    denominator; None when that denominator exceeds MAX_SCALE_BITS (adding one fraction
+    at a time would cost the square of the growing size)."""
+    L = _den_lcm(vectors, MAX_SCALE_BITS)
+    if not L:
+        return None
+    return tuple(Fraction(sum(col), L) for col in zip(*_scaled(vectors, L))) if vectors \
+        else (Fraction(0),) * d
+
+
+def _tverberg(parts: Any, where: str, pts: list[Vec], F: int, x: Vec, name: str,
+              ctx: Any) -> None:
     """At least F + 1 pairwise disjoint nonempty index groups, each with weights >= 0
-    summing to 1 and sum w_i p_i = x exactly (fact (c))."""
+    summing to 1 and sum w_i p_i = x exactly (fact (c)).  A part whose sums need a
+    common denominator beyond MAX_SCALE_BITS is recorded as unchecked."""
     _array(parts, where)
     if len(parts) < F + 1:
         raise Invalid(f"{where} has {len(parts)} parts, at least F + 1 = {F + 1} are needed")
@@ -489,8 +605,7 @@ def _tverberg(parts: Any, where: str, pts: list[Vec], F: int, x: Vec, name: str)
             raise Invalid(f"{w}.indices is empty")
         if len(wts) != len(idx):
             raise Invalid(f"{w} has {len(idx)} indices but {len(wts)} weights")
-        total = Fraction(0)
-        comb = [Fraction(0)] * d
+        terms: list[Vec] = []  # (w_i, w_i p_i) for the nonzero weights
         for t, (i, lam) in enumerate(zip(idx, wts)):
             i = _int(i, f"{w}.indices[{t}]", 0, n - 1)
             if i in owner:
@@ -502,8 +617,13 @@ def _tverberg(parts: Any, where: str, pts: list[Vec], F: int, x: Vec, name: str)
             if lam < 0:
                 raise Invalid(f"{w}.weights[{t}] = {_fq(lam)} is negative")
             if lam:
-                total += lam
-                comb = [c + lam * p for c, p in zip(comb, pts[i])]
+                terms.append((lam,) + tuple(lam * p for p in pts[i]))
+        sums = _exact_sum(terms, d + 1)
+        if sums is None:
+            ctx.trust("bit size", f"{w}: the common denominator of weights * points exceeds "
+                      f"the checker's limit of {MAX_SCALE_BITS} bits")
+            continue
+        total, comb = sums[0], sums[1:]
         if total != 1:
             raise Invalid(f"{w}: the weights sum to {_fq(total)}, not 1")
         if tuple(comb) != x:
@@ -544,17 +664,65 @@ def kind_kernel_point(c: dict, ctx: Any) -> str:
     x = _vec(c["x"], "x", d)
     m = _proof_method(c["proof"], "proof", {"halfspaces": (), "tverberg": ("parts",)})
     if m == "tverberg":
-        _tverberg(c["proof"]["parts"], "proof.parts", pts, F, x, "x")
+        _tverberg(c["proof"]["parts"], "proof.parts", pts, F, x, "x", ctx)
         how = "tverberg"
     else:
-        how = _in_kernel_halfspaces(pts, F, [x], ["x"], ctx)
+        _refute_by_axes(pts, F, [x], ["x"])
+        how = _in_kernel_halfspaces(pts, F, [x], ["x"], ctx, "x")
     return f"x is in the safe kernel (n={len(pts)}, d={d}, F={F}; {how})"
+
+
+FARKAS_PRIME = 2**61 - 1  # a Mersenne prime: the cheap modular test of the Farkas sum
+
+
+def _residue(t: Fraction) -> int | None:
+    """t modulo FARKAS_PRIME, or None when its denominator is a multiple of it."""
+    q = t.denominator % FARKAS_PRIME
+    return t.numerator * pow(q, -1, FARKAS_PRIME) % FARKAS_PRIME if q else None
+
+
+def _farkas_mod_p(terms: list[tuple[Fraction, Vec]], d: int) -> int | None:
+    """A coordinate j with sum t * a_j nonzero modulo FARKAS_PRIME, or None.  Reduction
+    mod p is a ring homomorphism on the rationals whose denominators p does not divide,
+    so a nonzero residue proves the exact sum nonzero; the test is linear in the input
+    size whatever the denominators (skipped when p divides one of them)."""
+    sums = [0] * d
+    for t, a in terms:
+        rt = _residue(t)
+        ra = [_residue(x) for x in a]
+        if rt is None or None in ra:
+            return None
+        sums = [(s + rt * x) % FARKAS_PRIME for s, x in zip(sums, ra)]
+    return next((j for j, s in enumerate(sums) if s), None)
+
+
+def _check_farkas(terms: list[tuple[Fraction, Vec, Fraction]], d: int, ctx: Any) -> None:
+    """Farkas: sum t_i a_i = 0 and sum t_i b_i < 0 over the (multiplier, normal, rhs)
+    terms.  The modular test runs first; the exact sums use one common denominator of
+    the products t_i a_ij, t_i b_i, and beyond MAX_SCALE_BITS the sign condition is
+    recorded as unchecked."""
+    terms = [(t, a, b) for t, a, b in terms if t]
+    j = _farkas_mod_p([(t, a) for t, a, _ in terms], d)
+    if j is not None:
+        raise Invalid(f"Farkas: sum of multipliers * normals is not 0 (coordinate {j} is "
+                      f"nonzero modulo the prime 2^61 - 1)")
+    sums = _exact_sum([tuple(t * x for x in a) + (t * b,) for t, a, b in terms], d + 1)
+    if sums is None:
+        ctx.trust("bit size", "Farkas sums: the common denominator of multipliers * "
+                  f"constraints exceeds the checker's limit of {MAX_SCALE_BITS} bits")
+        return
+    if any(sums[:d]):
+        raise Invalid(f"Farkas: sum of multipliers * normals = {_fmtv(sums[:d])} is not 0")
+    if sums[d] >= 0:
+        raise Invalid(f"Farkas: sum of multipliers * right-hand sides = {_fq(sums[d])} "
+                      "is not < 0")
 
 
 def kind_kernel_empty(c: dict, ctx: Any) -> str:
     """Psi(X, F) = ∅: valid constraints (fact (a)) with Farkas multipliers lambda >= 0,
     mu: sum lambda_i a_i + sum mu_j e_j = 0 and sum lambda_i b_i + sum mu_j f_j < 0.
-    (A point x of Psi would give 0 = (sum ...)·x <= sum lambda b + sum mu f < 0.)"""
+    (A point x of Psi would give 0 = (sum ...)·x <= sum lambda b + sum mu f < 0.)
+    The Farkas sums (cheap) are checked before the constraints are evaluated."""
     _obj(c, "certificate", _HEAD + ("points", "F", "halfspaces", "multipliers", "equalities",
                                     "eq_multipliers"))
     pts, d, F = _problem(c)
@@ -563,43 +731,34 @@ def kind_kernel_empty(c: dict, ctx: Any) -> str:
     E = _constraints(c["equalities"], "equalities", d)
     lam = _multipliers(c["multipliers"], "multipliers", len(H), nonneg=True)
     mu = _multipliers(c["eq_multipliers"], "eq_multipliers", len(E), nonneg=False)
-    _check_work(len(H) + len(E), n)
-    D = _den_lcm(pts)
-    P = _scaled(pts, D)
-    _check_halfspaces(H, "halfspaces", P, D, F)
-    _check_equalities(E, "equalities", P, D)
-    normal = [Fraction(0)] * d
-    rhs = Fraction(0)
-    for t, (a, b) in zip(lam + mu, H + E):
-        if t:
-            normal = [s + t * aj for s, aj in zip(normal, a)]
-            rhs += t * b
-    if any(normal):
-        raise Invalid(f"Farkas: sum of multipliers * normals = {_fmtv(normal)} is not 0")
-    if rhs >= 0:
-        raise Invalid(f"Farkas: sum of multipliers * right-hand sides = {_fq(rhs)} is not < 0")
+    _check_farkas([(t, a, b) for t, (a, b) in zip(lam + mu, H + E)], d, ctx)
+    _valid_for_psi(E, "equalities", H, "halfspaces", pts, F, ctx)
     return (f"the safe kernel is empty (n={n}, d={d}, F={F}; Farkas with "
             f"{len(H)} halfspaces, {len(E)} equalities)")
 
 
 def _poly_enumeration(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]],
-                      d: int, V: set[Vec]) -> None:
+                      d: int, V: set[Vec], ctx: Any) -> None:
     """P = {E·x = f, Fc·x <= g} (integer rows) is bounded and every vertex of P is in V.
 
     Assumes P is pointed (rank of all normals = d, which a listed vertex shows).
     Bounded: a pointed nonzero recession cone {E·y = 0, Fc·y <= 0} has an extreme ray,
     the 1-dimensional null space of rank-(d-1) tight rows: a basis of E plus d-1-r_E
     facet normals.  Vertices: unique solutions of a basis of E plus d-r_E facets that
-    satisfy every constraint."""
+    satisfy every constraint.  Beyond MAX_POLY_WORK (weighted by bit size) the part is
+    recorded as unchecked."""
     BE = _basis_with_rhs(E, d)
     rE = len(BE)
     m = len(Fc)
     r1, r0 = d - 1 - rE, d - rE
     subsets = (math.comb(m, r1) if r1 >= 0 else 0) + math.comb(m, r0)
-    work = subsets * (m + len(E) + d * d)
+    bits = _bit_size([a + [b] for a, b in E + Fc])
+    work = _cost(subsets * (m + len(E) + d * d), d * bits)
     if work > MAX_POLY_WORK:
-        raise Invalid(f"too large to check: enumerating the vertices of P needs "
-                      f"{subsets} subsets of the {m} facets (work {work} > {MAX_POLY_WORK})")
+        ctx.trust("vertex enumeration", f"facets: P bounded with every vertex listed: "
+                  f"enumerating {subsets} subsets of the {m} facets ({bits}-bit rows) needs "
+                  f"work {work} > {MAX_POLY_WORK}")
+        return
     if r1 >= 0:
         for sub in combinations(range(m), r1):
             y = _normal([a for a, _ in BE] + [Fc[i][0] for i in sub], d)
@@ -639,6 +798,54 @@ def _basis_with_rhs(E: list[tuple[list[int], int]], d: int) -> list[tuple[list[i
     return out
 
 
+def _check_dim(V: list[Vec], dim: int) -> None:
+    """The affine dimension of V is ``dim``: the rank of the differences v - v_0, each
+    row scaled by its own denominator (the rank does not change, and distinct vertex
+    denominators never multiply)."""
+    rows = [_int_vector(tuple(a - b for a, b in zip(v, V[0]))) for v in V[1:]]
+    k = len(_echelon(rows, stop=len(V[0]) + 1))
+    if k != dim:
+        raise Invalid(f"dim = {dim} but the vertices span an affine space of dimension {k}")
+
+
+def _int_vector(v: Vec) -> list[int]:
+    """s * v with integer entries for the least s > 0 (the same direction)."""
+    return _scaled([v], _den_lcm([v]))[0]
+
+
+def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], int]],
+                   V: list[Vec], d: int, ctx: Any) -> bool:
+    """Every v ∈ V satisfies the equalities and facets exactly and the constraints tight
+    at it have rank d (v is a vertex of P).  Costs #V x #constraints products, weighted
+    by bit size; beyond MAX_EVAL_WORK the part is recorded as unchecked and False is
+    returned (the vertex enumeration assumes it)."""
+    SV = [(_int_vector(v), _den_lcm([v])) for v in V]
+    bits = max(_bit_size([a + [b] for a, b in Ei + Fi]),
+               _bit_size([X + [e] for X, e in SV]))
+    work = _cost(len(V) * (len(Ei) + len(Fi) + d * d), 2 * bits)
+    if work > MAX_EVAL_WORK:
+        ctx.trust("vertex test", f"vertices: each a vertex of P ({len(V)} vertices, "
+                  f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work {work} > "
+                  f"{MAX_EVAL_WORK}")
+        return False
+    for i, ((X, Dv), v) in enumerate(zip(SV, V)):
+        for j, (a, f) in enumerate(Ei):
+            if _dot(a, X) != f * Dv:
+                raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
+        tight = [a for a, _ in Ei]
+        for j, (a, g) in enumerate(Fi):
+            s = _dot(a, X) - g * Dv
+            if s > 0:
+                raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates facets[{j}]")
+            if s == 0:
+                tight.append(a)
+        r = _rank(tight)
+        if r < d:
+            raise Invalid(f"vertices[{i}] = {_fmtv(v)} is not a vertex of P: the constraints "
+                          f"tight at it have rank {r} < d = {d}")
+    return True
+
+
 def kind_safe_kernel(c: dict, ctx: Any) -> str:
     """Psi(X, F) = conv(V) with dim aff(V) = dim.
 
@@ -654,7 +861,8 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
     if not varr:
         raise Invalid("vertices is empty (an empty kernel needs kind 'kernel_empty')")
     if len(varr) > MAX_CONSTRAINTS:
-        raise Invalid(f"too large to check: {len(varr)} vertices > {MAX_CONSTRAINTS}")
+        raise Unchecked("size limit", f"vertices: {len(varr)} entries exceed the checker's "
+                        f"limit of {MAX_CONSTRAINTS}")
     V = [_vec(v, f"vertices[{i}]", d) for i, v in enumerate(varr)]
     pos: dict[Vec, int] = {}
     for i, v in enumerate(V):
@@ -664,52 +872,28 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
     E = _constraints(c["equalities"], "equalities", d)
     Fc = _constraints(c["facets"], "facets", d)
     m = _proof_method(c["proof"], "proof", {"halfspaces": (), "tverberg": ("vertex_parts",)})
-    _check_work(len(E) + len(Fc), n + len(V))
+    names = [f"vertices[{i}]" for i in range(len(V))]
+    if m == "halfspaces":
+        _refute_by_axes(pts, F, V, names)  # cheap first
     # Psi ⊆ P
-    D = _den_lcm(pts)
-    P = _scaled(pts, D)
-    _check_equalities(E, "equalities", P, D)
-    _check_halfspaces(Fc, "facets", P, D, F)
-    # every vertex lies in P and is a vertex of P
+    _valid_for_psi(E, "equalities", Fc, "facets", pts, F, ctx)
+    # every vertex lies in P and is a vertex of P; P bounded, vert(P) ⊆ V
     Ei = [_int_constraint(a, b) for a, b in E]
     Fi = [_int_constraint(a, b) for a, b in Fc]
-    for i, v in enumerate(V):
-        Dv = _den_lcm([v])
-        X = _scaled([v], Dv)[0]
-        for j, (a, f) in enumerate(Ei):
-            if _dot(a, X) != f * Dv:
-                raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
-        tight = [a for a, _ in Ei]
-        for j, (a, g) in enumerate(Fi):
-            s = _dot(a, X) - g * Dv
-            if s > 0:
-                raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates facets[{j}]")
-            if s == 0:
-                tight.append(a)
-        r = _rank(tight)
-        if r < d:
-            raise Invalid(f"vertices[{i}] = {_fmtv(v)} is not a vertex of P: the constraints "
-                          f"tight at it have rank {r} < d = {d}")
-    # P bounded, vert(P) ⊆ V
-    _poly_enumeration(Ei, Fi, d, set(V))
-    # affine dimension
-    DV = _den_lcm(V)
-    SV = _scaled(V, DV)
-    k = len(_echelon([_sub(v, SV[0]) for v in SV]))
-    if k != dim:
-        raise Invalid(f"dim = {dim} but the vertices span an affine space of dimension {k}")
+    if _vertices_of_p(Ei, Fi, V, d, ctx):
+        _poly_enumeration(Ei, Fi, d, set(V), ctx)
+    _check_dim(V, dim)
     # V ⊆ Psi
-    names = [f"vertices[{i}]" for i in range(len(V))]
     if m == "tverberg":
         vp = _array(c["proof"]["vertex_parts"], "proof.vertex_parts")
         if len(vp) != len(V):
             raise Invalid(f"proof.vertex_parts has {len(vp)} entries, expected one per "
                           f"vertex ({len(V)})")
         for i, parts in enumerate(vp):
-            _tverberg(parts, f"proof.vertex_parts[{i}]", pts, F, V[i], names[i])
+            _tverberg(parts, f"proof.vertex_parts[{i}]", pts, F, V[i], names[i], ctx)
         how = "tverberg"
     else:
-        how = _in_kernel_halfspaces(pts, F, V, names, ctx)
+        how = _in_kernel_halfspaces(pts, F, V, names, ctx, "vertices")
     nv = f"{len(V)} vertex" if len(V) == 1 else f"{len(V)} vertices"
     return (f"safe kernel = conv of {nv}, dim {dim} "
             f"(n={n}, d={d}, F={F}; {how})")

@@ -382,11 +382,12 @@ def test_enumeration_speed_and_limits():
     assert time.perf_counter() - t0 < 10
     big = rand_edges(rng, 21, 0.9)
     res = check(rs_cert(21, big, 2, 1, {"method": "enumeration"}))
-    assert not res.valid and "too large to enumerate (n=21>20)" in res.reason
+    assert res.verdict == "unchecked" and res.trusted == ("enumeration",)
+    assert "too large to enumerate (n = 21 > 20)" in res.unchecked[0]
     res = check(rs_cert(21, big, 2, 1, {"method": "dp"}))
-    assert res.valid and res.trusted == ("dp",)
+    assert res.verdict == "unchecked" and res.trusted == ("dp",) and not res
     res = check(rs_cert(21, big, 2, 1, {"method": "dp", "info": {"seconds": 1.5}}))
-    assert res.valid and res.trusted == ("dp",)
+    assert res.verdict == "unchecked" and res.trusted == ("dp",)
 
 
 def test_enumeration_of_k20():
@@ -899,7 +900,10 @@ def test_trusted_nested_dp_and_milp():
     cert = rs_cert(n, edges, 2, 1, {"method": "construction", "order": list(range(n)),
                                     "seed_size": 21, "seed_proof": {"method": "dp"}})
     res = check(cert)
-    assert res.valid and res.trusted == ("dp",)
+    assert res.verdict == "unchecked" and res.trusted == ("dp",)
+    assert res.unchecked == ("proof.seed_proof: 'dp' proof of (2, 1)-robustness not checked: "
+                             "accepted on trust (n = 21 > 20, beyond the checker's own "
+                             "enumeration)",)
     cert["proof"]["seed_proof"] = {"method": "milp", "solver": "highs"}
     assert check(cert).trusted == ("milp",)
     cert["proof"]["seed_proof"] = seed
@@ -935,7 +939,8 @@ def test_examples_exist_and_are_valid():
         cert = json.loads(path.read_text())
         v.validate(cert)
         res = check(cert)
-        assert res.valid, (path.name, res.reason)
+        expect = "unchecked" if path.stem.endswith("_unchecked") else "valid"
+        assert res.verdict == expect, (path.name, res.reason)
         kinds.add(cert["kind"])
     assert kinds == set(C.KINDS)
 
@@ -978,8 +983,10 @@ def test_cli_exit_codes(tmp_path):
     c = rs_cert(21, complete_edges(21), 2, 1, {"method": "milp", "solver": "highs"})
     trusted.write_text(json.dumps(c))
     p = _run(trusted)
-    assert p.returncode == 0
-    assert p.stdout.splitlines() == ["valid", "accepted on trust: milp"]
+    assert p.returncode == 3 and p.stderr == ""
+    assert p.stdout.splitlines() == [
+        "unchecked", "not checked: proof: 'milp' proof of (2, 1)-robustness not checked: "
+        "accepted on trust (n = 21 > 20, beyond the checker's own enumeration)"]
 
     bad = tmp_path / "bad.json"
     c = _base()
@@ -1000,7 +1007,7 @@ def test_cli_exit_codes(tmp_path):
     assert p.returncode == 2
 
     for path in EXAMPLES:
-        assert _run(path).returncode == 0
+        assert _run(path).returncode == (3 if path.stem.endswith("_unchecked") else 0)
 
 
 def test_main_in_process(tmp_path, capsys):
