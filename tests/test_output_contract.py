@@ -150,3 +150,127 @@ def test_method_names_the_s_star_search_that_timed_out():
     assert rep.s_max is None and rep.s_lower < rep.s_upper  # s* cut by the time limit
     assert rep.r_lower == rep.r_upper == rep.r_max == 6  # rho proven: r_max is rho
     assert rep.method != "bounds", rep.method
+
+
+# --------------------------------------------------------------------------- #
+# bad input: exit 2, one line on stderr, no traceback
+# --------------------------------------------------------------------------- #
+
+
+def _run(argv, capsys):
+    from rescon.cli import main
+
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _clean_error(code, out, err, *words):
+    assert code == 2, (code, out, err)
+    assert out == "" and "Traceback" not in err
+    assert len(err.strip("\n").splitlines()) == 1 and err.startswith("rescon: error:"), err
+    for w in words:
+        assert w in err, err
+
+
+@pytest.fixture
+def square(tmp_path):
+    p = tmp_path / "square.csv"
+    p.write_text("0,0\n1,0\n1,1\n0,1\n")
+    return p
+
+
+def test_cli_plot_unsupported_format(capsys, square, tmp_path):
+    _clean_error(*_run(["kernel", square, "--F", 1, "--plot", tmp_path / "k.xyz"], capsys),
+                 "--plot", ".png")
+    _clean_error(*_run(["kernel", square, "--F", 1, "--plot", tmp_path / "k"], capsys),
+                 "--plot")
+
+
+def test_cli_overflow_is_a_clean_error(capsys, square, monkeypatch):
+    import rescon.geometry.kernel as gk
+
+    def overflow(X, F):
+        raise OverflowError("int too large to convert to float")
+
+    monkeypatch.setattr(gk, "safe_kernel", overflow)
+    _clean_error(*_run(["kernel", square, "--F", 1], capsys), "out of range")
+
+
+def test_cli_multi_line_error_message_is_one_line(capsys, square, monkeypatch):
+    import rescon.geometry.kernel as gk
+
+    def bad(X, F):
+        raise InputError("first line\nsecond line")
+
+    monkeypatch.setattr(gk, "safe_kernel", bad)
+    _clean_error(*_run(["kernel", square, "--F", 1], capsys), "first line second line")
+
+
+# --------------------------------------------------------------------------- #
+# one rule for output paths
+# --------------------------------------------------------------------------- #
+
+
+def test_output_paths_create_missing_parents(capsys, square, tmp_path):
+    cert = tmp_path / "a" / "b" / "k.json"
+    png = tmp_path / "c" / "d" / "k.png"
+    code, out, err = _run(["kernel", square, "--F", 1, "--certificate", cert, "--plot", png,
+                           "--json"], capsys)
+    assert code == 0, err
+    assert cert.is_file() and png.is_file()
+    g = tmp_path / "g.edgelist"
+    g.write_text("".join(f"{u} {v}\n" for u in range(4) for v in range(4) if u != v))
+    cert2 = tmp_path / "e" / "f" / "r.json"
+    assert _run(["robustness", g, "--certificate", cert2], capsys)[0] == 0
+    assert cert2.is_file()
+
+
+def test_output_paths_of_the_wrong_kind_are_refused(capsys, square, tmp_path):
+    _clean_error(*_run(["kernel", square, "--F", 1, "--certificate", tmp_path], capsys),
+                 "--certificate", "is a directory")
+    (tmp_path / "d.png").mkdir()
+    _clean_error(*_run(["kernel", square, "--F", 1, "--plot", tmp_path / "d.png"], capsys),
+                 "--plot", "is a directory")
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    _clean_error(*_run(["kernel", square, "--F", 1, "--certificate", blocker / "k.json"],
+                       capsys), "--certificate")
+
+
+def test_write_json_follows_the_output_rule(tmp_path):
+    from rescon.io import write_json
+
+    target = tmp_path / "new" / "dir" / "x.json"
+    write_json({"a": 1}, target)
+    assert json.loads(target.read_text()) == {"a": 1}
+    with pytest.raises(InputError, match="is a directory"):
+        write_json({"a": 1}, tmp_path)
+
+
+# --------------------------------------------------------------------------- #
+# without matplotlib (pip install -e . only)
+# --------------------------------------------------------------------------- #
+
+
+@pytest.fixture
+def no_matplotlib(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+
+    def find_spec(name, *args, **kw):
+        return None if name.split(".")[0] == "matplotlib" else real(name, *args, **kw)
+
+    monkeypatch.setattr(importlib.util, "find_spec", find_spec)
+
+
+def test_plot_without_matplotlib_says_what_to_install(no_matplotlib, capsys, square, tmp_path):
+    import rescon
+
+    _clean_error(*_run(["kernel", square, "--F", 1, "--plot", tmp_path / "k.png"], capsys),
+                 "install rescon[plot]")
+    K = rescon.safe_kernel([[0, 0], [1, 0], [1, 1], [0, 1]], 1)
+    with pytest.raises(rescon.errors.MissingDependency, match=r"install rescon\[plot\]"):
+        K.plot()
+    assert not (tmp_path / "k.png").exists()

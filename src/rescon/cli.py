@@ -10,7 +10,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any, Callable, Sequence
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
 
 from .errors import RESCONError, TimeLimitReached
 from .graphs.robustness import METHODS
@@ -31,17 +33,20 @@ def _pair_json(pair: Any) -> dict[str, list[Any]] | None:
     return {"S1": _sorted(S1), "S2": _sorted(S2)}
 
 
-def _write_certificate(cert: dict[str, Any] | None, path: str | None) -> None:
-    if path is None:
+def _output(path: str | None, what: str, *, directory: bool = False) -> Path | None:
+    """An output path checked (and its directories created) before any work is done."""
+    from .io import output_path
+
+    return None if path is None else output_path(path, what, directory=directory)
+
+
+def _write_certificate(cert: dict[str, Any] | None, target: Path | None) -> None:
+    if target is None:
         return
     if cert is None:
-        print(f"rescon: no certificate written to {path}: the time limit stopped the search "
-              "before an answer", file=sys.stderr)
+        print(f"rescon: no certificate written to {target}: the time limit stopped the "
+              "search before an answer", file=sys.stderr)
         return
-    from pathlib import Path
-
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
     # compact: a search-tree proof can hold millions of tokens
     target.write_text(json.dumps(cert, separators=(",", ":")) + "\n", encoding="utf-8")
 
@@ -60,13 +65,14 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
     from .graphs.robustness import is_rs_robust, max_s, robustness
     from .io import read_graph
 
-    G = read_graph(args.graph, undirected=args.undirected)
-    kw = {"time_limit": args.time_limit, "method": args.method}
     if args.s is not None and args.r is None:
         raise RESCONError("--s needs --r")
+    cert_path = _output(args.certificate, "--certificate")
+    G = read_graph(args.graph, undirected=args.undirected)
+    kw = {"time_limit": args.time_limit, "method": args.method}
     if args.r is None:
         rep = robustness(G, **kw)
-        _write_certificate(rep.certificate, args.certificate)
+        _write_certificate(rep.certificate, cert_path)
         out = {"n": rep.n, "r_max": rep.r_max, "s_max": rep.s_max, "exact": rep.exact,
                "witness": _pair_json(rep.witness), "method": rep.method,
                "seconds": round(rep.seconds, 6)}
@@ -93,7 +99,7 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         return 0
     if args.s is None:
         res = is_rs_robust(G, args.r, 1, **kw)
-        _write_certificate(res.certificate, args.certificate)
+        _write_certificate(res.certificate, cert_path)
         s_max: int | None = 0 if res.holds is False else None
         left = None if args.time_limit is None else args.time_limit - res.seconds
         if res.holds and (left is None or left > 0):
@@ -108,7 +114,7 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         lines = [f"G {verdict} {args.r}-robust; s*({args.r}) = {shown}"]
     else:
         res = is_rs_robust(G, args.r, args.s, **kw)
-        _write_certificate(res.certificate, args.certificate)
+        _write_certificate(res.certificate, cert_path)
         out = {"r": args.r, "s": args.s, "holds": res.holds, "witness": _pair_json(res.witness)}
         verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
         lines = [f"G {verdict} ({args.r}, {args.s})-robust"]
@@ -122,26 +128,28 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
 def _cmd_kernel(args: argparse.Namespace) -> int:
     from .geometry.kernel import safe_kernel
     from .io import read_points
+    from .plot import figure_path
 
+    plot = None if args.plot is None else figure_path(args.plot, "--plot")
+    cert_path = _output(args.certificate, "--certificate")
     X = read_points(args.points)
+    if plot is not None and X.shape[1] not in (2, 3):
+        raise RESCONError(f"--plot draws d = 2 or 3 only; the points have d = {X.shape[1]}")
     K = safe_kernel(X, args.F)
     point = None if K.is_empty else K.point("project")[0]
-    cert = K.certificate
-    _write_certificate(cert, args.certificate)
-    if args.plot:
-        if X.shape[1] not in (2, 3):
-            raise RESCONError(f"--plot draws d = 2 or 3 only; the points have d = {X.shape[1]}")
-        K.plot(point=point, path=args.plot)
+    _write_certificate(K.certificate, cert_path)
+    if plot is not None:
+        K.plot(point=point, path=plot)
     out = {"n": int(X.shape[0]), "d": int(X.shape[1]), "F": K.F, "empty": K.is_empty,
            "dim": K.dim, "vertices": K.vertices.tolist(), "A": K.A.tolist(),
            "b": K.b.tolist(), "point": None if point is None else point.tolist(),
            "seconds": round(K.seconds, 6)}
     if K.is_empty:
-        lines = [f"n = {X.shape[0]}, d = {X.shape[1]}, F = {K.F}: the safe kernel is EMPTY "
-                 "(Farkas certificate)"]
+        lines = [(f"n = {X.shape[0]}, d = {X.shape[1]}, F = {K.F}: the safe kernel is EMPTY "
+                  "(Farkas certificate)")]
     else:
-        lines = [f"n = {X.shape[0]}, d = {X.shape[1]}, F = {K.F}: safe kernel of dimension "
-                 f"{K.dim} with {len(K.vertices)} vertices, {len(K.b)} facets",
+        lines = [(f"n = {X.shape[0]}, d = {X.shape[1]}, F = {K.F}: safe kernel of dimension "
+                  f"{K.dim} with {len(K.vertices)} vertices, {len(K.b)} facets"),
                  f"point (closest to the mean of the points): {point.tolist()}"]
     lines.append(f"{K.seconds:.4f} s")
     _emit(out, args.json, lines)
@@ -150,11 +158,15 @@ def _cmd_kernel(args: argparse.Namespace) -> int:
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     import warnings
-    from pathlib import Path
 
     from .consensus.engine import simulate
     from .consensus.scenario import Scenario, ScenarioWarning
+    from .plot import figure_path
 
+    if args.plot and not args.out:
+        raise RESCONError("--plot needs --out DIR (where the figure is written)")
+    out_dir = _output(args.out, "--out", directory=True)
+    plot = figure_path(out_dir / "trajectory.png", "--plot") if args.plot else None
     sc = Scenario.from_toml(args.scenario)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScenarioWarning)
@@ -167,20 +179,17 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
            "final_diameter": traj.final_diameter, "max_validity": traj.max_validity,
            "assumptions_violated": traj.info["assumptions_violated"],
            "seconds": round(traj.seconds, 6)}
-    if args.out:
-        d = Path(args.out)
-        d.mkdir(parents=True, exist_ok=True)
-        (d / "trajectory.json").write_text(json.dumps(traj.to_json()) + "\n", encoding="utf-8")
-        traj.to_csv(d / "trajectory.csv")
-        if args.plot:
-            traj.plot(d / "trajectory.png")
-        out["out"] = str(d)
-    elif args.plot:
-        raise RESCONError("--plot needs --out DIR (where the figure is written)")
-    lines = [f"{sc.algorithm} with policy {sc.policy}: N = {len(sc.nodes)}, d = {sc.d}, "
-             f"F = {sc.F}, {sc.steps} steps in {traj.seconds:.2f} s",
-             f"final benign diameter {traj.final_diameter:.3e}, largest distance to the "
-             f"initial benign hull {traj.max_validity:.3e}"]
+    if out_dir is not None:
+        (out_dir / "trajectory.json").write_text(json.dumps(traj.to_json()) + "\n",
+                                                 encoding="utf-8")
+        traj.to_csv(out_dir / "trajectory.csv")
+        if plot is not None:
+            traj.plot(plot)
+        out["out"] = str(out_dir)
+    lines = [(f"{sc.algorithm} with policy {sc.policy}: N = {len(sc.nodes)}, d = {sc.d}, "
+              f"F = {sc.F}, {sc.steps} steps in {traj.seconds:.2f} s"),
+             (f"final benign diameter {traj.final_diameter:.3e}, largest distance to the "
+              f"initial benign hull {traj.max_validity:.3e}")]
     if args.out:
         lines.append(f"written to {args.out}")
     _emit(out, args.json, lines)
@@ -270,6 +279,11 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line(text: str) -> str:
+    """An error message on one line (the stderr contract)."""
+    return " ".join(text.split()) or "(no message)"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rescon`` console script; returns the exit status."""
     args = _parser().parse_args(argv)
@@ -277,7 +291,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return func(args)
     except (RESCONError, OSError) as exc:
-        print(f"rescon: error: {exc}", file=sys.stderr)
+        print(f"rescon: error: {_one_line(str(exc))}", file=sys.stderr)
+        return 2
+    except (OverflowError, MemoryError) as exc:  # an input beyond what can be represented
+        print(f"rescon: error: the input is out of range ({type(exc).__name__}: "
+              f"{_one_line(str(exc))})", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("rescon: interrupted", file=sys.stderr)

@@ -14,6 +14,7 @@ __all__ = [
     "SolverNotFound",
     "CertificateError",
     "TimeLimitReached",
+    "MissingDependency",
 ]
 
 
@@ -47,3 +48,8 @@ class TimeLimitReached(RESCONError, RuntimeError):
 
 class EmptyKernel(RESCONError, ValueError):
     """The safe kernel Ψ(X, F) is empty, so it has no point (F is too large for X)."""
+
+
+class MissingDependency(RESCONError, ImportError):
+    """An optional dependency (an extra such as ``rescon[plot]``) is not installed; the
+    message says what to install."""

@@ -17,9 +17,10 @@ import json
 import math
 import os
 import re
+from collections.abc import Callable, Hashable, Iterator
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Callable, Hashable, Iterator, TextIO
+from typing import Any, TextIO
 from xml.etree.ElementTree import ParseError
 
 import networkx as nx
@@ -27,7 +28,7 @@ import numpy as np
 
 from .errors import GraphFormatError, InputError
 
-__all__ = ["read_graph", "read_points", "to_jsonable", "write_json"]
+__all__ = ["output_path", "read_graph", "read_points", "to_jsonable", "write_json"]
 
 _INT = re.compile(r"[+-]?\d+")
 
@@ -390,6 +391,42 @@ def _number_row(p: Path, lineno: int, cells: list[str], width: int, first_line: 
     return row
 
 
+# --------------------------------------------------------------------------- output paths
+
+
+def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
+    """Where an output goes, by one rule for every output (``--plot``,
+    ``--certificate``, ``--out``, ``write_json``, figures): missing parent
+    directories are created; a file path that is an existing directory, or a
+    directory path that is an existing file, is refused.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    what : the argument's name, for the message (e.g. ``"--certificate"``).
+    directory : the output is a directory (created, with its parents).
+
+    Raises
+    ------
+    InputError
+        ``path`` is not a path, has the wrong kind, or a directory on it cannot be
+        created (one line naming ``what``).
+    """
+    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
+        raise InputError(f"{what} must be a non-empty path; got {path!r}")
+    p = Path(path)
+    if directory and p.exists() and not p.is_dir():
+        raise InputError(f"{what}: {p} exists and is not a directory")
+    if not directory and p.is_dir():
+        raise InputError(f"{what}: {p} is a directory, not a file name")
+    try:
+        (p if directory else p.parent).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{what}: cannot create the directory for {p} "
+                         f"({exc.strerror or exc})") from None
+    return p
+
+
 # --------------------------------------------------------------------------- JSON output
 
 
@@ -449,7 +486,8 @@ def write_json(obj: Any, path_or_stream: str | os.PathLike[str] | TextIO) -> Non
     obj : Any
         Anything :func:`to_jsonable` accepts.
     path_or_stream : str, os.PathLike or text stream
-        A file path (overwritten) or an object with a ``write(str)`` method.
+        A file path (overwritten; missing parent directories are created, as for
+        every output: :func:`output_path`) or an object with a ``write(str)`` method.
 
     Raises
     ------
@@ -459,7 +497,7 @@ def write_json(obj: Any, path_or_stream: str | os.PathLike[str] | TextIO) -> Non
     """
     text = json.dumps(to_jsonable(obj), indent=2) + "\n"
     if isinstance(path_or_stream, (str, os.PathLike)):
-        Path(path_or_stream).write_text(text, encoding="utf-8")
+        output_path(path_or_stream, "path_or_stream").write_text(text, encoding="utf-8")
     elif callable(getattr(path_or_stream, "write", None)):
         path_or_stream.write(text)
     else:

@@ -6,17 +6,17 @@ from typing import Any
 
 import numpy as np
 
+from . import figure_path, pyplot
+
 __all__ = ["plot_trajectory"]
 
 
 def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -> Any:
     """One panel per coordinate (benign agents blue, adversaries red dashed, as in the
-    paper's Figs. 3–4) and one for the benign diameter. Saves to ``path`` if given."""
-    import matplotlib
-
-    if path is not None:
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    paper's Figs. 3–4) and one for the benign diameter. Saves to ``path`` if given
+    (:func:`rescon.plot.figure_path`)."""
+    path = None if path is None else figure_path(path)
+    plt = pyplot(path)
 
     t, X = traj.times, traj.states
     d = X.shape[2]

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from . import figure_path, pyplot
 
 __all__ = ["plot_kernel"]
 
@@ -19,17 +20,14 @@ def _ordered_polygon(V: np.ndarray) -> np.ndarray:
 
 def plot_kernel(K: Any, *, ax: Any = None, point: Any = None, path: Any = None) -> Any:
     """Draw K.points, Ψ (filled polygon / polytope hull) and ``point`` (d = 2 or 3).
-    Saves to ``path`` when given; returns the matplotlib Axes."""
-    import matplotlib
-
-    if path is not None and ax is None:
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    Saves to ``path`` when given (:func:`rescon.plot.figure_path`); returns the
+    matplotlib Axes."""
     X = K.points
     d = X.shape[1]
     if d not in (2, 3):
         raise InputError(f"plot draws d = 2 or 3 only; got d = {d}")
+    path = None if path is None else figure_path(path)
+    plt = pyplot(path if ax is None else None)
     if ax is None:
         fig = plt.figure(figsize=(5, 5))
         ax = fig.add_subplot(projection="3d" if d == 3 else None)
