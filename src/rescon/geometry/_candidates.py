@@ -7,9 +7,11 @@ For a k-subset {p_0, ..., p_{k-1}} of points in R^k and a point q, the orientati
 (C_j the cofactors of the last row) is > 0, = 0 or < 0 as q lies on the positive
 side of, on, or on the negative side of the hyperplane through the subset. With
 ``c_err > 0`` the float value is trusted only when |s| exceeds the rounding-error
-bound c_err · Σ_j |q − p_0|_j · |C|_j (|C|_j: the same cofactors of the absolute
-values, a permanent); otherwise the point is counted as *uncertain* and decided
-later in exact integer arithmetic. With ``c_err = 0`` the caller guarantees that
+bound c_err · Σ_j |q − p_0|_j · |C|_j + floor (|C|_j: the same cofactors of the
+absolute values, a permanent; floor: the underflow term of
+:func:`rescon._rounding.underflow_floor`); otherwise — and whenever s or the bound is
+inf or NaN, as no comparison with them holds — the point is counted as *uncertain*
+and decided later in exact integer arithmetic. With ``c_err = 0`` the caller guarantees that
 float arithmetic is exact (small integers), and s = 0 means "on the hyperplane".
 """
 
@@ -71,16 +73,16 @@ def _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols):
 PARALLEL_MIN_SUBSETS = 5_000
 
 
-def classify(Y, W, subsets, perms, psigns, c_err, F):
+def classify(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
     """:func:`classify_subsets`, on one thread for small inputs."""
     count, k = subsets.shape
     if count >= PARALLEL_MIN_SUBSETS:
-        return classify_subsets(Y, W, subsets, perms, psigns, c_err, F)
+        return classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor)
     out = (np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64),
            np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_),
            np.empty((count, k)), np.empty((count, k)))
     M = float(np.abs(Y).max()) if Y.size else 0.0
-    _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, 0, count, *out)
+    _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, 0, count, *out)
     return out
 
 
@@ -127,7 +129,7 @@ def _tally(side, w, np_, nm, nu):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
+def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, floor, F):
     """The point scan of _classify_range for k = 3 with scalars (the hot loop; the
     counts are accumulated without branches on the side, which is unpredictable)."""
     c0, c1, c2 = C[0], C[1], C[2]
@@ -143,7 +145,7 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
         s = d0 * c0 + d1 * c1 + d2 * c2
         bound = coarse
         if c_err != 0.0 and abs(s) <= coarse:
-            bound = c_err * (abs(d0) * a0 + abs(d1) * a1 + abs(d2) * a2)
+            bound = c_err * (abs(d0) * a0 + abs(d1) * a1 + abs(d2) * a2) + floor
         pos = s > bound
         neg = s < -bound
         w = W[q]
@@ -157,7 +159,7 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, F):
 
 
 @njit(cache=True, nogil=True)
-def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
+def _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, t0, t1,
                     plus, minus, unc, degenerate, cof, cof_abs):
     """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays)."""
     n, k = Y.shape
@@ -180,13 +182,14 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
             coarse += Cabs[j]
             if C[j] != 0.0:
                 zero = False
-        coarse *= c_err * 2.0 * M
+        coarse = coarse * c_err * 2.0 * M + floor
         if zero and c_err == 0.0:
             degenerate[t] = True
             continue
         p0 = idx[0]
         if k == 3:
-            np_, nm, nu = _scan3(Y, W, idx[0], idx[1], idx[2], C, Cabs, coarse, c_err, F)
+            np_, nm, nu = _scan3(Y, W, idx[0], idx[1], idx[2], C, Cabs, coarse, c_err, floor,
+                                 F)
             plus[t] = np_
             minus[t] = nm
             unc[t] = nu
@@ -206,7 +209,7 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
                 bound = 0.0
                 for j in range(k):
                     bound += abs(Y[q, j] - Y[p0, j]) * Cabs[j]
-                bound *= c_err
+                bound = bound * c_err + floor
             else:
                 bound = coarse
             np_, nm, nu = _tally(_side(s, bound, c_err), W[q], np_, nm, nu)
@@ -218,7 +221,7 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, t0, t1,
 
 
 @njit(cache=True, parallel=True)
-def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
+def classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
     """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
     on the + side, surely on the − side and uncertain, its cofactors C and their
     permanents |C|, and whether C is surely zero (degenerate subset; only decided
@@ -226,7 +229,7 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
 
     A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
     (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
-    the precise one. The scan of a subset stops once both sides surely hold more than
+    the precise one (both plus ``floor``, 0 when c_err = 0). The scan of a subset stops once both sides surely hold more than
     F points (it can then bound no valid halfspace), so counts above F are not exact."""
     n, k = Y.shape
     count = subsets.shape[0]
@@ -242,7 +245,7 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F):
             M = max(M, abs(Y[q, j]))
     chunks = 64
     for c in prange(chunks):
-        _classify_range(Y, W, subsets, perms, psigns, c_err, F, M, count * c // chunks,
+        _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, count * c // chunks,
                         count * (c + 1) // chunks, plus, minus, unc, degenerate, cof,
                         cof_abs)
     return plus, minus, unc, degenerate, cof, cof_abs

@@ -21,6 +21,7 @@ __all__ = [
     "affine_hull",
     "bareiss_rank",
     "exact_points",
+    "float_view",
     "int_vector",
     "nullspace_exact",
     "solve_exact",
@@ -48,6 +49,38 @@ def exact_points(X: np.ndarray) -> ExactPoints:
     scale = max((den for row in ratios for _, den in row), default=1)
     ints = tuple(tuple(num * (scale // den) for num, den in row) for row in ratios)
     return ExactPoints(ints, scale)
+
+
+#: the data keep their own units when the largest |coordinate| lies in [2^-WINDOW,
+#: 2^WINDOW] (integer data stay integers: exact float arithmetic, int64 paths)
+WINDOW = 32
+
+
+def float_view(rows: list[tuple[int, ...]], scale: int) -> tuple[np.ndarray, int, bool]:
+    """The integer rows (the points times ``scale``, a power of two) as floats
+    ``rows / unit``, for the float filters, with ``unit`` a power of two: ``scale``
+    itself (the data's own values) when the largest |coordinate| lies in
+    [2^-WINDOW, 2^WINDOW], else the unit that brings it into [1/2, 1). Since
+    Ψ(2^j X) = 2^j Ψ(X), the filters then see magnitudes ≤ 2^WINDOW at any scale of
+    the data, and no product of a few of them overflows.
+
+    Each entry is v / unit correctly rounded (Python's int / int: it cannot overflow).
+    ``exact`` says no entry was rounded: an entry v = odd · 2^t (odd < 2^53, from a
+    float) is representable iff its last bit 2^t / unit is ≥ 2^-1074; entries more
+    than ~2^1074 below the largest can fall below that and are rounded (to 0 or a
+    subnormal), which the caller's filters must allow for."""
+    top = max((abs(v) for row in rows for v in row), default=0)
+    low = 0
+    for row in rows:
+        for v in row:
+            low |= abs(v)
+    s = scale.bit_length() - 1  # scale = 2^s; 2^(L−1) ≤ top < 2^L
+    L = top.bit_length()
+    unit = scale if top == 0 or -WINDOW <= L - 1 - s < WINDOW else 1 << L
+    u = unit.bit_length() - 1
+    exact = low == 0 or (low & -low).bit_length() - 1 - u >= -1074
+    Yf = np.array([[v / unit for v in row] for row in rows], dtype=np.float64)
+    return Yf.reshape(len(rows), -1), unit, exact
 
 
 def bareiss_rank(rows: list[list[int]]) -> tuple[int, list[int], list[int]]:

@@ -25,11 +25,11 @@ import itertools
 
 import numpy as np
 
+from .._rounding import UNIT_ROUNDOFF as _EPS
 from .polytope import ExactPolytope, _normalise
 
 __all__ = ["certified_kernel"]
 
-_EPS = 2.0**-53
 MAX_ROUNDS = 4
 #: a Chebyshev radius below this fraction of the coordinates triggers the local pass
 LOCAL_RADIUS = 1e-4
@@ -100,7 +100,8 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
 
 def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope | None:
     """Ψ in scaled integer coordinates as an ExactPolytope (constraints: the facets),
-    or None when the fast path cannot certify it."""
+    or None when the fast path cannot certify it. ``scale``: the float unit of H (its
+    floats are the integer coordinates / scale)."""
     if len(H) < k + 1:
         return None
     sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
@@ -149,12 +150,14 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         for h in T:
             tight[i] |= 1 << where[h]
     # exact feasibility, and the complete tight sets within S: floats of the exact
-    # vertices (correctly rounded) with a rounding bound decide the clear cases
-    Vx = np.array([[yi / v[0] for yi in v[1:]] for v in verts]) / scale
+    # vertices (correctly rounded, int / int) with a rounding bound, plus the underflow
+    # term, decide the clear cases; inf or NaN is never "clear"
+    Vx = np.array([[yi / (v[0] * scale) for yi in v[1:]] for v in verts])
     c = 2.0 * (k + 4) * _EPS
     M = np.abs(Vx).max()
+    floor = H.floor()
     l1, perm_sum, babs = H.row_terms()
-    row_bound = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs)
+    row_bound = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs) + floor
     if V is None or top is None:
         from ._candidates import row_max
 
@@ -162,14 +165,14 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
         shift = np.abs(V - Vx[of_proposal]).max()
         row_bound = row_bound + l1 * shift
-    rows = np.flatnonzero(top >= -row_bound)  # the rows not surely slack at every vertex
+    rows = np.flatnonzero(~(top < -row_bound))  # the rows not surely slack at every vertex
     absV = np.abs(Vx).T
     Sv = H.af[rows] @ Vx.T - H.bf[rows, None]
     bound = H.c_err * (H.af_abs[rows] @ absV + H.b_abs[rows, None]) + c * (
-        np.abs(H.af[rows]) @ absV + np.abs(H.bf[rows])[:, None])
+        np.abs(H.af[rows]) @ absV + np.abs(H.bf[rows])[:, None]) + floor
     if (Sv > bound).any():
         return None
-    near_r, near_v = np.nonzero(np.abs(Sv) <= bound)
+    near_r, near_v = np.nonzero(~(np.abs(Sv) > bound))
     slacks = _int64_slacks(H, scale, verts, rows[near_r], near_v)
     if slacks is not None:  # small integers: all undecided pairs at once
         if (slacks > 0).any():
@@ -204,7 +207,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
             fewest = min((members[h] for h in _bits(Z)), key=len)
             if not any((tight[u] & Z) == Z for u in fewest if u != vi):
                 return None
-    P = ExactPolytope(k)
+    P = ExactPolytope(k, unit=scale)
     for h in S_set:
         a, b = H.exact(h)
         P.a.append(a)

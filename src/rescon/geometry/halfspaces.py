@@ -21,13 +21,14 @@ from typing import Any
 
 import numpy as np
 
+from .._rounding import UNIT_ROUNDOFF as _EPS
+from .._rounding import underflow_floor
 from ..errors import InputError
 
 __all__ = ["MAX_CANDIDATE_COST", "Halfspaces", "candidate_cost", "valid_halfspaces"]
 
 #: refuse inputs whose candidate enumeration needs more point tests than this
 MAX_CANDIDATE_COST = 4_000_000_000
-_EPS = 2.0**-53
 #: from this many distinct points on, lines in the plane are counted by the angular
 #: sweep (O(n² log n)) instead of the direct scan (O(n³))
 SWEEP_MIN_POINTS = 150
@@ -69,6 +70,13 @@ class Halfspaces:
             out = self._cache[-1] = (np.abs(self.af).sum(axis=1), self.af_abs.sum(axis=1),
                                      np.abs(self.bf))
         return out
+
+    def floor(self) -> float:
+        """The underflow term of every float bound on these rows (|coordinates| ≤ the
+        data's box; :func:`rescon._rounding.underflow_floor`)."""
+        lo, hi, _ = self.box
+        top = max(float(np.abs(lo).max(initial=0.0)), float(np.abs(hi).max(initial=0.0)))
+        return underflow_floor(len(lo), top)
 
     def exact(self, h: int) -> tuple[tuple[int, ...], int]:
         """(a, b), primitive integers: a·y ≤ b in the scaled integer coordinates."""
@@ -143,10 +151,14 @@ def _primitive(a: tuple[int, ...], b: int) -> tuple[tuple[int, ...], int]:
     return tuple(v // g for v in a), b // g
 
 
-def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F: int
-                     ) -> Halfspaces:
+def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F: int,
+                     exact_view: bool = True) -> Halfspaces:
     """All valid halfspaces of the unique points Y (float, (m, k)) with exact integer
-    coordinates Yi (Yi = Y · scale) and multiplicities W.
+    coordinates Yi (Yi = Y · unit, unit a power of two) and multiplicities W.
+
+    ``exact_view``: Y is exactly Yi / unit (:func:`.exact.float_view`); otherwise some
+    tiny entries were rounded, and only the filters whose bounds allow for that (the
+    underflow term) run — not the angular sweep nor the exact float expansions.
 
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
@@ -164,12 +176,16 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     exact_floats = k == 1 or bits <= _exact_float_bits(k)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
+    # exact floats: Y holds small integers over a unit ≤ 2^(bits + 32), so no product of
+    # k + 1 of them underflows either
+    floor = 0.0 if exact_floats else underflow_floor(k, float(np.abs(Y).max()))
+    expansions = exact_view and in_range(Y)
     subsets = k_subsets(m, k, count)
     # small integers in the plane: two distinct directions between data points differ
     # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
     # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
     # window is exactly on the line
-    sweep = k == 2 and m >= SWEEP_MIN_POINTS
+    sweep = k == 2 and m >= SWEEP_MIN_POINTS and exact_view
     separated = sweep and exact_floats and 16 * ANGLE_ERR * 2 * max(
         max(col) - min(col) for col in zip(*Yi)) ** 2 < 1
     if sweep and (separated or not exact_floats):
@@ -180,13 +196,14 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     else:
         plus, minus, unc, degenerate, cof, cof_abs = classify(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms,
-            signs, c_err, F)
+            signs, c_err, F, floor)
     live = ~degenerate
     sure_plus = live & (plus + unc <= F)
     sure_minus = live & (minus + unc <= F)
     sure_p, sure_m = np.flatnonzero(sure_plus), np.flatnonzero(sure_minus)
     maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
-    n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F)  # exactly
+    n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F,
+                                                    expansions)  # exactly
     add_p = ~dependent & (n_plus <= F) & ~sure_plus[maybe]
     add_m = ~dependent & (n_minus <= F) & ~sure_minus[maybe]
     idx = np.concatenate([sure_p, sure_m, maybe[add_p], maybe[add_m]])
@@ -197,7 +214,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     p0 = Y[through[:, 0]] if len(idx) else np.zeros((0, k))
     af = cof[idx] * sign[:, None]
     af_abs = cof_abs[idx]
-    if k == 3 and not exact_floats and in_range(Y):
+    if k == 3 and not exact_floats and expansions:
         # nearly collinear triples: their float cofactors' error (relative to the
         # permanents) can exceed a tiny kernel, so take the exact normals, rounded
         # (error ≤ ε|a_j|); the others keep their cofactors with the permanents scaled
@@ -256,18 +273,19 @@ def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
     return np.sort(order[starts])
 
 
-def _exact_side_counts(Y, Yi, W, subsets, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Exact weighted numbers of points strictly on the + and − side of the hyperplane
     through each subset (those above F may be lower bounds), and whether the subset is
-    affinely dependent: by floating-point expansions in numba for k ≤ 3 (data in
-    range), else in integers."""
-    from ._expansions import in_range, side_counts
+    affinely dependent: by floating-point expansions in numba for k ≤ 3 when
+    ``expansions`` (Y exact and in their range), else in integers."""
+    from ._expansions import side_counts
 
     k = Y.shape[1]
     plus = np.zeros(len(subsets), dtype=np.int64)
     minus = np.zeros(len(subsets), dtype=np.int64)
     dependent = np.zeros(len(subsets), dtype=np.bool_)
-    if k in (2, 3) and in_range(Y):
+    if k in (2, 3) and expansions:
         side_counts(np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64),
                     np.ascontiguousarray(subsets), F, plus, minus, dependent)
         return plus, minus, dependent

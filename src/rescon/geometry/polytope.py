@@ -7,6 +7,13 @@ edge (u, v) with s_u < 0 < s_v, the point s_v·u − s_u·v. Two vertices span a
 iff no third vertex is tight on every constraint tight at both (the combinatorial
 adjacency test of the double-description method, exact for polytopes of any
 dimension, degenerate ones included). All arithmetic is on Python ints.
+
+Floats only filter: the vertices as correctly rounded floats y / (w · unit), ``unit``
+the power of two that puts the data at magnitudes ≤ 2^32
+(:func:`.exact.float_view`), so no filter overflows at any scale of the data; each
+filter's bound has an absolute term for underflow (:func:`rescon._rounding.
+underflow_floor`), and inf or NaN never passes a "decided" test (every comparison
+with them is False), so such pairs are decided on the integers.
 """
 
 from __future__ import annotations
@@ -18,11 +25,11 @@ from math import gcd
 
 import numpy as np
 
+from .._rounding import UNIT_ROUNDOFF as _EPS
+from .._rounding import underflow_floor
 from .exact import bareiss_rank, nullspace_exact
 
 __all__ = ["ExactPolytope", "Farkas"]
-
-_EPS = 2.0**-53
 
 
 @dataclass(frozen=True)
@@ -70,14 +77,15 @@ class ExactPolytope:
     verts: list[tuple[int, ...]] = field(default_factory=list)  # (w, y_1..y_k)
     tight: list[int] = field(default_factory=list)
     farkas: Farkas | None = None  # set when a clip empties the polytope
+    unit: int = 1  # a power of two: the float vertices are y / (w · unit)
     _fv: np.ndarray | None = field(default=None, repr=False)  # float vertices (cache)
 
     @classmethod
-    def box(cls, lo: list[int], hi: list[int]) -> ExactPolytope:
+    def box(cls, lo: list[int], hi: list[int], unit: int = 1) -> ExactPolytope:
         """The box lo ≤ y ≤ hi (lo_j < hi_j), constraints 2j: −y_j ≤ −lo_j and
         2j+1: y_j ≤ hi_j."""
         k = len(lo)
-        P = cls(k)
+        P = cls(k, unit=unit)
         for j in range(k):
             e = [0] * k
             e[j] = -1
@@ -109,14 +117,20 @@ class ExactPolytope:
         return sum(ai * yi for ai, yi in zip(a, v[1:], strict=True)) - b * v[0]
 
     def _signs(self, a: tuple[int, ...], b: int) -> tuple[np.ndarray, dict[int, int]]:
-        """sign(a·x_v − b) for every vertex: floats beyond a rounding bound (the float
-        vertices are correctly rounded, a and b rounded once), exact integers inside it.
-        Also the exact slacks computed on the way."""
+        """sign(a·x_v − b) for every vertex: floats beyond a rounding bound, exact
+        integers inside it. Also the exact slacks computed on the way.
+
+        In float units x = y / (w · unit) the sign is that of a'·x − b' with
+        a' = a / 2^e, b' = b / (unit · 2^e), 2^e > max |a_j|: |a'_j| < 1, each
+        correctly rounded (int / int, no overflow whatever the integers' size), as
+        are the float vertices; the bound adds the underflow term."""
         fv = self._float_array()
-        af = np.array([float(x) for x in a])
-        bf = float(b)
+        e = max(abs(x) for x in a).bit_length()
+        af = np.array([x / (1 << e) for x in a])
+        bf = b / (self.unit << e)
         sf = fv @ af - bf
-        bound = 2.0 * (self.k + 3) * _EPS * (np.abs(fv) @ np.abs(af) + abs(bf))
+        floor = underflow_floor(self.k, float(np.abs(fv).max(initial=1.0)))
+        bound = 2.0 * (self.k + 3) * _EPS * (np.abs(fv) @ np.abs(af) + abs(bf)) + floor
         sign = np.where(sf > bound, 1, np.where(sf < -bound, -1, 0))
         exact: dict[int, int] = {}
         for i in np.flatnonzero(sign == 0):
@@ -126,7 +140,7 @@ class ExactPolytope:
 
     def _float_array(self) -> np.ndarray:
         if self._fv is None or len(self._fv) != len(self.verts):
-            self._fv = np.array([[yi / v[0] for yi in v[1:]] for v in self.verts],
+            self._fv = np.array([[yi / (v[0] * self.unit) for yi in v[1:]] for v in self.verts],
                                 dtype=np.float64).reshape(len(self.verts), self.k)
         return self._fv
 
@@ -172,7 +186,7 @@ class ExactPolytope:
                                      zip(self.verts[u], self.verts[v], strict=True)))
                 new_v.append(p)
                 new_t.append(z | bit)
-                new_f.append([yi / p[0] for yi in p[1:]])
+                new_f.append([yi / (p[0] * self.unit) for yi in p[1:]])
         keep = np.flatnonzero(sign <= 0).tolist()
         fv = self._float_array()
         self.verts = [self.verts[i] for i in keep] + new_v
@@ -220,7 +234,7 @@ class ExactPolytope:
     # ------------------------------------------------------------------ #
 
     def float_vertices(self) -> np.ndarray:
-        """The vertices as correctly rounded floats."""
+        """The vertices in float units, x = y / (w · unit), correctly rounded."""
         return self._float_array().copy()
 
     def fraction_vertices(self) -> list[tuple[Fraction, ...]]:
@@ -236,8 +250,10 @@ class ExactPolytope:
         if len(self.verts) > self.k:
             V = self._float_array()
             D = V[1:] - V[0]
-            # entries off by ≤ 4ε max|V|; the SVD's own error ≤ a few ε ‖D‖ (margin 8)
-            err = np.sqrt(D.size) * _EPS * (4.0 * np.abs(V).max() + 8.0 * np.linalg.norm(D))
+            # entries off by ≤ 4ε max|V| (+ underflow); the SVD's own error ≤ a few ε ‖D‖
+            # (margin 8); an inf or NaN anywhere fails the test
+            err = np.sqrt(D.size) * (_EPS * (4.0 * np.abs(V).max() + 8.0 * np.linalg.norm(D))
+                                     + underflow_floor(self.k, float(np.abs(V).max())))
             if np.linalg.svd(D, compute_uv=False)[-1] > 2.0 * err:
                 return self.k
         w0, *y0 = self.verts[0]
@@ -256,14 +272,16 @@ class ExactPolytope:
     def clear_rank(self, members: list[int]) -> int:
         """A lower bound on the affine dimension of the vertices ``members``: the
         singular values of their float differences that exceed the rounding
-        perturbation (Weyl: the exact matrix differs by ‖E‖₂ ≤ √(size) · 8ε ·
-        (max|x| + ‖D‖₂)), each certifying one dimension."""
+        perturbation (Weyl: the exact matrix differs by ‖E‖₂ ≤ √(size) · (8ε ·
+        (max|x| + ‖D‖₂) + the underflow term)), each certifying one dimension."""
         if len(members) < 2:
             return 0
         fv = self._float_array()[members]
         D = fv[1:] - fv[0]
         sv = np.linalg.svd(D, compute_uv=False)
-        perturb = np.sqrt(D.size) * 8.0 * _EPS * (np.abs(fv).max() + sv[0])
+        top = float(np.abs(fv).max())
+        perturb = np.sqrt(D.size) * (8.0 * _EPS * (top + sv[0])
+                                     + underflow_floor(self.k, top))
         return int((sv > 16.0 * perturb).sum())
 
     def face_dim(self, members: list[int]) -> int:
@@ -284,9 +302,10 @@ class ExactPolytope:
 
 def clip_to_fixpoint(P: ExactPolytope, H, scale: int, first: np.ndarray | None = None
                      ) -> None:
-    """Clip P (scaled integer coordinates y = scale · x) by every valid halfspace of
-    ``H`` (:class:`rescon.geometry.halfspaces.Halfspaces`) that a vertex violates,
-    until none is.
+    """Clip P (integer coordinates y) by every valid halfspace of ``H``
+    (:class:`rescon.geometry.halfspaces.Halfspaces`, whose floats are in units of
+    y / scale, which P's float vertices then use too) that a vertex violates, until
+    none is.
 
     Floats only choose the order (each round clips by, for every vertex, its most
     violated halfspace); "satisfied" is decided with a rounding bound — covering the
@@ -295,12 +314,14 @@ def clip_to_fixpoint(P: ExactPolytope, H, scale: int, first: np.ndarray | None =
     satisfied at every vertex is satisfied for good and leaves the working set.
     ``first``: indices of H to clip by before the others (the likely facets).
     """
+    if P.unit != scale:
+        P.unit, P._fv = scale, None
     if first is not None and 0 < len(first) < len(H):
-        _clip_rounds(P, H, scale, np.asarray(first, dtype=np.int64))
-    _clip_rounds(P, H, scale, np.arange(len(H)))
+        _clip_rounds(P, H, np.asarray(first, dtype=np.int64))
+    _clip_rounds(P, H, np.arange(len(H)))
 
 
-def _clip_rounds(P: ExactPolytope, H, scale: int, ids: np.ndarray) -> None:
+def _clip_rounds(P: ExactPolytope, H, ids: np.ndarray) -> None:
     """clip_to_fixpoint on the halfspaces ``ids`` of H.
 
     Each round evaluates every (halfspace, vertex) pair in floats. A per-row bound
@@ -308,19 +329,22 @@ def _clip_rounds(P: ExactPolytope, H, scale: int, ids: np.ndarray) -> None:
     surely satisfied and near; rows with near pairs get the per-pair bound, and the
     pairs still undecided are decided exactly. A row satisfied at every vertex is
     done for good (P only shrinks); surely violated rows are clipped by the most
-    violated per vertex, exactly violated ones all."""
+    violated per vertex, exactly violated ones all. Both bounds add the underflow
+    term for the data's magnitude (the vertices lie in the data's box)."""
     Af, bf, Aabs, babs = H.af[ids], H.bf[ids], H.af_abs[ids], H.b_abs[ids]
     norms = np.linalg.norm(Af, axis=1)
     c = 2.0 * (P.k + 4) * _EPS
+    floor = H.floor()
     while not P.is_empty and len(ids):
-        V = P.float_vertices() / scale
+        V = P.float_vertices()
         M = np.abs(V).max()
         row_bound = (H.c_err * (Aabs.sum(axis=1) * M + babs)
-                     + c * (np.abs(Af).sum(axis=1) * M + np.abs(bf)))
+                     + c * (np.abs(Af).sum(axis=1) * M + np.abs(bf)) + floor)
         S = Af @ V.T - bf[:, None]
         sure = S > row_bound[:, None]
         violated = sure.any(axis=1)
-        near_rows = np.flatnonzero(~violated & (S.max(axis=1) >= -row_bound))
+        # "surely satisfied" must be shown (S < −bound); NaN or inf stays undecided
+        near_rows = np.flatnonzero(~violated & ~(S.max(axis=1) < -row_bound))
         done = ~violated
         done[near_rows] = False
         exact_cuts = []
@@ -328,14 +352,15 @@ def _clip_rounds(P: ExactPolytope, H, scale: int, ids: np.ndarray) -> None:
             absV = np.abs(V).T
             Sn = S[near_rows]
             bound = (H.c_err * (Aabs[near_rows] @ absV + babs[near_rows, None])
-                     + c * (np.abs(Af[near_rows]) @ absV + np.abs(bf[near_rows])[:, None]))
+                     + c * (np.abs(Af[near_rows]) @ absV + np.abs(bf[near_rows])[:, None])
+                     + floor)
             for r, h in enumerate(near_rows):
                 if (Sn[r] > bound[r]).any():
                     exact_cuts.append(int(ids[h]))
                     continue
                 a, b = H.exact(int(ids[h]))
                 if any(sum(ai * yi for ai, yi in zip(a, P.verts[v][1:], strict=True))
-                       - b * P.verts[v][0] > 0 for v in np.flatnonzero(Sn[r] >= -bound[r])):
+                       - b * P.verts[v][0] > 0 for v in np.flatnonzero(~(Sn[r] < -bound[r]))):
                     exact_cuts.append(int(ids[h]))
                 else:
                     done[h] = True
