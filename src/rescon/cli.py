@@ -2,7 +2,8 @@
 
 Every subcommand takes ``--json`` (one JSON object on stdout). Bad input exits 2
 with one line on stderr, never a traceback; ``rescon check`` exits 0 (valid),
-1 (invalid, reason on stderr) or 2 (unreadable).
+1 (invalid, reason on stderr), 2 (unreadable) or 3 (not fully checked: the parts taken
+on trust or beyond the checker's limits are named).
 """
 
 from __future__ import annotations
@@ -197,19 +198,27 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from rescon_certificates.check import check, load, main as check_main
+    """Exit 0 valid, 1 invalid, 2 unreadable, 3 unchecked (the standalone checker's codes);
+    ``--json``: one object with ``verdict``, ``valid``, ``readable``, ``reason``,
+    ``trusted`` and ``unchecked`` (the parts not verified)."""
+    from rescon_certificates.check import EXIT_CODES, check, load
+    from rescon_certificates.check import main as check_main
 
     if not args.json:
         return check_main([args.certificate])
     try:
         cert = load(args.certificate)
     except (ValueError, OSError, RecursionError) as exc:  # what the checker calls unreadable
-        print(json.dumps({"valid": False, "readable": False, "reason": str(exc)}))
+        print(json.dumps({"verdict": "unreadable", "valid": False, "readable": False,
+                          "reason": str(exc), "trusted": [], "unchecked": []}))
         return 2
     res = check(cert)
-    print(json.dumps({"valid": res.valid, "readable": True, "reason": res.reason,
-                      "trusted": list(res.trusted)}))
-    return 0 if res.valid else 1
+    if res.verdict == "invalid":
+        print(f"invalid: {res.reason}", file=sys.stderr)
+    print(json.dumps({"verdict": res.verdict, "valid": res.valid, "readable": True,
+                      "reason": res.reason, "trusted": list(res.trusted),
+                      "unchecked": list(res.unchecked)}))
+    return EXIT_CODES[res.verdict]
 
 
 def _nonneg_int(text: str) -> int:
