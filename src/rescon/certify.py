@@ -17,7 +17,11 @@ def check_certificate(cert: dict[str, Any]) -> CheckResult:
     Returns
     -------
     CheckResult
-        ``valid``, ``reason`` and ``trusted`` (proof methods accepted without
-        re-verification, e.g. ``milp``).
+        ``verdict`` is ``"valid"`` (every part verified; ``valid`` is True only then),
+        ``"invalid"`` (``reason`` says what is malformed or refuted) or ``"unchecked"``
+        (well-formed, nothing refuted, but some part was taken on trust, e.g. a
+        ``milp`` proof on n > 20 nodes, or exceeds the checker's size / work / bit-size
+        limits: ``unchecked`` names those parts, ``trusted`` their short names).
+        ``rescon check`` exits 0, 1 and 3 for these verdicts (2: unreadable file).
     """
     return check(cert)
