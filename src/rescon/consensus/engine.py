@@ -8,8 +8,12 @@ One step k (t_k = k T), for every benign agent i (SPEC §3):
    ("drop"). A non-finite message is treated as missing and never stored;
 2. Algorithm 1: m = (d+1)F+1; for each coordinate p the m smallest (Y) and m largest
    (Z) values by coordinate p (ties by sender order), y_p ∈ Ψ(Y, F), z_p ∈ Ψ(Z, F),
-   Λ = {y_1..y_d, z_1..z_d}, x̃_i = Cen(Λ); with fewer than m usable values the agent
-   holds its state this step (counted in ``starved``);
+   Λ = {y_1..y_d, z_1..z_d}, x̃_i = Cen(Λ) by ``centre`` (:func:`_centre`): "mean"
+   (default, the vertex mean) and "centroid" (the centroid of conv Λ, the paper's
+   definition) lie in conv Λ, as the δ-validity proof needs; "box" ((min + max)/2 per
+   coordinate, what the agreement proof computes) may leave conv Λ and, with it, the
+   benign hull. With fewer than m usable values the agent holds its state this step
+   (counted in ``starved``);
 3. x_i ← α_i x_i + (1 − α_i) x̃_i + ε(t_k)·1.
 
 Links are kept as flat arrays (receiver, sender) sorted by receiver, so gathering,
@@ -25,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.centroid import hull_centroid
 from ..geometry.kernel import safe_kernel
 from .adversaries import StepView, adversary_messages
 from .dos import blocked_mask
@@ -182,14 +187,24 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     if sc.algorithm == "kernel":
         for (r, _, _), pt in zip(where, points, strict=True):
             aux[r] = pt
-    elif sc.algorithm == "alg1":
-        lam: dict[int, list[np.ndarray]] = {}
-        for (r, _, _), pt in zip(where, points, strict=True):
-            lam.setdefault(r, []).append(pt)
-        for r, pts in lam.items():
-            L = np.array(pts)
-            aux[r] = (L.min(axis=0) + L.max(axis=0)) / 2 if sc.centre == "box" else L.mean(axis=0)
+    elif sc.algorithm == "alg1" and points:
+        rows = [r for r, _, _ in where[::2 * d]]  # each row has its 2d points in turn
+        aux[rows] = _centre(np.reshape(points, (len(rows), 2 * d, d)), sc.centre)
     return aux, starved
+
+
+def _centre(lam: np.ndarray, centre: str) -> np.ndarray:
+    """Cen(Λ) for every agent: ``lam`` (R, 2d, d) holds one Λ per row.
+
+    "box": (min + max)/2 per coordinate (the paper's agreement proof; may leave
+    conv Λ); "mean": the vertex mean (1/2d) Σ λ (a convex combination, in conv Λ);
+    "centroid": the centroid of conv Λ (the paper's definition; exact, per agent,
+    :func:`rescon.geometry.centroid.hull_centroid`)."""
+    if centre == "box":
+        return (lam.min(axis=1) + lam.max(axis=1)) / 2
+    if centre == "mean":
+        return lam.mean(axis=1)
+    return np.array([hull_centroid(L) for L in lam])
 
 
 #: largest point sets the batch paths take, by dimension (they hold m(m−1) lines,

@@ -32,7 +32,7 @@ __all__ = ["ALGORITHMS", "CENTRES", "POLICIES", "Scenario", "ScenarioWarning"]
 
 POLICIES = ("hold", "zero", "drop")
 ALGORITHMS = ("alg1", "kernel", "wmsr", "mean")
-CENTRES = ("box", "mean")
+CENTRES = ("box", "mean", "centroid")
 KERNEL_POINTS = ("project", "project-exact", "vertex-mean")
 #: seconds the robustness condition of the theorems may take before it is reported as
 #: not decided (with bounds)
@@ -84,8 +84,11 @@ class Scenario:
         failing) or "drop" (nothing).
     algorithm : "alg1" (Algorithm 1), "kernel" (a safe-kernel point of all received
         values, Yan et al. 2022), "wmsr" (coordinate-wise W-MSR) or "mean".
-    centre : Cen(Λ) of Algorithm 1: "box" ((min + max)/2 per coordinate, used in the
-        agreement proof) or "mean" (mean of Λ, inside conv Λ, needed for validity).
+    centre : Cen(Λ) of Algorithm 1: "mean" (default: the mean of the 2d points of Λ,
+        inside conv Λ as the validity proof needs), "centroid" (the centroid of conv Λ,
+        the paper's definition, exact, d ≤ 3; slower) or "box" ((min + max)/2 per
+        coordinate, what the agreement proof computes; it can leave conv Λ and the
+        benign hull).
     alpha : α_i, a number or a mapping node → number; must satisfy α_i < c and
         1 − α_i < c.
     c : the constant 0.5 < c < 1 of the convergence theorem.
@@ -138,6 +141,9 @@ class Scenario:
                                      ("kernel_point", self.kernel_point, KERNEL_POINTS)):
             if value not in allowed:
                 raise InputError(f"{name} must be one of {', '.join(allowed)}; got {value!r}")
+        if self.centre == "centroid" and self.d > 3:
+            raise InputError(f"centre 'centroid' is computed for d <= 3; got d = {self.d} "
+                             "(use 'mean')")
         unknown = [a for a in self.adversaries if a not in self.graph]
         if unknown:
             raise InputError(f"adversaries {unknown} are not nodes of the graph")
