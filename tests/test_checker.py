@@ -911,6 +911,100 @@ def test_trusted_nested_dp_and_milp():
     assert res.valid and res.trusted == ()
 
 
+# --------------------------------------------------------------------------- #
+# three verdicts: what the checker did not verify is never "valid"
+# --------------------------------------------------------------------------- #
+
+
+def ring_lattice_edges(n, k):
+    """Each node receives from the k nearest nodes on each side: in-degree 2k."""
+    return [((i + j) % n, i) for i in range(n) for j in range(-k, k + 1) if j]
+
+
+def test_check_result_verdicts():
+    res = check(_base())
+    assert res.verdict == "valid" and res.valid and res.unchecked == () and bool(res)
+    res = check(dict(_base(), r=3))
+    assert res.verdict == "invalid" and not res and res.unchecked == ()
+    res = check(rs_cert(22, complete_edges(22), 11, 22, {"method": "milp", "solver": "highs"}))
+    assert res.verdict == "unchecked" and not res.valid and not res
+    assert res.trusted == ("milp",) and res.reason.startswith("not fully checked: ")
+    assert res.unchecked == ("proof: 'milp' proof of (11, 22)-robustness not checked: accepted "
+                             "on trust (n = 22 > 20, beyond the checker's own enumeration)",)
+    with pytest.raises(ValueError):
+        C.CheckResult(True, "x", ("milp",), ("proof",))
+    assert set(C.EXIT_CODES) == set(C.VERDICTS) and C.EXIT_CODES["unchecked"] == 3
+
+
+def test_forged_milp_claim_is_refuted_by_linear_time_witnesses():
+    """rho = 15 claimed for a 30-node ring lattice of in-degree 6 with a milp proof:
+    ({min in-degree node}, the rest) violates (r, s) for every r >= 7."""
+    n = 30
+    edges = ring_lattice_edges(n, 3)
+    milp = {"method": "milp", "solver": "highs"}
+    forged = {"rescon_certificate": 1, "kind": "robustness", "graph": graph_json(n, edges),
+              "exact": True, "r_max": 15, "s_max": n, "lower": milp, "lower_s": milp,
+              "upper_r": {"method": "half"}, "upper_s": None}
+    res = check(forged)
+    assert res.verdict == "invalid", res
+    assert "S1 = {0}" in res.reason and "linear-time witness" in res.reason
+    for r, s in ((7, 1), (3, 1)):  # r > min in-degree: refuted; else not refuted cheaply
+        res = check(rs_cert(n, edges, r, s, milp))
+        assert res.verdict == ("invalid" if r > 6 else "unchecked"), (r, s, res)
+    # r > ceil(n/2): the balanced split refutes it even on K_n (every method)
+    for method in (milp, {"method": "dp"}, {"method": "cost_search", "order": list(range(n))},
+                   {"method": "search", "order": list(range(n)), "tree": None},
+                   {"method": "enumeration"}):
+        res = check(rs_cert(n, complete_edges(n), 16, 1, method))
+        assert res.verdict == "invalid" and "S1 = {0, 1, 2" in res.reason, (method, res)
+        res = check(rs_cert(n, complete_edges(n), 15, 1, method))
+        assert res.verdict == "unchecked" and len(res.unchecked) == 1, (method, res)
+    # two nodes without in-neighbours: ({0}, {1}) violates (1, s) for every s (while
+    # ({0}, the rest) does not: every other node hears node 0)
+    edges = [e for e in complete_edges(n) if e[1] not in (0, 1)]
+    res = check(rs_cert(n, edges, 1, 1, milp))
+    assert res.verdict == "invalid" and "S1 = {0}, S2 = {1}" in res.reason, res
+
+
+def test_spectral_and_enumeration_beyond_limits_are_unchecked():
+    n = C.MAX_SPECTRAL_N + 1
+    res = check(rs_cert(n, complete_edges(n), 2, 1, {"method": "spectral", "c": "2"}))
+    assert res.verdict == "unchecked" and "spectral" in res.unchecked[0], res
+    res = check(rs_cert(n, complete_edges(n), 2, 1, {"method": "spectral", "c": "x"}))
+    assert res.verdict == "invalid"  # still parsed first
+    res = check({"rescon_certificate": 1, "kind": "rs_robust",
+                 "graph": {"n": C.MAX_N + 1, "edges": []}, "r": 1, "s": 1,
+                 "proof": {"method": "trivial"}})
+    assert res.verdict == "unchecked" and res.trusted == ("size limit",), res
+
+
+def test_sarymsakov_trusted_methods_are_unchecked_unless_refuted():
+    n = 14
+    cycle = [[i, (i + 1) % n] for i in range(n)] + [[i, i] for i in range(n)]
+    for method in ("min_cut", "enumeration"):
+        c = {"rescon_certificate": 1, "kind": "sarymsakov", "method": method, "n": n,
+             "support": cycle}
+        res = check(c)
+        assert res.verdict == "unchecked" and res.trusted == (method,), res
+        # rows 0 and 1 with one entry each, in different columns: V1 = {0}, V2 = {1}
+        c["support"] = [e for e in cycle if e[0] not in (0, 1) or e[1] == e[0]]
+        res = check(c)
+        assert res.verdict == "invalid" and "V1 = {0}, V2 = {1}" in res.reason, res
+
+
+def test_number_overflowing_a_double_is_unreadable_like_infinity(tmp_path):
+    """1e400 and Infinity get the same verdict: unreadable (exit 2)."""
+    for i, text in enumerate(("1e400", "-1e400", "Infinity", "-Infinity", "1E+999")):
+        f = tmp_path / f"big{i}.json"
+        f.write_text('{"rescon_certificate": 1, "kind": "kernel_point", "points": [[%s]], '
+                     '"F": 0, "x": [0], "proof": {"method": "halfspaces"}}' % text)
+        assert C.main([str(f)]) == 2, text
+    # a dict holding an infinite float (no file) is invalid, as before
+    res = check({"rescon_certificate": 1, "kind": "kernel_point", "points": [[float("inf")]],
+                 "F": 0, "x": [0], "proof": {"method": "halfspaces"}})
+    assert res.verdict == "invalid" and "not a finite number" in res.reason
+
+
 def test_deeply_nested_proof_is_rejected_not_crashing():
     proof = {"method": "trivial"}
     for _ in range(3000):
