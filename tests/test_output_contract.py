@@ -274,3 +274,112 @@ def test_plot_without_matplotlib_says_what_to_install(no_matplotlib, capsys, squ
     with pytest.raises(rescon.errors.MissingDependency, match=r"install rescon\[plot\]"):
         K.plot()
     assert not (tmp_path / "k.png").exists()
+
+
+# --------------------------------------------------------------------------- #
+# scenario files: every malformed value is one clean error
+# --------------------------------------------------------------------------- #
+
+_RING = "".join(f"{u} {(u + k) % 12}\n" for u in range(12) for k in (1, 2, 3, -1, -2, -3))
+_STATES = "".join(f"{i} = [{i}.0, {i % 3}.5]\n" for i in range(12))
+
+
+def _scenario_file(tmp_path, *, scenario="F = 1\nsteps = 3", initial=_STATES, extra=""):
+    (tmp_path / "ring.edgelist").write_text(_RING)
+    p = tmp_path / "s.toml"
+    p.write_text(f"[scenario]\n{scenario}\n[graph]\nedgelist = \"ring.edgelist\"\n"
+                 f"[initial]\n{initial}\n{extra}")
+    return p
+
+
+def test_scenario_file_template_is_valid(tmp_path):
+    from rescon.consensus.scenario import Scenario
+
+    sc = Scenario.from_toml(_scenario_file(tmp_path, extra=(
+        '[[dos]]\nlinks = [[1, 2], [2, 3]]\n[dos.schedule]\nkind = "periodic"\n'
+        "period = 2.0\nduration = 0.5\n")))
+    assert (len(sc.nodes), sc.d, sc.steps, sc.dos[0].links) == (12, 2, 3,
+                                                               frozenset({(1, 2), (2, 3)}))
+
+
+_DOS = '[dos.schedule]\nkind = "periodic"\nperiod = 2.0\nduration = 0.5\n'
+_BAD_SCENARIOS = {
+    "steps": (dict(scenario="F = 1\nsteps = 10000000000000"), ["steps", "PiB"]),
+    "links all": (dict(extra=f'[[dos]]\nlinks = "all"\n{_DOS}'), ["links"]),
+    "links flat": (dict(extra=f"[[dos]]\nlinks = [1, 2]\n{_DOS}"), ["links"]),
+    "links triple": (dict(extra=f"[[dos]]\nlinks = [[1, 2, 3]]\n{_DOS}"), ["links"]),
+    "file 5": (dict(initial="file = 5"), ["file"]),
+    "state a": (dict(initial=_STATES.replace("0 = [0.0, 0.5]", '0 = "a"')), ["[initial] 0"]),
+    "state bool": (dict(initial=_STATES.replace("0 = [0.0, 0.5]", "0 = [true, 1.0]")),
+                   ["[initial] 0"]),
+    "state huge": (dict(initial=_STATES.replace("0 = [0.0, 0.5]", "0 = [1e308, 1.0]")),
+                   ["1e+150"]),
+    "file and states": (dict(initial='file = "x.csv"\n0 = [1.0, 2.0]'), ["file", "not both"]),
+    "adversary kind": (dict(extra='[adversaries.0]\nkind = "nope"\n'), ["adversaries.0"]),
+    "T bool": (dict(scenario="F = 1\nsteps = 3\nT = true"), ["T"]),
+    "alpha text": (dict(scenario='F = 1\nsteps = 3\nalpha = "x"'), ["alpha"]),
+    "paper yes": (dict(scenario='paper_example = "yes"'), ["paper_example"]),
+}
+
+
+@pytest.mark.parametrize("case", list(_BAD_SCENARIOS))
+def test_bad_scenario_files(case, tmp_path, capsys):
+    from rescon.consensus.scenario import Scenario
+
+    kw, words = _BAD_SCENARIOS[case]
+    path = _scenario_file(tmp_path, **kw)
+    with pytest.raises(InputError) as exc:
+        Scenario.from_toml(path)
+    assert "\n" not in str(exc.value)
+    for w in words:
+        assert w in str(exc.value), str(exc.value)
+    _clean_error(*_run(["simulate", path, "--json"], capsys), *words)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("scenario = 5\n", ["[scenario]", "table"]),
+    ("[scenario]\npaper_example = true\nsteps = 3\n[graph]\nedges = [[1, 2]]\n", ["[graph]"]),
+    ("[scenario]\nF = 1\n[graph]\nedges = [[1, 2]]\nundirected = \"no\"\n[initial]\n",
+     ["undirected"]),
+    ("[scenario]\nF = 1\n[graph]\nedges = [[1.5, 2]]\n[initial]\n", ["edges"]),
+    ("[scenario]\nF = 1\n[graph]\nedgelist = 3\n[initial]\n", ["edgelist"]),
+    ("initial = 3\n[scenario]\nF = 1\n[graph]\nedges = [[1, 2]]\n", ["[initial]", "table"]),
+    ("dos = 5\n[scenario]\nF = 1\n[graph]\nedges = [[1, 2]]\n[initial]\n", ["dos"]),
+    ("adversaries = 5\n[scenario]\nF = 1\n[graph]\nedges = [[1, 2]]\n[initial]\n",
+     ["[adversaries]"]),
+])
+def test_bad_scenario_tables(text, words, tmp_path, capsys):
+    from rescon.consensus.scenario import Scenario
+
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    with pytest.raises(InputError) as exc:
+        Scenario.from_toml(path)
+    for w in words:
+        assert w in str(exc.value), str(exc.value)
+    _clean_error(*_run(["simulate", path], capsys), *words)
+
+
+def test_scenario_api_validates_states_and_numbers():
+    from rescon.consensus.scenario import Scenario
+    from rescon.graphs.generators import circulant
+
+    G = circulant(12, 3)
+    x0 = {v: [float(v), 1.0] for v in G}
+    with pytest.raises(InputError, match=r"x0\[3\]"):
+        Scenario(graph=G, x0={**x0, 3: ["a", 1.0]}, F=1)
+    with pytest.raises(InputError, match=r"x0"):
+        Scenario(graph=G, x0=[[1e308, 0.0]] * 12, F=1)
+    with pytest.raises(InputError, match="alpha"):
+        Scenario(graph=G, x0=x0, F=1, alpha="x")
+    with pytest.raises(InputError, match="T"):
+        Scenario(graph=G, x0=x0, F=1, T=True)
+    with pytest.raises(InputError, match="steps.*PiB"):
+        Scenario(graph=G, x0=x0, F=1, steps=10**13)
+    with pytest.raises(InputError, match="adversaries"):
+        Scenario(graph=G, x0=x0, F=1, adversaries={0: "constant"})
+    big = Scenario(graph=G, x0=[[1e150 * (-1) ** v, v] for v in range(12)], F=1, steps=3,
+                   residual="none", check_robustness=False)
+    import rescon
+
+    assert np.isfinite(rescon.simulate(big).final_diameter)  # the largest states still run

@@ -484,8 +484,10 @@ def attack_from_dict(d: Mapping[str, Any]) -> DoSAttack:
     if not isinstance(d, Mapping):
         raise InputError(f"attack must be a dict; got {type(d).__name__}")
     check_keys("attack", d, ("name", "links", "schedule"), tag=None)
+    if not isinstance(d["links"], (list, tuple)):
+        raise InputError(f"links must be a list of [i, j] pairs; got {d['links']!r}")
     links = [tuple(v) if isinstance(v, list) else v for v in d["links"]]
-    return DoSAttack(d["name"], frozenset(links), schedule_from_dict(d["schedule"]))
+    return DoSAttack(d["name"], links, schedule_from_dict(d["schedule"]))
 
 
 def _attacks(attacks: Any) -> tuple[DoSAttack, ...]:

@@ -14,6 +14,8 @@ because showing what happens then is the point.
 from __future__ import annotations
 
 import math
+import os
+import re
 import tomllib
 import warnings
 from collections.abc import Callable, Hashable, Mapping
@@ -24,9 +26,10 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from .._validate import integer, positive, real
 from ..errors import InputError
-from .adversaries import behaviour_from_dict, paper_adversaries
-from .dos import DoSAttack, paper_attacks, schedule_from_dict
+from .adversaries import Behaviour, behaviour_from_dict, paper_adversaries
+from .dos import DoSAttack, _attacks, attack_from_dict, paper_attacks
 
 __all__ = ["ALGORITHMS", "CENTRES", "POLICIES", "Scenario", "ScenarioWarning"]
 
@@ -43,6 +46,61 @@ _DOS_CHUNK = 4096  # update times per blocked-mask block in the cut-off check
 
 class ScenarioWarning(UserWarning):
     """An assumption of the convergence theorems does not hold for this scenario."""
+
+
+#: largest |entry| of an initial state: distances between states are computed in floats,
+#: and Σ_p (x_p − y_p)² ≤ d·(2·10^150)² stays finite for any d below 4·10^7
+STATE_LIMIT = 1e150
+
+
+def _reals(name: str, value: Any) -> np.ndarray:
+    """``value`` as a float array whose every entry is a real number (no bool, string,
+    complex or None, which numpy would convert or refuse with its own error)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+        return value.astype(np.float64)
+    try:
+        obj = np.asarray(value, dtype=object)
+    except ValueError:  # ragged nesting numpy cannot even hold as objects
+        raise InputError(f"{name} must be an array of real numbers; got {value!r}") from None
+    return np.array([real(name, v) for v in obj.reshape(-1)],
+                    dtype=np.float64).reshape(obj.shape)
+
+
+def _state(name: str, value: Any) -> np.ndarray:
+    """One initial state: a real number or a flat list of real numbers, as a (d,) array."""
+    arr = _reals(name, value)
+    if arr.ndim > 1:
+        raise InputError(f"{name} must be a flat list of real numbers; got shape {arr.shape}")
+    return arr.reshape(-1)
+
+
+def _memory_bytes() -> int:
+    """This machine's physical memory (2^36 bytes where the OS does not say)."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return 2**36
+
+
+def _check_trajectory_size(steps: int, n: int, d: int) -> None:
+    """Refuse a run whose trajectory cannot fit in memory: it holds K + 1 states of
+    N·d floats, plus per step the spread (d), per-agent validity (≤ N) and 4 scalars,
+    i.e. 8·(K + 1)·(N·d + N + d + 4) bytes."""
+    need = 8 * (steps + 1) * (n * d + n + d + 4)
+    have = _memory_bytes()
+    if need > have:
+        raise InputError(f"steps = {steps}: the trajectory would need {_bytes(need)} "
+                         f"(8·(steps+1)·(N·d + N + d + 4) bytes, N = {n}, d = {d}), more "
+                         f"than this machine's {_bytes(have)} of memory")
+
+
+def _bytes(b: float) -> str:
+    """``b`` bytes in binary units, 3 significant digits (e.g. "2.84 PiB")."""
+    units = ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB")
+    k = 0
+    while b >= 1024 and k < len(units) - 1:
+        b, k = b / 1024, k + 1
+    return f"{b:.3g} {units[k]}"
 
 
 def _residual(spec: Any) -> Callable[[float], float]:
@@ -128,12 +186,10 @@ class Scenario:
         object.__setattr__(self, "graph", nx.DiGraph(D))
         nodes = list(self.graph.nodes)
         object.__setattr__(self, "x0", self._states(nodes))
-        for name, value, low in (("F", self.F, 0), ("steps", self.steps, 0),
-                                 ("seed", self.seed, 0)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-                raise InputError(f"{name} must be an integer >= {low}; got {value!r}")
-        if not (isinstance(self.T, (int, float)) and math.isfinite(self.T) and self.T > 0):
-            raise InputError(f"T must be a positive number of seconds; got {self.T!r}")
+        for name in ("F", "steps", "seed"):
+            object.__setattr__(self, name, integer(name, getattr(self, name), low=0))
+        _check_trajectory_size(self.steps, len(nodes), self.d)
+        object.__setattr__(self, "T", positive("T", self.T, what="number of seconds"))
         for name, value, allowed in (("model", self.model, ("local", "total")),
                                      ("policy", self.policy, POLICIES),
                                      ("algorithm", self.algorithm, ALGORITHMS),
@@ -144,9 +200,16 @@ class Scenario:
         if self.centre == "centroid" and self.d > 3:
             raise InputError(f"centre 'centroid' is computed for d <= 3; got d = {self.d} "
                              "(use 'mean')")
+        if not isinstance(self.adversaries, Mapping):
+            raise InputError("adversaries must be a mapping node -> Behaviour; got "
+                             f"{type(self.adversaries).__name__}")
         unknown = [a for a in self.adversaries if a not in self.graph]
         if unknown:
             raise InputError(f"adversaries {unknown} are not nodes of the graph")
+        for a, beh in self.adversaries.items():
+            if not isinstance(beh, Behaviour):
+                raise InputError(f"adversaries[{a!r}] must be a Behaviour; got {beh!r}")
+        object.__setattr__(self, "dos", _attacks(self.dos))
         for att in self.dos:
             missing = [(i, j) for i, j in att.links if not self.graph.has_edge(j, i)]
             if missing:
@@ -183,33 +246,35 @@ class Scenario:
                 raise InputError(f"x0 has states for {extra}, which are not nodes of the graph")
             if missing:
                 raise InputError(f"x0 has no state for nodes {missing[:5]}")
-            rows = [np.asarray(x0[v], dtype=np.float64).reshape(-1) for v in nodes]
+            rows = [_state(f"x0[{v!r}]", x0[v]) for v in nodes]
             if len({r.shape for r in rows}) != 1:
                 raise InputError("x0: every state must have the same dimension d; got "
                                  f"{sorted({r.shape[0] for r in rows})}")
             arr = np.array(rows)
         else:
-            try:
-                arr = np.array(x0, dtype=np.float64)
-            except (TypeError, ValueError):
-                raise InputError("x0 must be a mapping node -> state or an (N, d) array") from None
+            arr = _reals("x0", x0)
             if arr.ndim != 2 or arr.shape[0] != len(nodes):
                 raise InputError(f"x0 must have shape (N, d) = ({len(nodes)}, d); got "
                                  f"{arr.shape}")
         if arr.shape[1] < 1 or not np.isfinite(arr).all():
             raise InputError(f"x0 must be finite with d >= 1; got shape {arr.shape}")
+        top = float(np.abs(arr).max())
+        if top > STATE_LIMIT:
+            raise InputError(f"x0 entries must be at most {STATE_LIMIT:g} in absolute value "
+                             "(squared distances between states must be finite floats); "
+                             f"got {top:g}")
         arr.setflags(write=False)
         return arr
 
     def _alphas(self, nodes: list[Hashable]) -> np.ndarray:
-        c = self.c
-        if not (isinstance(c, (int, float)) and 0.5 < c < 1):
-            raise InputError(f"c must satisfy 0.5 < c < 1; got {c!r}")
+        c = real("c", self.c)
+        if not 0.5 < c < 1:
+            raise InputError(f"c must satisfy 0.5 < c < 1; got {self.c!r}")
         a = self.alpha
         if isinstance(a, Mapping):
-            arr = np.array([a.get(v, 0.5) for v in nodes], dtype=np.float64)
+            arr = np.array([real(f"alpha[{v!r}]", a.get(v, 0.5)) for v in nodes])
         else:
-            arr = np.full(len(nodes), a, dtype=np.float64)
+            arr = np.full(len(nodes), real("alpha", a))
         bad = [v for v, x in zip(nodes, arr, strict=True) if not (x < c and 1 - x < c)]
         if bad:
             raise InputError(f"alpha must satisfy alpha < c and 1 - alpha < c (c = {c}); "
@@ -371,51 +436,113 @@ def _keys(d: Mapping, allowed: set[str], where: str) -> None:
 
 
 def _label(text: str) -> Hashable:
-    try:
-        return int(text)
-    except ValueError:
-        return text
+    """A TOML key as a node label: decimal digits (ASCII, optional minus) are an int."""
+    return int(text) if re.fullmatch(r"-?[0-9]+", text) else text
 
 
-def _from_dict(data: dict, base: Path, where: str) -> Scenario:
+def _table(data: Mapping, key: str, where: str) -> dict:
+    """``data[key]`` as a TOML table ({} when absent)."""
+    value = data.get(key, {})
+    if not isinstance(value, dict):
+        raise InputError(f"{where}: [{key}] must be a table; got {value!r}")
+    return value
+
+
+def _flag(table: Mapping, key: str, where: str) -> bool:
+    """A boolean key (false when absent): "yes", 1 … are refused, not read as true."""
+    value = table.get(key, False)
+    if not isinstance(value, bool):
+        raise InputError(f"{where}: {key} must be true or false; got {value!r}")
+    return value
+
+
+def _path(table: Mapping, key: str, base: Path, where: str) -> Path:
+    """A file named by a string key, relative to the scenario file's directory."""
+    value = table[key]
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{where}: {key} must be a file name (a string); got {value!r}")
+    return base / value
+
+
+def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
+    """The scenario of a parsed TOML file (format: README, "Scenario files").
+
+    ``paper_example = true`` takes the paper's graph, states, adversaries and DoS
+    attacks: a file that also gives [graph], [initial], [adversaries] or [[dos]] is
+    refused rather than half used."""
     _keys(data, _TOP, where)
-    sc = dict(data.get("scenario", {}))
+    sc = dict(_table(data, "scenario", where))
     _keys(sc, _SCENARIO, f"{where} [scenario]")
-    if sc.pop("paper_example", False):
+    if _flag(sc, "paper_example", f"{where} [scenario]"):
+        del sc["paper_example"]
+        given = [f"[{k}]" for k in ("graph", "initial", "adversaries") if k in data]
+        given += ["[[dos]]"] * ("dos" in data)
+        if given:
+            raise InputError(f"{where}: paper_example = true takes the paper's graph, "
+                             f"states, adversaries and DoS attacks; remove {', '.join(given)}")
         return Scenario.paper_example(**sc)
+    sc.pop("paper_example", None)
     if "graph" not in data or "initial" not in data or "F" not in sc:
         raise InputError(f"{where}: needs [graph], [initial] and scenario.F "
                          "(or scenario.paper_example = true)")
-    g = data["graph"]
-    _keys(g, _GRAPH, f"{where} [graph]")
+    adversaries = {}
+    for k, v in _table(data, "adversaries", where).items():
+        try:
+            adversaries[_label(k)] = behaviour_from_dict(v)
+        except InputError as exc:
+            raise InputError(f"{where} [adversaries.{k}]: {exc}") from None
+    return Scenario(graph=_graph(_table(data, "graph", where), base, f"{where} [graph]"),
+                    x0=_initial(_table(data, "initial", where), base, f"{where} [initial]"),
+                    adversaries=adversaries, dos=_dos(data.get("dos", []), where), **sc)
+
+
+def _graph(g: Mapping, base: Path, where: str) -> nx.DiGraph:
+    """[graph]: ``edgelist`` (a graph file, any format of :func:`rescon.io.read_graph`)
+    or ``edges`` (a list of [u, v], u → v, labels integers or strings); ``undirected``."""
+    _keys(g, _GRAPH, where)
+    undirected = _flag(g, "undirected", where)
+    if ("edgelist" in g) == ("edges" in g):
+        raise InputError(f"{where}: give one of 'edgelist' (a file) or 'edges'")
     if "edgelist" in g:
         from ..io import read_graph
 
-        G = read_graph(base / g["edgelist"], undirected=bool(g.get("undirected", False)))
-    elif "edges" in g:
-        G = nx.DiGraph()
-        for e in g["edges"]:
-            if not isinstance(e, list) or len(e) != 2:
-                raise InputError(f"{where} [graph] edges: each edge is [u, v]; got {e!r}")
-            G.add_edge(e[0], e[1])
-        if g.get("undirected", False):
-            G = G.to_undirected().to_directed()
-    else:
-        raise InputError(f"{where} [graph]: give 'edgelist' (a file) or 'edges'")
-    init = data["initial"]
+        return read_graph(_path(g, "edgelist", base, where), undirected=undirected)
+    edges = g["edges"]
+    if not isinstance(edges, list):
+        raise InputError(f"{where}: edges must be a list of [u, v]; got {edges!r}")
+    G = nx.DiGraph()
+    for e in edges:
+        if not (isinstance(e, list) and len(e) == 2 and all(
+                isinstance(v, (int, str)) and not isinstance(v, bool) for v in e)):
+            raise InputError(f"{where}: edges: each edge is [u, v] with integer or string "
+                             f"labels; got {e!r}")
+        G.add_edge(e[0], e[1])
+    return G.to_undirected().to_directed() if undirected else G
+
+
+def _initial(init: Mapping, base: Path, where: str) -> Any:
+    """[initial]: ``file`` (points, one row per node in graph order) or one key per
+    node holding its state (a number or a list of numbers)."""
     if "file" in init:
+        if len(init) > 1:
+            raise InputError(f"{where}: give either file or one state per node, not both")
         from ..io import read_points
 
-        x0: Any = read_points(base / init["file"])
-    else:
-        x0 = {_label(k): v for k, v in init.items()}
-    adversaries = {_label(k): behaviour_from_dict(v)
-                   for k, v in data.get("adversaries", {}).items()}
-    dos = []
-    for m, att in enumerate(data.get("dos", [])):
-        _keys(att, {"name", "links", "schedule"}, f"{where} [[dos]] #{m + 1}")
-        links = frozenset((int(i), int(j)) if isinstance(i, int) else (i, j)
-                          for i, j in att.get("links", []))
-        dos.append(DoSAttack(att.get("name", f"DoS_{m + 1}"), links,
-                             schedule_from_dict(att.get("schedule", {}))))
-    return Scenario(graph=G, x0=x0, adversaries=adversaries, dos=tuple(dos), **sc)
+        return read_points(_path(init, "file", base, where))
+    return {_label(k): _state(f"{where} {k}", v) for k, v in init.items()}
+
+
+def _dos(attacks: Any, where: str) -> tuple[DoSAttack, ...]:
+    """[[dos]]: an array of tables {name (default DoS_m), links = [[i, j], …], schedule}."""
+    if not isinstance(attacks, list):
+        raise InputError(f"{where}: dos must be an array of tables [[dos]]; got {attacks!r}")
+    out = []
+    for m, att in enumerate(attacks, start=1):
+        here = f"{where} [[dos]] #{m}"
+        if not isinstance(att, dict):
+            raise InputError(f"{here}: must be a table; got {att!r}")
+        try:
+            out.append(attack_from_dict({"name": f"DoS_{m}", **att}))
+        except InputError as exc:
+            raise InputError(f"{here}: {exc}") from None
+    return tuple(out)
