@@ -17,6 +17,8 @@ import pytest
 from rescon.consensus.adversaries import Behaviour
 from rescon.errors import InputError
 
+pytestmark = pytest.mark.filterwarnings("ignore::rescon.consensus.scenario.ScenarioWarning")
+
 #: one API call per place a HiGHS model is built (each in its own process)
 API_CALLS = {
     "margin LP (empty kernel)":
@@ -274,6 +276,11 @@ def test_plot_without_matplotlib_says_what_to_install(no_matplotlib, capsys, squ
     with pytest.raises(rescon.errors.MissingDependency, match=r"install rescon\[plot\]"):
         K.plot()
     assert not (tmp_path / "k.png").exists()
+    _clean_error(*_run(["simulate", _scenario_file(tmp_path), "--out", tmp_path / "o",
+                        "--plot"], capsys), "install rescon[plot]")
+    tr = rescon.simulate(rescon.Scenario.from_toml(_scenario_file(tmp_path)))
+    with pytest.raises(rescon.errors.MissingDependency, match=r"install rescon\[plot\]"):
+        tr.plot(tmp_path / "t.png")
 
 
 # --------------------------------------------------------------------------- #
