@@ -217,7 +217,7 @@ def test_cli_multi_line_error_message_is_one_line(capsys, square, monkeypatch):
 def test_output_paths_create_missing_parents(capsys, square, tmp_path):
     cert = tmp_path / "a" / "b" / "k.json"
     png = tmp_path / "c" / "d" / "k.png"
-    code, out, err = _run(["kernel", square, "--F", 1, "--certificate", cert, "--plot", png,
+    code, _out, err = _run(["kernel", square, "--F", 1, "--certificate", cert, "--plot", png,
                            "--json"], capsys)
     assert code == 0, err
     assert cert.is_file() and png.is_file()
@@ -311,21 +311,21 @@ def test_scenario_file_template_is_valid(tmp_path):
 
 _DOS = '[dos.schedule]\nkind = "periodic"\nperiod = 2.0\nduration = 0.5\n'
 _BAD_SCENARIOS = {
-    "steps": (dict(scenario="F = 1\nsteps = 10000000000000"), ["steps", "PiB"]),
-    "links all": (dict(extra=f'[[dos]]\nlinks = "all"\n{_DOS}'), ["links"]),
-    "links flat": (dict(extra=f"[[dos]]\nlinks = [1, 2]\n{_DOS}"), ["links"]),
-    "links triple": (dict(extra=f"[[dos]]\nlinks = [[1, 2, 3]]\n{_DOS}"), ["links"]),
-    "file 5": (dict(initial="file = 5"), ["file"]),
-    "state a": (dict(initial=_STATES.replace("0 = [0.0, 0.5]", '0 = "a"')), ["[initial] 0"]),
-    "state bool": (dict(initial=_STATES.replace("0 = [0.0, 0.5]", "0 = [true, 1.0]")),
+    "steps": ({"scenario": "F = 1\nsteps = 10000000000000"}, ["steps", "PiB"]),
+    "links all": ({"extra": f'[[dos]]\nlinks = "all"\n{_DOS}'}, ["links"]),
+    "links flat": ({"extra": f"[[dos]]\nlinks = [1, 2]\n{_DOS}"}, ["links"]),
+    "links triple": ({"extra": f"[[dos]]\nlinks = [[1, 2, 3]]\n{_DOS}"}, ["links"]),
+    "file 5": ({"initial": "file = 5"}, ["file"]),
+    "state a": ({"initial": _STATES.replace("0 = [0.0, 0.5]", '0 = "a"')}, ["[initial] 0"]),
+    "state bool": ({"initial": _STATES.replace("0 = [0.0, 0.5]", "0 = [true, 1.0]")},
                    ["[initial] 0"]),
-    "state huge": (dict(initial=_STATES.replace("0 = [0.0, 0.5]", "0 = [1e308, 1.0]")),
+    "state huge": ({"initial": _STATES.replace("0 = [0.0, 0.5]", "0 = [1e308, 1.0]")},
                    ["1e+150"]),
-    "file and states": (dict(initial='file = "x.csv"\n0 = [1.0, 2.0]'), ["file", "not both"]),
-    "adversary kind": (dict(extra='[adversaries.0]\nkind = "nope"\n'), ["adversaries.0"]),
-    "T bool": (dict(scenario="F = 1\nsteps = 3\nT = true"), ["T"]),
-    "alpha text": (dict(scenario='F = 1\nsteps = 3\nalpha = "x"'), ["alpha"]),
-    "paper yes": (dict(scenario='paper_example = "yes"'), ["paper_example"]),
+    "file and states": ({"initial": 'file = "x.csv"\n0 = [1.0, 2.0]'}, ["file", "not both"]),
+    "adversary kind": ({"extra": '[adversaries.0]\nkind = "nope"\n'}, ["adversaries.0"]),
+    "T bool": ({"scenario": "F = 1\nsteps = 3\nT = true"}, ["T"]),
+    "alpha text": ({"scenario": 'F = 1\nsteps = 3\nalpha = "x"'}, ["alpha"]),
+    "paper yes": ({"scenario": 'paper_example = "yes"'}, ["paper_example"]),
 }
 
 
