@@ -31,6 +31,9 @@ API_CALLS = {
     "kernel QP on highs":
         "rescon.safe_kernel([[0, 0], [1, 0], [1, 1], [0, 1], [0.3, 0.6]], 1)"
         ".point('project', backend='highs')",
+    "kernel QP on cvxpy:HIGHS (CVXPY builds its own Highs)":
+        "rescon.safe_kernel([[0, 0], [1, 0], [1, 1], [0, 1], [0.3, 0.6]], 1)"
+        ".point('project', backend='cvxpy:HIGHS')",
 }
 
 

@@ -8,15 +8,18 @@ naming the backends that would do.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.util
+import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
 from ..errors import SolverNotFound
 
 __all__ = ["BACKENDS", "STATUSES", "Backend", "available_backends", "require_backend",
-           "silent_highs"]
+           "silent_highs", "silent_highs_inside"]
 
 #: The shared status set every backend's native statuses map onto.
 STATUSES = ("optimal", "infeasible", "time_limit", "error")
@@ -96,6 +99,26 @@ def silent_highs() -> Any:
     h = _silent_highs_class()()
     h.setOptionValue("output_flag", False)
     return h
+
+
+_SWAP = threading.RLock()
+
+
+@contextlib.contextmanager
+def silent_highs_inside() -> Iterator[None]:
+    """Within the block, ``highspy.Highs()`` builds :func:`silent_highs` instances: for
+    libraries that construct their own model (CVXPY's HiGHS interface calls
+    ``highspy.Highs()`` at solve time, and the banner comes before any option it
+    passes). The class is swapped back on exit; blocks run one at a time."""
+    import highspy
+
+    with _SWAP:
+        saved = highspy.Highs
+        highspy.Highs = _silent_highs_class()
+        try:
+            yield
+        finally:
+            highspy.Highs = saved
 
 
 @functools.cache

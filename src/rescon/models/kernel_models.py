@@ -42,7 +42,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import InputError, SolverError, SolverNotFound
-from .backends import available_backends, require_backend, silent_highs
+from .backends import available_backends, require_backend, silent_highs, silent_highs_inside
 
 __all__ = ["chebyshev", "lp_backends", "project", "project_batch", "qp_backends"]
 
@@ -624,8 +624,10 @@ _MATRIX = {"clarabel": _clarabel, "proxsuite": _proxsuite, "highs": _highs}
 def _cvxpy_solve(problem, solver: str) -> None:
     import cvxpy as cp
 
+    quiet = silent_highs_inside() if solver == "HIGHS" else contextlib.nullcontext()
     try:
-        problem.solve(solver=solver, **_CVXPY_SOLVERS[solver][1])
+        with quiet:
+            problem.solve(solver=solver, **_CVXPY_SOLVERS[solver][1])
     except cp.error.SolverError as exc:
         raise SolverError(f"cvxpy:{solver}: {exc}") from exc
     if problem.status != cp.OPTIMAL:
