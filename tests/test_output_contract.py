@@ -243,7 +243,8 @@ def test_output_paths_of_the_wrong_kind_are_refused(capsys, square, tmp_path):
                        capsys), "--certificate")
 
 
-def test_write_json_follows_the_output_rule(tmp_path):
+def test_write_json_and_to_csv_follow_the_output_rule(tmp_path):
+    import rescon
     from rescon.io import write_json
 
     target = tmp_path / "new" / "dir" / "x.json"
@@ -251,6 +252,11 @@ def test_write_json_follows_the_output_rule(tmp_path):
     assert json.loads(target.read_text()) == {"a": 1}
     with pytest.raises(InputError, match="is a directory"):
         write_json({"a": 1}, tmp_path)
+    tr = rescon.simulate(rescon.Scenario.from_toml(_scenario_file(tmp_path)))
+    csv_path = tr.to_csv(tmp_path / "more" / "t.csv")
+    assert csv_path.read_text().startswith("k,t,node,benign,x1,x2")
+    with pytest.raises(InputError, match="is a directory"):
+        tr.to_csv(tmp_path)
 
 
 # --------------------------------------------------------------------------- #

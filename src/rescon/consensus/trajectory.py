@@ -67,8 +67,11 @@ class Trajectory:
                 "info": self.info, "seconds": self.seconds}
 
     def to_csv(self, path: str | Path) -> Path:
-        """One row per (step, agent): k, t, node, benign, x_1..x_d."""
-        p = Path(path)
+        """One row per (step, agent): k, t, node, benign, x_1..x_d (missing parent
+        directories are created, as for every output: :func:`rescon.io.output_path`)."""
+        from ..io import output_path
+
+        p = output_path(path, "path")
         d = self.states.shape[2]
         benign = set(self.benign.tolist())
         with p.open("w", newline="", encoding="utf-8") as fh:
