@@ -335,6 +335,8 @@ _BAD_SCENARIOS = {
     "T bool": ({"scenario": "F = 1\nsteps = 3\nT = true"}, ["T"]),
     "alpha text": ({"scenario": 'F = 1\nsteps = 3\nalpha = "x"'}, ["alpha"]),
     "paper yes": ({"scenario": 'paper_example = "yes"'}, ["paper_example"]),
+    "check yes": ({"scenario": 'F = 1\nsteps = 3\ncheck_robustness = "no"'},
+                  ["check_robustness"]),
 }
 
 

@@ -190,6 +190,9 @@ class Scenario:
             object.__setattr__(self, name, integer(name, getattr(self, name), low=0))
         _check_trajectory_size(self.steps, len(nodes), self.d)
         object.__setattr__(self, "T", positive("T", self.T, what="number of seconds"))
+        if not isinstance(self.check_robustness, bool):
+            raise InputError(f"check_robustness must be True or False; got "
+                             f"{self.check_robustness!r}")
         for name, value, allowed in (("model", self.model, ("local", "total")),
                                      ("policy", self.policy, POLICIES),
                                      ("algorithm", self.algorithm, ALGORITHMS),
