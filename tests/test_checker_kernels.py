@@ -18,6 +18,7 @@ import math
 import random
 import subprocess
 import sys
+import time
 from fractions import Fraction
 from itertools import combinations
 from pathlib import Path
@@ -875,6 +876,125 @@ def test_resource_limits():
     c["halfspaces"] = [{"a": [0, 0], "b": 0}] * (K.MAX_CONSTRAINTS + 1)
     res = check(c)
     assert res.verdict == "unchecked" and res.trusted == ("size limit",), res
+
+
+# --------------------------------------------------------------------------- #
+# verdicts: cheap refutations first, bounded time on huge numbers
+# --------------------------------------------------------------------------- #
+
+
+def gaussian_cloud(seed, n, d, scale=1.0):
+    rng = random.Random(seed)
+    return [tuple(rng.gauss(0, 1) * scale for _ in range(d)) for _ in range(n)]
+
+
+def test_wrong_kernel_beyond_the_enumeration_limit_is_refuted():
+    """The bounding box of 200 Gaussian points x 2^600 with F = 20 (what a float
+    overflow once returned) has corners of Tukey depth 1: an axis halfspace refutes it,
+    although the halfspace enumeration is far beyond its limit."""
+    d, F = 3, 20
+    pts = gaussian_cloud(1, 200, d, 2.0**600)
+    lo = [min(p[j] for p in pts) for j in range(d)]
+    hi = [max(p[j] for p in pts) for j in range(d)]
+    corners = [[(lo, hi)[(m >> j) & 1][j] for j in range(d)] for m in range(1 << d)]
+    box = [{"a": [s if j == i else 0 for j in range(d)], "b": s * (hi if s > 0 else lo)[i]}
+           for i in range(d) for s in (1, -1)]
+    cert = {"rescon_certificate": 1, "kind": "safe_kernel", "points": [list(p) for p in pts],
+            "F": F, "dim": d, "vertices": corners, "equalities": [], "facets": box,
+            "proof": {"method": "halfspaces"}}
+    t0 = time.perf_counter()
+    res = check(json.loads(json.dumps(cert)))
+    assert res.verdict == "invalid" and "Tukey depth is at most 1" in res.reason, res
+    assert time.perf_counter() - t0 < 10
+
+
+def test_point_outside_the_hull_is_refuted_cheaply():
+    """200 points, F = 199: only a point equal to every data point has depth 200."""
+    pts = gaussian_cloud(2, 200, 3)
+    for x in ((5.0, 5.0, 5.0), (0.0, 0.0, 0.0), pts[0]):
+        res = check(point_cert(pts, 199, x))
+        assert res.verdict == "invalid" and "Tukey depth" in res.reason, (x, res)
+    # a true claim beyond the limit is unchecked, not valid and not invalid
+    sym = [p for q in gaussian_cloud(3, 150, 3) for p in (q, tuple(-t for t in q))]
+    res = check(point_cert(sym, 1, (0, 0, 0)))
+    assert res.verdict == "unchecked" and res.trusted == ("halfspaces",), res
+
+
+def big_denominator_cloud(seed, pairs, digits):
+    """A centrally symmetric cloud (so the origin has depth >= n/2) whose coordinates
+    have distinct denominators of ``digits`` digits."""
+    rng = random.Random(seed)
+    pts = []
+    for _ in range(pairs):
+        p = [Fraction(rng.randint(-9, 9)) + Fraction(1, rng.randrange(10**(digits - 1),
+                                                                        10**digits))
+             for _ in range(3)]
+        pts += [p, [-t for t in p]]
+    return pts
+
+
+def test_large_distinct_denominators_answer_quickly():
+    """40 points with distinct 400-digit denominators took 111 s (every number scaled by
+    one common denominator); 120 points with 4000-digit ones, hours.  Now the common
+    denominator is bounded (MAX_SCALE_BITS) and the part beyond it is unchecked."""
+    for pairs, digits in ((20, 400), (60, 4000)):
+        cert = point_cert(big_denominator_cloud(pairs, pairs, digits), 1, (0, 0, 0))
+        t0 = time.perf_counter()
+        res = check(cert)
+        assert time.perf_counter() - t0 < 10, (pairs, digits)
+        assert res.verdict == "unchecked" and res.trusted == ("bit size",), res
+        assert f"exceeds the checker's limit of {K.MAX_SCALE_BITS} bits" in res.unchecked[0]
+    # the cheap test still refutes a false claim on the same data
+    pts = big_denominator_cloud(7, 20, 400)
+    res = check(point_cert(pts, 1, (100, 0, 0)))
+    assert res.verdict == "invalid" and "Tukey depth is at most 0" in res.reason
+    # a Tverberg proof whose sums need a huge common denominator: unchecked, quickly
+    parts = [{"indices": [2 * i, 2 * i + 1], "weights": ["1/2", "1/2"]} for i in range(20)]
+    res = check(point_cert(pts, 1, (0, 0, 0), {"method": "tverberg", "parts": parts}))
+    assert res.verdict == "valid", res  # each part alone is small: exact
+    big = [{"indices": list(range(40)), "weights": ["1/40"] * 40}] * 2
+    res = check(point_cert(pts, 1, (0, 0, 0), {"method": "tverberg", "parts": big}))
+    assert res.verdict == "invalid" and "already used" in res.reason
+
+
+def test_kernel_empty_with_a_wrong_farkas_sum_is_refuted_first():
+    """A 2.4 MB kernel_empty with a trivially wrong Farkas sum took > 120 s (its
+    halfspaces were evaluated at every point first, over one huge common denominator)."""
+    rng = random.Random(4)
+    pts = big_denominator_cloud(4, 60, 1000)
+    H = [{"a": [f"1/{rng.randrange(10**999, 10**1000)}", 1, 0], "b": 100} for _ in range(300)]
+    cert = {"rescon_certificate": 1, "kind": "kernel_empty",
+            "points": [[jnum(t) for t in p] for p in pts], "F": 1, "halfspaces": H,
+            "multipliers": [1] * len(H), "equalities": [], "eq_multipliers": []}
+    assert len(json.dumps(cert)) > 600_000
+    t0 = time.perf_counter()
+    res = check(cert)
+    assert res.verdict == "invalid" and "Farkas" in res.reason, res
+    assert "modulo the prime" in res.reason
+    assert time.perf_counter() - t0 < 10
+    # right sums, constraints not evaluable within the bit-size limit: unchecked
+    cert["halfspaces"] = [{"a": [1, 0, 0], "b": -1000}, {"a": [-1, 0, 0], "b": -1000}]
+    cert["multipliers"] = [1, 1]
+    res = check(cert)
+    assert res.verdict == "unchecked" and res.trusted == ("bit size",), res
+    cert["points"] = [[0, 0, 0]] * 3  # small points: the halfspaces are refuted
+    res = check(cert)
+    assert res.verdict == "invalid" and "more than F = 1" in res.reason, res
+
+
+def test_farkas_modular_test_never_rejects_a_right_sum():
+    """Sums that cancel exactly pass the modular test whatever the denominators (also
+    denominators divisible by the prime, where it is skipped)."""
+    p = K.FARKAS_PRIME
+    for q in (3, 10**40 + 7, p, 2 * p):
+        t = Fraction(1, q)
+        cert = {"rescon_certificate": 1, "kind": "kernel_empty", "points": [[0], [1], [2]],
+                "F": 1, "halfspaces": [{"a": [jnum(t)], "b": 0}, {"a": [jnum(-t)], "b": jnum(-t)}],
+                "multipliers": [1, 1], "equalities": [], "eq_multipliers": []}
+        res = check(cert)  # x <= 0 (2 points outside) and x >= 1 (1 point outside)
+        assert res.verdict == "invalid" and "more than F = 1" in res.reason, (q, res)
+        cert["F"] = 2
+        assert check(cert).verdict == "valid", q
 
 
 # --------------------------------------------------------------------------- #
