@@ -157,6 +157,8 @@ class Scenario:
         the mean of Y; in the plane by the batch path — exact decisions, float geometry
         within a certified ~1e-15 relative bound — else exactly), "project-exact" (the
         same point, all in exact arithmetic) or "vertex-mean".
+    check_robustness : let :meth:`assumptions` decide the graph condition of the
+        theorems (up to :data:`ROBUSTNESS_SECONDS`, then bounds); False skips it.
     """
 
     graph: Any

@@ -13,7 +13,9 @@ is taken with respect to the k-dimensional measure of conv Λ in its affine hull
 This lies in the relative interior of conv Λ (a convex combination with positive
 weights of the simplices covering it). Everything is computed on the exact integer
 form of the floats (:func:`rescon.geometry.exact.exact_points`); the only rounding is
-the final correctly rounded conversion of each coordinate to a float.
+the final correctly rounded conversion of each coordinate to a float. (When conv Λ
+is flat and tilted, no float may lie on its plane: the returned point is then within
+half an ulp per coordinate of conv Λ, as the vertex mean's is.)
 """
 
 from __future__ import annotations
