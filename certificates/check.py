@@ -26,12 +26,22 @@ from __future__ import annotations
 import json
 import math
 import sys
-from fractions import Fraction
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from fractions import Fraction
+from typing import Any
 
-__all__ = ["CheckResult", "check", "load", "main", "EXIT_CODES", "FORMAT_VERSION", "MAX_ENUM_N",
-           "MAX_N", "VERDICTS"]
+__all__ = [
+    "EXIT_CODES",
+    "FORMAT_VERSION",
+    "MAX_ENUM_N",
+    "MAX_N",
+    "VERDICTS",
+    "CheckResult",
+    "check",
+    "load",
+    "main",
+]
 
 FORMAT_VERSION = 1
 MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
@@ -218,7 +228,7 @@ def _bits(mask: int) -> list[int]:
 class Graph:
     """Nodes 0..n-1; ``inmask[i]`` = bitmask of the in-neighbours N(i) of i."""
 
-    __slots__ = ("n", "inmask", "m")
+    __slots__ = ("inmask", "m", "n")
 
     def __init__(self, n: int, inmask: list[int], m: int) -> None:
         self.n = n
@@ -229,7 +239,7 @@ class Graph:
     def full(self) -> int:
         return (1 << self.n) - 1
 
-    def induced(self, nodes: list[int]) -> "Graph":
+    def induced(self, nodes: list[int]) -> Graph:
         """Subgraph induced on ``nodes``, re-indexed so that ``nodes[j]`` becomes j."""
         pos = {v: j for j, v in enumerate(nodes)}
         inmask = []
@@ -1146,7 +1156,7 @@ def load(path: str) -> dict:
     obj = json.loads(data.decode("utf-8"), object_pairs_hook=_no_duplicate_keys,
                      parse_constant=_no_constant, parse_float=_finite_float)
     if not isinstance(obj, dict):
-        raise ValueError(f"top level is a JSON {_tname(obj)}, not an object")
+        raise ValueError(f"top level is a JSON {_tname(obj)}, not an object")  # noqa: TRY004
     return obj
 
 
