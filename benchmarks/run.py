@@ -710,11 +710,11 @@ def _time_call(fn: Callable[[], Any], repeats: int, same: Callable[[Any, Any], b
             return first, statistics.median(times)
 
 
-def _check_in_worker(cert: dict) -> tuple[bool, str, tuple[str, ...]]:
+def _check_in_worker(cert: dict) -> tuple[str, str, tuple[str, ...]]:
     import rescon
 
     r = rescon.check_certificate(cert)
-    return bool(r.valid), str(r.reason), tuple(r.trusted)
+    return str(r.verdict), str(r.reason), tuple(r.trusted)
 
 
 class _CertChecker:
@@ -740,26 +740,26 @@ class _CertChecker:
             self._pool = None
 
     def __call__(self, cert: dict) -> tuple[str, str]:
-        """valid / trusted / too_large (checker work limit) / timeout / INVALID / error."""
+        """valid / trusted / too_large (checker work limit) / timeout / INVALID / error;
+        the checker's "unchecked" verdict is too_large when its vertex enumeration was
+        beyond the limit, else trusted (the halfspace membership beyond its limit)."""
         import multiprocessing
 
         try:
             if self.timeout > 0:
                 self.start()
-                valid, reason, trusted = self._pool.apply_async(
+                verdict, reason, trusted = self._pool.apply_async(
                     _check_in_worker, (cert,)).get(self.timeout)
             else:
-                valid, reason, trusted = _check_in_worker(cert)
+                verdict, reason, trusted = _check_in_worker(cert)
         except multiprocessing.TimeoutError:
             self.close()
             return "timeout", f"checker still running after {self.timeout:g} s: not verified"
         except Exception as exc:  # noqa: BLE001
             return "error", f"{type(exc).__name__}: {exc}"
-        if valid:
-            return ("trusted" if trusted else "valid"), reason
-        if "too large to check" in reason:
-            return "too_large", reason
-        return "INVALID", reason
+        if verdict == "unchecked":
+            return ("too_large" if "vertex enumeration" in trusted else "trusted"), reason
+        return ("valid" if verdict == "valid" else "INVALID"), reason
 
 
 def _same_kernel(a: Any, b: Any) -> bool:
@@ -1111,8 +1111,8 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
         f"- {_versions()}.",
         f"- {len(recs)} clouds ({n_empty} with an empty kernel); {status}",
         f"- Certificates (rescon.check_certificate, not timed): kernel/emptiness "
-        f"{cert_counts('kcert')}; point {cert_counts('pcert')}. `trusted` = accepted with "
-        f"the proof method trusted, `too_large` = beyond the checker's work limit, "
+        f"{cert_counts('kcert')}; point {cert_counts('pcert')}. `trusted` = not fully "
+        f"checked (halfspace membership beyond the checker's limit), `too_large` = beyond the checker's work limit, "
         f"`timeout` = the checker ran longer than {cfg.cert_timeout:g} s (both: not "
         f"verified, not counted as failures).",
         "",
