@@ -9,8 +9,12 @@
 
 from __future__ import annotations
 
+import math
+from fractions import Fraction
+
 import numpy as np
 
+from .._rounding import UNIT_ROUNDOFF
 from ..geometry.kernel import safe_kernel
 
 __all__ = ["ValidityMonitor", "diameter", "spread"]
@@ -32,6 +36,8 @@ class ValidityMonitor:
 
     def __init__(self, initial: np.ndarray) -> None:
         self.hull = safe_kernel(initial, 0)
+        full = self.hull.dim == initial.shape[1] and bool(self.hull._exact.facets)
+        self._rows = _filter_rows(self.hull._exact.facets) if full else None
 
     def distance(self, x: np.ndarray) -> float:
         if self.hull.contains(x):
@@ -39,17 +45,46 @@ class ValidityMonitor:
         y, _ = self.hull.point("project", target=x)
         return float(np.linalg.norm(x - y))
 
+    def surely_inside(self, states: np.ndarray) -> np.ndarray:
+        """Rows of ``states`` (n, d) that a float filter proves inside the hull (False:
+        not proven). With the exact facets a·x ≤ β scaled by 1/max|a_j| and rounded
+        to Â, b̂ (each entry within u of its value, or 2^-1075 of it in the subnormal
+        range), the exact a·x/top − β/top differs from fl(Â x − b̂) by at most
+        ((d + 2) u + O(u²)) (|Â| |x| + |b̂|) (entry rounding, then the d + 1 terms of
+        the dot product) plus (d + 2)(‖x‖∞ + 1)·2^-1074 for gradual underflow; twice
+        the first term covers the rounding of the bound itself. Overflow makes the
+        bound inf or the value NaN, and the row unproven."""
+        if self._rows is None:
+            return np.zeros(len(states), dtype=bool)
+        A, b = self._rows
+        d = states.shape[1]
+        with np.errstate(over="ignore", invalid="ignore"):
+            S = states @ A.T - b
+            bound = (2 * (d + 2) * UNIT_ROUNDOFF * (np.abs(states) @ np.abs(A).T + np.abs(b))
+                     + (d + 2) * 2.0**-1074 * (np.abs(states).max(axis=1) + 1)[:, None])
+            return (S < -bound).all(axis=1)
+
     def distances(self, states: np.ndarray) -> np.ndarray:
-        """Distances of the rows of ``states``; rows surely inside the hull (every facet
-        value below its rounding bound, full-dimensional hull) are 0 without exact work."""
-        K = self.hull
-        out = np.empty(len(states))
-        sure = np.zeros(len(states), dtype=bool)
-        if K.dim == states.shape[1] and len(K.b):
-            S = states @ K.A.T - K.b
-            bound = 16.0 * 2.0**-53 * (np.abs(states) @ np.abs(K.A).T + np.abs(K.b))
-            sure = (S < -bound).all(axis=1)
-        out[sure] = 0.0
-        for i in np.flatnonzero(~sure):
+        """Distances of the rows of ``states``; rows :meth:`surely_inside` the hull are 0
+        without exact work."""
+        out = np.zeros(len(states))
+        for i in np.flatnonzero(~self.surely_inside(states)):
             out[i] = self.distance(states[i])
         return out
+
+
+def _filter_rows(facets) -> tuple[np.ndarray, np.ndarray]:
+    """Floats of the exact facets a·x ≤ β, each divided exactly by max|a_j| (so the
+    entries of Â are in [−1, 1]; b̂ is ±inf beyond the float range)."""
+    rows = [(tuple(v / top for v in a), beta / top)
+            for a, beta in facets for top in (max(map(abs, a)),)]
+    A = np.array([[float(v) for v in a] for a, _ in rows])
+    return A, np.array([_float(beta) for _, beta in rows])
+
+
+def _float(v: Fraction) -> float:
+    """v rounded to a float, ±inf beyond the float range."""
+    try:
+        return float(v)
+    except OverflowError:
+        return math.copysign(math.inf, v)
