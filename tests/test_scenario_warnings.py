@@ -3,13 +3,18 @@ and for the F-total model (issue 10 §4)."""
 
 from __future__ import annotations
 
+import re
+
 import networkx as nx
 import numpy as np
+import pytest
 
 from rescon.consensus import scenario as scenario_module
 from rescon.consensus.dos import DoSAttack, Explicit, Periodic
 from rescon.consensus.scenario import Scenario
+from rescon.graphs import robustness as robustness_module
 from rescon.graphs.generators import circulant
+from rescon.graphs.robustness import RobustnessCheck
 
 
 def ring(n: int, k: int, *, d: int = 2, F: int = 1, **kw) -> Scenario:
@@ -36,7 +41,21 @@ def test_undecided_robustness_is_reported_with_bounds(monkeypatch):
     sc = Scenario(graph=G, x0=np.zeros((40, 1)), F=3, steps=1)  # needs 7-robust
     msgs = [m for m in sc.assumptions() if "robust" in m]
     assert len(msgs) == 1 and msgs[0].startswith("not decided"), msgs
-    assert "4 <= rho(G) <= 8" in msgs[0]
+    lo, hi = map(int, re.search(r"(\d+) <= rho\(G\) <= (\d+)", msgs[0]).groups())
+    assert 4 <= lo < 7 <= hi <= 8  # the bounds alone give [4, 8]
+
+
+@pytest.mark.parametrize("n, k, verdict", [(100, 2, "not 4-robust"), (14, 4, None)])
+def test_bounds_settle_what_the_stopped_check_left_open(monkeypatch, n, k, verdict):
+    """When the exact check stops, bounds that decide give the verdict: ρ ≤ 2 < 4 a
+    failure with its witness, ρ ≥ 4 (circulant(14, 4) is 4-robust) no warning."""
+    undecided = RobustnessCheck(4, 1, None, None, None, None, method="search", seconds=0.0)
+    monkeypatch.setattr(robustness_module, "is_rs_robust", lambda *a, **kw: undecided)
+    msgs = [m for m in ring(n, k).assumptions() if "robust" in m]
+    if verdict is None:
+        assert not msgs
+    else:
+        assert len(msgs) == 1 and verdict in msgs[0] and "witness S1 = [" in msgs[0]
 
 
 def test_total_model_needs_dF1_F1_robustness_only():

@@ -323,16 +323,21 @@ class Scenario:
         else:
             r, s, need = d * F + 1, F + 1, f"({d * F + 1}, {F + 1})-robust (= (dF+1, F+1))"
         res = is_rs_robust(self.graph, r, s, time_limit=ROBUSTNESS_SECONDS)
-        if res.holds:
+        witness = res.witness
+        if res.holds is None:
+            rep = robustness(self.graph, time_limit=_BOUNDS_SECONDS, progress=False)
+            if rep.r_lower >= r + s - 1:
+                return []
+            if rep.r_upper >= r:
+                return [(f"not decided within {ROBUSTNESS_SECONDS:g} s whether the graph is "
+                         f"{need} as the theorems need for the F-{self.model} model: "
+                         f"{rep.r_lower} <= rho(G) <= {rep.r_upper} (rho >= {r + s - 1} "
+                         f"suffices, rho < {r} fails)")]
+            witness = rep.witness  # G is not (r_upper + 1)-robust, r_upper + 1 <= r
+        elif res.holds:
             return []
-        if res.holds is False:
-            return [(f"the graph is not {need} as the theorems need for the F-{self.model} "
-                     f"model; witness S1 = {sorted(res.witness[0])}, "
-                     f"S2 = {sorted(res.witness[1])}")]
-        rep = robustness(self.graph, time_limit=_BOUNDS_SECONDS, progress=False)
-        return [(f"not decided within {ROBUSTNESS_SECONDS:g} s whether the graph is {need} "
-                 f"as the theorems need for the F-{self.model} model: {rep.r_lower} <= "
-                 f"rho(G) <= {rep.r_upper} (rho >= {r + s - 1} suffices, rho < {r} fails)")]
+        return [(f"the graph is not {need} as the theorems need for the F-{self.model} "
+                 f"model; witness S1 = {sorted(witness[0])}, S2 = {sorted(witness[1])}")]
 
     def _dos_problems(self) -> list[str]:
         """Assumption 3 for some T_d > 1, μ_d > 0 (it holds iff the long-run blocked
