@@ -42,8 +42,9 @@ MAX_EVAL_WORK = 20_000_000  # (#constraints) * n, evaluating constraints at the 
 MAX_RATIONAL_CHARS = 100_000  # longest "p/q" string (exact vertex means get long)
 MAX_HALFSPACE_WORK = 3_000_000  # C(u, k) * (u + #test points) for (b); beyond: unchecked
 MAX_POLY_WORK = 3_000_000  # vertex / ray enumeration of P; beyond: unchecked
-MAX_NUMBER_BITS = 16_384  # numerator / denominator of one input rational; beyond: unchecked
-MAX_SCALE_BITS = 32_768  # a common denominator (all points, or one constraint); beyond: unchecked
+MAX_NUMBER_BITS = 32_768  # numerator / denominator of one input rational; beyond: unchecked
+MAX_DIGITS = MAX_NUMBER_BITS * 30_103 // 100_000 + 1  # decimal digits of such a number
+MAX_SCALE_BITS = 65_536  # a common denominator (of all points, of a sum); beyond: unchecked
 WORD_BITS = 1_024  # integers up to this size count as one unit of work
 
 _HEAD = ("rescon_certificate", "kind")
@@ -96,15 +97,26 @@ def _rat(x: Any, where: str) -> Fraction:
         p, _, q = x.partition("/")
         if len(x) > MAX_RATIONAL_CHARS:
             raise _too_big(where, f"a string of {len(x)} characters")
-        try:
-            num, den = int(p), int(q) if q else 1
-        except ValueError:  # beyond Python's limit on int-from-string digits
-            raise _too_big(where, "more decimal digits than Python converts") from None
+        num = _decimal(p.lstrip("-"), where) * (-1 if p.startswith("-") else 1)
+        den = _decimal(q, where) if q else 1
         if den == 0:
             raise Invalid(f"{where} = {_short(repr(x))} has denominator 0")
         return _bounded(Fraction(num, den), where)
     raise Invalid(f"{where} must be a rational number (integer, finite number or "
                   f"\"p/q\" string), got {_tname(x)}")
+
+
+def _decimal(digits: str, where: str) -> int:
+    """The value of a string of decimal digits, up to MAX_DIGITS significant digits
+    (converted in chunks: Python's int() refuses more than 4300 digits by default)."""
+    digits = digits.lstrip("0") or "0"
+    if len(digits) > MAX_DIGITS:
+        raise _too_big(where, f"{len(digits)} decimal digits")
+    value = 0
+    for i in range(0, len(digits), 4000):
+        chunk = digits[i:i + 4000]
+        value = value * 10 ** len(chunk) + int(chunk)
+    return value
 
 
 def _too_big(where: str, what: str) -> Exception:
