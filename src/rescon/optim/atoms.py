@@ -1,0 +1,393 @@
+"""The atom library: convex costs with exact data and documented subgradients.
+
+Every atom is an :class:`~rescon.optim.oracle.Oracle` evaluated with vectorised numpy on
+stacked points Z (B, d), keeps its data (``Q``, ``c``, ``q``, ``A``, ``b``, …) as
+attributes, and says whether it is ``quadratic`` (a convex polynomial of degree ≤ 2:
+argmin from linear algebra) or ``polyhedral`` (piecewise affine: argmin from an LP),
+so that a redundancy check can compute argmin sets exactly.
+
+Subgradient conventions (r = A z − b, the residual; ties are decided on the computed
+float values, and any element chosen is a subgradient up to that rounding):
+
+* smooth atoms (quadratic, affine, Huber, log-sum-exp): the gradient;
+* ``|aᵀz − b|``, ``‖Az − b‖₁``, hinge ``max(0, aᵀz − b)``: sign(r) with sign(0) = 0,
+  i.e. the minimum-norm element of the subdifferential (for ‖·‖₁ when A = I);
+* ``‖Az − b‖₂``: Aᵀ r/‖r‖, and 0 at r = 0 (the minimum-norm element, 0 ∈ ∂);
+* ``‖Az − b‖∞``, max of affine functions, max of convex terms: the mean of the
+  gradients of the active pieces (for ‖·‖∞ with A = I and for two tied pieces of equal
+  gradient norm this is the minimum-norm element; otherwise an element of ∂), and
+  0 for ‖·‖∞ at r = 0;
+* sums and nonnegative scalings: the sum / the scaled subgradient.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .oracle import Oracle
+
+__all__ = [
+    "AbsAffine",
+    "Affine",
+    "Atom",
+    "Hinge",
+    "Huber",
+    "LogSumExp",
+    "MaxAffine",
+    "MaxOf",
+    "Norm1",
+    "Norm2",
+    "NormInf",
+    "Quadratic",
+    "Scaled",
+    "Sum",
+    "is_psd",
+    "ldl_psd",
+]
+
+
+def ldl_psd(M: Sequence[Sequence[Any]]) -> list[tuple[Fraction, list[Fraction]]] | None:
+    """M = Σ_k p_k l_k l_kᵀ with p_k > 0 when the symmetric matrix ``M`` (Fractions, ints
+    or floats, each read exactly) is positive semidefinite, else None — decided in exact
+    rational arithmetic.
+
+    Symmetric Gaussian elimination: a negative pivot refutes PSD; a zero pivot requires
+    its whole remaining row to vanish (else a 2×2 principal minor is negative).
+    O(d³) Fraction operations.
+    """
+    A = [[Fraction(v) for v in row] for row in M]
+    n = len(A)
+    out = []
+    for k in range(n):
+        p = A[k][k]
+        if p < 0 or (p == 0 and any(A[k][j] != 0 for j in range(k + 1, n))):
+            return None
+        if p == 0:
+            continue
+        col = [Fraction(0)] * k + [A[i][k] / p for i in range(k, n)]
+        for i in range(k + 1, n):
+            if col[i]:
+                for j in range(k + 1, n):
+                    A[i][j] -= col[i] * A[k][j]
+        out.append((p, col))
+    return out
+
+
+def is_psd(M: Sequence[Sequence[Any]]) -> bool:
+    """Whether the symmetric matrix ``M`` is positive semidefinite, exactly
+    (see :func:`ldl_psd`)."""
+    return ldl_psd(M) is not None
+
+
+def _matrix(name: str, value: Any, *, cols: int | None = None) -> np.ndarray:
+    """``value`` as a finite float 2-D array (a 1-D array is one row)."""
+    try:
+        A = np.array(value, dtype=float, ndmin=2)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a real matrix; got {type(value).__name__}") from None
+    if A.ndim != 2 or A.shape[1] == 0 or (cols is not None and A.shape[1] != cols):
+        raise InputError(f"{name} must be a real (m, {cols or 'd'}) matrix; got shape {A.shape}")
+    if not np.isfinite(A).all():
+        raise InputError(f"{name} must be finite")
+    return A
+
+
+def _vector(name: str, value: Any, n: int) -> np.ndarray:
+    v = np.zeros(n) if value is None else np.array(value, dtype=float).reshape(-1)
+    if v.shape != (n,) or not np.isfinite(v).all():
+        raise InputError(f"{name} must be a finite vector of length {n}; got {value!r}")
+    return v
+
+
+def _scalar(name: str, value: Any) -> float:
+    v = np.asarray(value, dtype=float)
+    if v.size != 1 or not np.isfinite(v).all():
+        raise InputError(f"{name} must be a finite real number; got {value!r}")
+    return float(v.reshape(()))
+
+
+def _mean_active(vals: np.ndarray, grads: np.ndarray) -> np.ndarray:
+    """Mean of ``grads[:, i]`` over the pieces i attaining the row maximum of ``vals``
+    (B, m); ``grads`` (B, m, d) or (m, d) when the same for every row."""
+    active = (vals == vals.max(axis=1, keepdims=True)).astype(float)
+    active /= active.sum(axis=1, keepdims=True)
+    if grads.ndim == 2:
+        return active @ grads
+    return np.einsum("bm,bmd->bd", active, grads)
+
+
+class Atom(Oracle):
+    """Base of the library atoms (``kind = "atom"``)."""
+
+    kind = "atom"
+
+
+class Quadratic(Atom):
+    """f(x) = ½(x − c)ᵀQ(x − c) + qᵀx + const, Q symmetric positive semidefinite
+    (checked exactly); ∇f = Q(x − c) + q."""
+
+    quadratic = True
+
+    def __init__(self, Q: Any, c: Any = None, q: Any = None, const: float = 0.0, *,
+                 name: str = "cost") -> None:
+        Q = _matrix("Q", Q)
+        d = Q.shape[0]
+        if Q.shape != (d, d) or not np.array_equal(Q, Q.T):
+            raise InputError(f"Q must be a symmetric (d, d) matrix; got shape {Q.shape}")
+        if not is_psd(Q.tolist()):
+            raise InputError("Q must be positive semidefinite (the quadratic is not convex)")
+        super().__init__(d, name)
+        self.Q, self.c, self.q = Q, _vector("c", c, d), _vector("q", q, d)
+        self.const = _scalar("const", const)
+        self.polyhedral = not Q.any()
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        W = Z - self.c
+        return 0.5 * np.einsum("bi,ij,bj->b", W, self.Q, W) + Z @ self.q + self.const
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return (Z - self.c) @ self.Q + self.q
+
+
+class Affine(Atom):
+    """f(x) = aᵀx + b; ∇f = a."""
+
+    quadratic = polyhedral = True
+
+    def __init__(self, a: Any, b: float = 0.0, *, name: str = "cost") -> None:
+        a = _matrix("a", a)
+        if a.shape[0] != 1:
+            raise InputError(f"a must be a vector; got shape {a.shape}")
+        super().__init__(a.shape[1], name)
+        self.a, self.b = a[0], _scalar("b", b)
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return Z @ self.a + self.b
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return np.broadcast_to(self.a, Z.shape).copy()
+
+
+class _Residual(Atom):
+    """Atoms of the residual r = A x − b (A: (m, d), b: (m,))."""
+
+    def __init__(self, A: Any, b: Any = None, *, name: str = "cost") -> None:
+        self.A = _matrix("A", A)
+        super().__init__(self.A.shape[1], name)
+        self.b = _vector("b", b, self.A.shape[0])
+
+    def _r(self, Z: np.ndarray) -> np.ndarray:
+        return Z @ self.A.T - self.b
+
+
+class AbsAffine(_Residual):
+    """f(x) = |aᵀx − b|; subgradient sign(r)·a, 0 at r = 0 (minimum norm)."""
+
+    polyhedral = True
+
+    def __init__(self, a: Any, b: float = 0.0, *, name: str = "cost") -> None:
+        super().__init__(a, [_scalar("b", b)], name=name)
+        if self.A.shape[0] != 1:
+            raise InputError(f"a must be a vector; got shape {self.A.shape}")
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return np.abs(self._r(Z))[:, 0]
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return np.sign(self._r(Z)) @ self.A
+
+
+class Norm1(_Residual):
+    """f(x) = ‖Ax − b‖₁; subgradient Aᵀ sign(r) with sign(0) = 0."""
+
+    polyhedral = True
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return np.abs(self._r(Z)).sum(axis=1)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return np.sign(self._r(Z)) @ self.A
+
+
+class Norm2(_Residual):
+    """f(x) = ‖Ax − b‖₂; subgradient Aᵀ r/‖r‖, and 0 at r = 0 (minimum norm).
+
+    The residual is divided by max|r_i| before squaring, so neither the value nor the
+    direction under- or overflows."""
+
+    def _unit(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r = self._r(Z)
+        s = np.abs(r).max(axis=1, initial=0.0)
+        u = r / np.where(s > 0, s, 1.0)[:, None]
+        n = np.sqrt((u * u).sum(axis=1))
+        return s, u, n
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        s, _, n = self._unit(Z)
+        return s * n
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        _, u, n = self._unit(Z)
+        return (u / np.where(n > 0, n, 1.0)[:, None]) @ self.A
+
+
+class NormInf(_Residual):
+    """f(x) = ‖Ax − b‖∞; subgradient Aᵀ of the mean of sign(r_i) e_i over the entries
+    attaining max|r_i|, and 0 at r = 0."""
+
+    polyhedral = True
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return np.abs(self._r(Z)).max(axis=1, initial=0.0)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        r = self._r(Z)
+        a = np.abs(r)
+        w = np.sign(r) * (a == a.max(axis=1, keepdims=True))
+        w /= np.maximum((w != 0).sum(axis=1, keepdims=True), 1)
+        return w @ self.A
+
+
+class MaxAffine(Atom):
+    """f(x) = max_i (a_iᵀx + b_i) (pieces, so b enters with a plus sign); subgradient
+    the mean of the active a_i."""
+
+    polyhedral = True
+
+    def __init__(self, A: Any, b: Any = None, *, name: str = "cost") -> None:
+        self.A = _matrix("A", A)
+        super().__init__(self.A.shape[1], name)
+        self.b = _vector("b", b, self.A.shape[0])
+
+    def _pieces(self, Z: np.ndarray) -> np.ndarray:
+        return Z @ self.A.T + self.b
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return self._pieces(Z).max(axis=1)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return _mean_active(self._pieces(Z), self.A)
+
+
+class Hinge(AbsAffine):
+    """f(x) = max(0, aᵀx − b); subgradient a where r > 0, else 0 (minimum norm)."""
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return np.maximum(self._r(Z)[:, 0], 0.0)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return (self._r(Z) > 0).astype(float) @ self.A
+
+
+class Huber(_Residual):
+    """f(x) = Σ_i h_M(a_iᵀx − b_i), h_M(u) = u² for |u| ≤ M, 2M|u| − M² otherwise
+    (CVXPY's convention); gradient Aᵀ clip(2r, −2M, 2M)."""
+
+    def __init__(self, A: Any, b: Any = None, M: float = 1.0, *, name: str = "cost") -> None:
+        super().__init__(A, b, name=name)
+        self.M = _scalar("M", M)
+        if self.M <= 0:
+            raise InputError(f"M must be a positive number; got {M!r}")
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        a = np.abs(self._r(Z))
+        return np.where(a <= self.M, a * a, 2 * self.M * a - self.M**2).sum(axis=1)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return np.clip(2 * self._r(Z), -2 * self.M, 2 * self.M) @ self.A
+
+
+class LogSumExp(MaxAffine):
+    """f(x) = log Σ_i exp(a_iᵀx + b_i); gradient Aᵀ softmax (shifted by the max)."""
+
+    polyhedral = False
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        P = self._pieces(Z)
+        m = P.max(axis=1)
+        return m + np.log(np.exp(P - m[:, None]).sum(axis=1))
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        P = self._pieces(Z)
+        E = np.exp(P - P.max(axis=1, keepdims=True))
+        return (E / E.sum(axis=1, keepdims=True)) @ self.A
+
+
+def _val(t: Oracle, Z: np.ndarray) -> np.ndarray:
+    """A term's values on already-checked points (atoms unchecked: they are ours)."""
+    return t._value(Z) if isinstance(t, Atom) else t.value(Z)
+
+
+def _sub(t: Oracle, Z: np.ndarray) -> np.ndarray:
+    return t._subgradient(Z) if isinstance(t, Atom) else t.subgradient(Z)
+
+
+def _same_d(terms: Sequence[Oracle], what: str) -> int | None:
+    dims = {t.d for t in terms} - {None}
+    if len(dims) > 1:
+        raise InputError(f"{what}: terms of different dimensions {sorted(dims)}")
+    return dims.pop() if dims else None
+
+
+def _oracles(terms: Any, what: str) -> list[Oracle]:
+    ts = list(terms)
+    if not ts or not all(isinstance(t, Oracle) for t in ts):
+        raise InputError(f"{what} needs a nonempty list of oracles; got {terms!r}")
+    return ts
+
+
+class Sum(Atom):
+    """f = Σ_j f_j; subgradient Σ_j g_j. Quadratic / polyhedral when every term is."""
+
+    def __init__(self, terms: Any, *, name: str = "cost") -> None:
+        self.terms = _oracles(terms, "Sum")
+        super().__init__(_same_d(self.terms, "Sum"), name)
+        self.quadratic = all(t.quadratic for t in self.terms)
+        self.polyhedral = all(t.polyhedral for t in self.terms)
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return np.sum([_val(t, Z) for t in self.terms], axis=0)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return np.sum([_sub(t, Z) for t in self.terms], axis=0)
+
+
+class Scaled(Atom):
+    """f = coef · term with coef ≥ 0; subgradient coef · g."""
+
+    def __init__(self, coef: float, term: Oracle, *, name: str = "cost") -> None:
+        self.coef = _scalar("coef", coef)
+        if self.coef < 0:
+            raise InputError(f"coef must be >= 0 (a negative scaling is not convex); got {coef}")
+        self.term = _oracles([term], "Scaled")[0]
+        super().__init__(term.d, name)
+        self.quadratic, self.polyhedral = term.quadratic, term.polyhedral
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return self.coef * _val(self.term, Z)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return self.coef * _sub(self.term, Z)
+
+
+class MaxOf(Atom):
+    """f = max_j f_j of convex terms; subgradient the mean of the active terms' ones
+    (pos(g) is ``MaxOf([g, Affine(0, 0)])``: 0 where g ≤ 0)."""
+
+    def __init__(self, terms: Any, *, name: str = "cost") -> None:
+        self.terms = _oracles(terms, "MaxOf")
+        super().__init__(_same_d(self.terms, "MaxOf"), name)
+        self.polyhedral = all(t.polyhedral for t in self.terms)
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return np.max([_val(t, Z) for t in self.terms], axis=0)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        vals = np.stack([_val(t, Z) for t in self.terms], axis=1)
+        grads = np.stack([_sub(t, Z) for t in self.terms], axis=1)
+        return _mean_active(vals, grads)

@@ -1,0 +1,503 @@
+"""Cost expressions: a small exact IR, the TOML grammar's parser, convexity, lowering.
+
+Grammar (DESIGN.md; a recursive-descent parser, no ``eval``)::
+
+    expr  := term (("+" | "-") term)*
+    term  := unary (("*" | "/") unary)*
+    unary := ("+" | "-") unary | power
+    power := atom ("^" unary)?
+    atom  := NUMBER | x1 | x2 | … | FUNC "(" expr ("," expr)* ")" | "(" expr ")"
+    FUNC  := abs | pos | max | min | norm1 | norm2 | norminf | huber | sqrt | logsumexp
+
+Numbers are read exactly (``0.3`` is 3/10). Every expression is kept in a canonical
+form: a polynomial of degree ≤ 2 with rational coefficients plus a list of
+coef · call terms. Convexity is decided by DCP-style rules, with one exact
+refinement: the polynomial part is convex iff its Hessian is positive semidefinite,
+decided in rational arithmetic (so ``x1^2 + 2*x1*x2 + x2^2`` is convex).
+
+* ``abs``, ``norm1/2/inf``, ``huber``, ``logsumexp``: convex, of affine arguments;
+* ``pos``, ``max``: convex and nondecreasing: arguments convex (or affine);
+* ``min``: concave and nondecreasing: arguments concave (or affine);
+* ``sqrt(q)``: convex when q is a sum of squares of affine functions, i.e. the
+  homogenised matrix [[S, l/2], [l/2ᵀ, k]] of q = xᵀSx + lᵀx + k is positive
+  semidefinite (exactly); it is then the norm ‖R(x, 1)‖₂ of an exact LDLᵀ factor;
+* ``e^2`` of an affine e, products of polynomials up to degree 2, ``/`` by a nonzero
+  constant; a nonnegative sum of convex terms is convex, a negated concave one too.
+
+The same IR is the target of the CasADi and CVXPY lowerings (:mod:`.casadi_adapter`,
+:mod:`.cvxpy_adapter`), so every source gets the atom library's conventions.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from . import atoms
+from .oracle import Oracle
+
+__all__ = ["FUNCTIONS", "Expr", "ExprError", "expression_cost", "lower", "parse"]
+
+#: the grammar's functions and their number of arguments (None: one or more)
+FUNCTIONS = {"abs": 1, "pos": 1, "sqrt": 1, "huber": (1, 2), "max": None, "min": None,
+             "norm1": None, "norm2": None, "norminf": None, "logsumexp": None}
+_AFFINE_ARGS = {"abs", "norm1", "norm2", "norminf", "huber", "logsumexp"}
+
+
+class ExprError(Exception):
+    """An expression cannot be built or is not convex; ``pos`` locates it (an offset in
+    the source string, or None). ``nonconvex`` is True when non-convexity is proven
+    (an indefinite or concave quadratic polynomial), not only outside the rules."""
+
+    def __init__(self, msg: str, pos: int | None, nonconvex: bool = False) -> None:
+        super().__init__(msg)
+        self.msg, self.pos, self.nonconvex = msg, pos, nonconvex
+
+
+@dataclass
+class Call:
+    """fn(args) with an optional parameter (Huber's M)."""
+
+    fn: str
+    args: list[Expr]
+    pos: int | None
+    param: Fraction | None = None
+
+
+@dataclass
+class Expr:
+    """const + Σ lin[i] x_i + Σ_{i≤j} quad[i, j] x_i x_j + Σ coef · call."""
+
+    pos: int | None = None
+    const: Fraction = Fraction(0)
+    lin: dict[int, Fraction] = field(default_factory=dict)
+    quad: dict[tuple[int, int], Fraction] = field(default_factory=dict)
+    terms: list[tuple[Fraction, Call]] = field(default_factory=list)
+
+    # -- constructors ------------------------------------------------------ #
+
+    @classmethod
+    def number(cls, value: Any, pos: int | None = None) -> Expr:
+        return cls(pos, Fraction(value))
+
+    @classmethod
+    def var(cls, i: int, pos: int | None = None) -> Expr:
+        return cls(pos, lin={i: Fraction(1)})
+
+    @classmethod
+    def call(cls, fn: str, args: list[Expr], pos: int | None = None,
+             param: Any = None) -> Expr:
+        if not args:
+            raise ExprError(f"{fn} needs at least one argument", pos)
+        par = None if param is None else Fraction(param)
+        if fn == "huber" and (par is None or par <= 0):
+            raise ExprError("huber's M must be a positive constant", pos)
+        return cls(pos, terms=[(Fraction(1), Call(fn, list(args), pos, par))])
+
+    # -- shape ------------------------------------------------------------- #
+
+    @property
+    def degree(self) -> int:
+        """Polynomial degree (3 stands for "has call terms")."""
+        if self.terms:
+            return 3
+        if any(self.quad.values()):
+            return 2
+        return 1 if any(self.lin.values()) else 0
+
+    @property
+    def variables(self) -> set[int]:
+        vs = {i for i, c in self.lin.items() if c} | {v for k in self.quad for v in k}
+        for _, call in self.terms:
+            for a in call.args:
+                vs |= a.variables
+        return vs
+
+    # -- arithmetic -------------------------------------------------------- #
+
+    def __add__(self, other: Expr) -> Expr:
+        out = Expr(self.pos, self.const + other.const, dict(self.lin), dict(self.quad),
+                   self.terms + other.terms)
+        for k, v in other.lin.items():
+            out.lin[k] = out.lin.get(k, 0) + v
+        for k, v in other.quad.items():
+            out.quad[k] = out.quad.get(k, 0) + v
+        return out
+
+    def scale(self, c: Fraction) -> Expr:
+        return Expr(self.pos, c * self.const, {k: c * v for k, v in self.lin.items()},
+                    {k: c * v for k, v in self.quad.items()},
+                    [(c * a, t) for a, t in self.terms if c * a])
+
+    def __neg__(self) -> Expr:
+        return self.scale(Fraction(-1))
+
+    def __sub__(self, other: Expr) -> Expr:
+        return self + (-other)
+
+    def mul(self, other: Expr, pos: int | None) -> Expr:
+        if self.degree == 0:
+            return other.scale(self.const)
+        if other.degree == 0:
+            return self.scale(other.const)
+        if self.degree + other.degree > 2:
+            raise ExprError("a product of non-constant expressions must be a polynomial "
+                            "of degree <= 2", pos)
+        out = Expr(self.pos)
+        for a, b in ((self, other), (other, self)):
+            out = out + Expr(lin={i: a.const * c for i, c in b.lin.items()},
+                             quad={k: a.const * c for k, c in b.quad.items()})
+        out.const = self.const * other.const
+        for i, a in self.lin.items():
+            for j, b in other.lin.items():
+                k = (min(i, j), max(i, j))
+                out.quad[k] = out.quad.get(k, 0) + a * b
+        return out
+
+    def div(self, other: Expr, pos: int | None) -> Expr:
+        if other.degree != 0:
+            raise ExprError("can only divide by a constant", pos)
+        if other.const == 0:
+            raise ExprError("division by zero", pos)
+        return self.scale(1 / other.const)
+
+    def power(self, exponent: Expr, pos: int | None) -> Expr:
+        p = exponent.const if exponent.degree == 0 else None
+        if p == 0:
+            return Expr.number(1, self.pos)
+        if p == 1:
+            return self
+        if p == 2:
+            if self.degree > 1:
+                raise ExprError("^2 needs an affine base", pos)
+            return self.mul(self, pos)
+        raise ExprError("the exponent must be the number 0, 1 or 2", exponent.pos)
+
+    # -- curvature --------------------------------------------------------- #
+
+    def hessian(self, d: int) -> list[list[Fraction]]:
+        """Q with ½xᵀQx the quadratic part."""
+        Q = [[Fraction(0)] * d for _ in range(d)]
+        for (i, j), c in self.quad.items():
+            Q[i][j] += c
+            Q[j][i] += c
+        return Q
+
+    def curvature(self) -> tuple[str, tuple[str, int | None] | None]:
+        """("constant" | "affine" | "convex" | "concave" | "none", why-not-convex)."""
+        deg = _poly_degree(self)
+        d = 1 + max(self.variables, default=-1)
+        if deg < 2:
+            curv = ("constant", "affine")[deg]
+        else:
+            Q = self.hessian(d)
+            curv = ("convex" if atoms.is_psd(Q) else
+                    "concave" if atoms.is_psd([[-v for v in r] for r in Q]) else "none")
+        why = None if curv != "none" else (_INDEFINITE, self.pos)
+        for coef, call in self.terms:
+            c, w = _call_curvature(call)
+            if coef < 0:
+                c = {"convex": "concave", "concave": "convex"}.get(c, c)
+            curv, why = _combine(curv, why, c, w, call.pos)
+        return curv, why
+
+    def check_convex(self) -> None:
+        """Raise :class:`ExprError` (with the position) unless the rules prove convexity."""
+        curv, why = self.curvature()
+        if curv in ("constant", "affine", "convex"):
+            return
+        if why is None:
+            why = ("the expression is concave, not convex", self.pos)
+        poly_only = not self.terms
+        raise ExprError(why[0], why[1], nonconvex=poly_only)
+
+
+def _poly_degree(e: Expr) -> int:
+    if any(e.quad.values()):
+        return 2
+    return 1 if any(e.lin.values()) else 0
+
+
+_ORDER = {"constant": 0, "affine": 1}
+_INDEFINITE = "the quadratic part is neither convex nor concave"
+
+
+def _combine(a: str, wa: Any, b: str, wb: Any, pos: int | None) -> tuple[str, Any]:
+    """Curvature of a sum."""
+    if a == "none":
+        return a, wa
+    if b == "none":
+        return b, wb
+    if a in _ORDER and b in _ORDER:
+        return max(a, b, key=_ORDER.get), None
+    if a in _ORDER:
+        return b, None
+    if b in _ORDER or a == b:
+        return a, None
+    return "none", ("a sum of convex and concave terms is not convex", pos)
+
+
+def _call_curvature(call: Call) -> tuple[str, tuple[str, int | None] | None]:
+    fn, args = call.fn, call.args
+    if fn in _AFFINE_ARGS:
+        for a in args:
+            if a.degree > 1:
+                return "none", (f"{fn} needs affine arguments", a.pos)
+        return "convex", None
+    if fn == "sqrt":
+        if args[0].degree > 2 or atoms.ldl_psd(_homogenised(args[0])) is None:
+            return "none", ("sqrt needs a sum of squares of affine expressions", args[0].pos)
+        return "convex", None
+    want = ("concave",) if fn == "min" else ("convex",)
+    for a in args:
+        c, w = a.curvature()
+        if c == "none":
+            return c, w
+        if c not in _ORDER and c not in want:
+            return "none", (f"{fn} needs {want[0]} (or affine) arguments", a.pos)
+    return ("concave" if fn == "min" else "convex"), None
+
+
+def _homogenised(e: Expr) -> list[list[Fraction]]:
+    """H with e(x) = (x, 1)ᵀ H (x, 1), for a polynomial e of degree ≤ 2."""
+    d = 1 + max(e.variables, default=-1)
+    H = [[v / 2 for v in row] + [Fraction(0)] for row in e.hessian(d)]
+    H.append([Fraction(0)] * (d + 1))
+    for i, c in e.lin.items():
+        H[i][d] += c / 2
+        H[d][i] += c / 2
+    H[d][d] = e.const
+    return H
+
+
+# --------------------------------------------------------------------------- #
+# lowering to atoms
+# --------------------------------------------------------------------------- #
+
+
+def _float(v: Fraction) -> float:
+    try:
+        f = float(v)
+    except OverflowError:
+        f = math.inf
+    if not math.isfinite(f):
+        raise ExprError(f"the number {v} does not fit a float", None)
+    return f
+
+
+def _affine_rows(args: list[Expr], d: int) -> tuple[np.ndarray, np.ndarray]:
+    """A, c with args[i] = A[i] x + c[i] (affine args)."""
+    A = np.zeros((len(args), d))
+    c = np.array([_float(a.const) for a in args])
+    for r, a in enumerate(args):
+        for i, v in a.lin.items():
+            A[r, i] = _float(v)
+    return A, c
+
+
+def lower(e: Expr, d: int) -> Oracle:
+    """The atom (tree) computing the convex expression ``e`` over x ∈ R^d
+    (:meth:`Expr.check_convex` must have passed)."""
+    parts: list[Oracle] = []
+    if any(e.quad.values()):
+        Q = np.array([[_float(v) for v in row] for row in e.hessian(d)])
+        parts.append(atoms.Quadratic(Q, q=_affine_rows([_linear(e)], d)[0][0],
+                                     const=_float(e.const)))
+    elif any(e.lin.values()) or e.const or not e.terms:
+        A, c = _affine_rows([_linear(e)], d)
+        parts.append(atoms.Affine(A[0], c[0]))
+    for coef, call in e.terms:
+        atom = _lower_call(call, d) if coef > 0 else _lower_negated_min(call, d)
+        parts.append(atom if abs(coef) == 1 else atoms.Scaled(_float(abs(coef)), atom))
+    return parts[0] if len(parts) == 1 else atoms.Sum(parts)
+
+
+def _linear(e: Expr) -> Expr:
+    return Expr(e.pos, e.const, e.lin)
+
+
+def _lower_call(call: Call, d: int) -> Oracle:
+    fn, args = call.fn, call.args
+    if fn == "sqrt":
+        fac = atoms.ldl_psd(_homogenised(args[0]))
+        n = 1 + max(args[0].variables, default=-1)
+        R = np.zeros((max(len(fac), 1), d + 1))
+        for r, (p, col) in enumerate(fac):
+            R[r, :n] = [_float(v) * math.sqrt(_float(p)) for v in col[:n]]
+            R[r, d] = _float(col[n]) * math.sqrt(_float(p))
+        return atoms.Norm2(R[:, :d], -R[:, d])
+    if fn == "pos":
+        if args[0].degree <= 1:
+            A, c = _affine_rows(args, d)
+            return atoms.Hinge(A[0], -c[0])
+        return atoms.MaxOf([lower(args[0], d), atoms.Affine(np.zeros(d), 0.0)])
+    if fn == "max":
+        if all(a.degree <= 1 for a in args):
+            return atoms.MaxAffine(*_affine_rows(args, d))
+        return atoms.MaxOf([lower(a, d) for a in args])
+    A, c = _affine_rows(args, d)
+    if fn == "abs":
+        return atoms.AbsAffine(A[0], -c[0])
+    if fn == "huber":
+        return atoms.Huber(A, -c, _float(call.param))
+    if fn == "logsumexp":
+        return atoms.LogSumExp(A, c)
+    return {"norm1": atoms.Norm1, "norm2": atoms.Norm2, "norminf": atoms.NormInf}[fn](A, -c)
+
+
+def _lower_negated_min(call: Call, d: int) -> Oracle:
+    """−min(e_1, …) = max(−e_1, …)."""
+    return _lower_call(Call("max", [-a for a in call.args], call.pos), d)
+
+
+# --------------------------------------------------------------------------- #
+# the parser
+# --------------------------------------------------------------------------- #
+
+_TOKEN = re.compile(r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"
+                    r"|(?P<name>[A-Za-z_][A-Za-z_0-9]*)|(?P<op>[-+*/^(),]))")
+
+
+def _tokens(src: str) -> list[tuple[str, str, int]]:
+    out, i = [], 0
+    while True:
+        m = _TOKEN.match(src, i)
+        if m is None:
+            j = len(src) - len(src[i:].lstrip())
+            if j == len(src):
+                break
+            raise ExprError(f"unexpected character {src[j]!r}", j)
+        kind = m.lastgroup or ""
+        out.append((kind, m.group(kind), m.start(kind)))
+        i = m.end()
+    out.append(("end", "", len(src)))
+    return out
+
+
+class _Parser:
+    def __init__(self, src: str) -> None:
+        self.toks = _tokens(src)
+        self.i = 0
+
+    def peek(self) -> tuple[str, str, int]:
+        return self.toks[self.i]
+
+    def take(self, want: str | None = None) -> tuple[str, str, int]:
+        tok = self.toks[self.i]
+        if want is not None and tok[1] != want:
+            got = "the end" if tok[0] == "end" else repr(tok[1])
+            raise ExprError(f"expected {want!r}, found {got}", tok[2])
+        self.i += 1
+        return tok
+
+    def expr(self) -> Expr:
+        e = self.term()
+        while self.peek()[1] in ("+", "-"):
+            op = self.take()[1]
+            t = self.term()
+            e = e + t if op == "+" else e - t
+        return e
+
+    def term(self) -> Expr:
+        e = self.unary()
+        while self.peek()[1] in ("*", "/"):
+            _, op, pos = self.take()
+            u = self.unary()
+            e = e.mul(u, pos) if op == "*" else e.div(u, pos)
+        return e
+
+    def unary(self) -> Expr:
+        if self.peek()[1] in ("+", "-"):
+            _, op, pos = self.take()
+            e = self.unary()
+            e = e if op == "+" else -e
+            e.pos = pos
+            return e
+        return self.power()
+
+    def power(self) -> Expr:
+        e = self.atom()
+        if self.peek()[1] == "^":
+            pos = self.take()[2]
+            e = e.power(self.unary(), pos)
+        return e
+
+    def atom(self) -> Expr:
+        kind, text, pos = self.take()
+        if kind == "num":
+            return Expr.number(Fraction(text), pos)
+        if text == "(":
+            e = self.expr()
+            self.take(")")
+            e.pos = pos
+            return e
+        if kind == "name":
+            m = re.fullmatch(r"x([1-9]\d*)", text)
+            if m:
+                return Expr.var(int(m.group(1)) - 1, pos)
+            if text in FUNCTIONS:
+                return self.call(text, pos)
+            raise ExprError(f"unknown name {text!r} (variables are x1, x2, …; functions: "
+                            f"{', '.join(FUNCTIONS)})", pos)
+        got = "the end" if kind == "end" else repr(text)
+        raise ExprError(f"expected a number, a variable, a function or '(', found {got}", pos)
+
+    def call(self, fn: str, pos: int) -> Expr:
+        self.take("(")
+        args = [self.expr()]
+        while self.peek()[1] == ",":
+            self.take()
+            args.append(self.expr())
+        self.take(")")
+        n = FUNCTIONS[fn]
+        lo, hi = (n, n) if isinstance(n, int) else n if n else (1, None)
+        if len(args) < lo or (hi is not None and len(args) > hi):
+            raise ExprError(f"{fn} takes {lo if lo == hi else f'{lo} or {hi}'} argument(s); "
+                            f"got {len(args)}", pos)
+        if fn == "huber" and len(args) == 2:
+            if args[1].degree != 0:
+                raise ExprError("huber's M must be a positive constant", args[1].pos)
+            return Expr.call(fn, args[:1], pos, args[1].const)
+        return Expr.call(fn, args, pos, 1 if fn == "huber" else None)
+
+
+def parse(src: str) -> Expr:
+    """The expression ``src`` in canonical form (raises :class:`ExprError`)."""
+    p = _Parser(src)
+    e = p.expr()
+    kind, text, pos = p.peek()
+    if kind != "end":
+        raise ExprError(f"unexpected {text!r}", pos)
+    return e
+
+
+def expression_cost(src: Any, *, d: int | None = None, name: str = "cost") -> Oracle:
+    """The oracle of the cost expression ``src`` (the grammar above) over x ∈ R^d
+    (d defaults to the largest variable index used; 1 for a constant).
+
+    Raises
+    ------
+    InputError
+        A syntax error, an expression the rules cannot prove convex, or a variable
+        beyond ``d`` — one line naming the expression and the position (0-based).
+    """
+    if not isinstance(src, str):
+        raise InputError(f"{name}: a cost expression must be a string; got {type(src).__name__}")
+    try:
+        e = parse(src)
+        e.check_convex()
+        used = 1 + max(e.variables, default=0)
+        if d is not None and used > d:
+            raise ExprError(f"x{used} is used but d = {d}", None)
+        o = lower(e, d if d is not None else used)
+    except ExprError as exc:
+        at = "" if exc.pos is None else f" at position {exc.pos}"
+        raise InputError(f"{name}: expression {src!r}: {exc.msg}{at}") from None
+    o.name, o.kind, o.source = name, "expression", src
+    return o
