@@ -20,9 +20,15 @@ Facts used (proofs in FORMAT.md):
 (c) Tverberg: F + 1 pairwise disjoint index groups, each with x in its hull, put a
     whole group inside every S with |S| = n - F, so x ∈ Psi.
 
+Cheap tests run first (the Tukey depth of a claimed point along each axis, the Farkas
+sums modulo a prime); every exact stage has a size, work and bit-size limit (work in
+steps on WORD_BITS-bit integers, :func:`_cost`), beyond which the part is recorded as
+unchecked (``ctx.trust``), never as invalid.
+
 check.py calls :func:`install` with its strict-JSON helpers (``Invalid``, ``_obj``,
-``_int``, ``_array``, ``_tname``), so the exception raised here is the one its
-``check()`` catches however check.py was loaded (script, package module, or by path).
+``_int``, ``_array``, ``_tname``) and its ``Unchecked`` exception, so the exceptions
+raised here are the ones its ``check()`` catches however check.py was loaded (script,
+package module, or by path).
 """
 
 from __future__ import annotations
