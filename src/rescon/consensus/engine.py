@@ -218,12 +218,14 @@ def _kernel_points(problems: list[np.ndarray], F: int, method: str,
 
     "project" in the plane goes through the numba batch path
     (:mod:`rescon.geometry._small2d`: exact decisions, float geometry, certified error
-    bound), in space through :mod:`rescon.geometry._small3d` (exact halfspaces, one
-    batched QP, a KKT polish checked to 1e-11 of the set's scale); the sets they
-    decline and every other case are computed exactly, once per distinct set in a run
-    (``cache``: held values and converged states repeat the same sets).
-    "project-exact" computes everything exactly."""
-    from ..geometry._small2d import OK, project_small_2d
+    bound), in space through :mod:`rescon.geometry._small3d` (exact halfspaces, a float
+    QP, a KKT certificate with rigorous rounding bounds); a batch point is used only if
+    its certified error bound is at most ACCEPT_REL of its own magnitude, so no far
+    value in the set can loosen it. The sets they decline and every other case are
+    computed exactly, once per distinct set in a run (``cache``: held values and
+    converged states repeat the same sets). "project-exact" computes everything
+    exactly."""
+    from ..geometry._small2d import ACCEPT_REL, OK, project_small_2d
     from ..geometry._small3d import project_small_3d
 
     out: list[np.ndarray | None] = [None] * len(problems)
@@ -239,9 +241,9 @@ def _kernel_points(problems: list[np.ndarray], F: int, method: str,
                 err = np.empty(len(idx))
                 status = np.empty(len(idx), dtype=np.int64)
                 project_small_2d(Ys, F, pts, err, status)
-                found = status == OK
+                found = (status == OK) & (err <= ACCEPT_REL * np.abs(pts).max(axis=1))
             else:
-                pts, found = project_small_3d(Ys, F)
+                pts, _, found = project_small_3d(Ys, F)
             for k, p, ok in zip(idx, pts, found, strict=True):
                 if ok:
                     out[k] = p

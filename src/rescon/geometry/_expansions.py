@@ -21,11 +21,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .._rounding import MIN_NORMAL
+from .._rounding import UNIT_ROUNDOFF as EPS
+
 #: Dekker's splitter for doubles: 2^27 + 1
 _SPLITTER = 134217729.0
 #: what :func:`side_of_meet` returns for parallel lines
 PARALLEL = 2
-EPS = 2.0**-53
 #: nonzero |coordinates| must lie in [TINY, HUGE] for the predicates here to be exact:
 #: then products of up to four differences neither underflow nor overflow
 TINY, HUGE = 2.0**-120, 2.0**120
@@ -185,6 +187,35 @@ def _normal3(Y, i, j, k, C, nC):
 
 
 @njit(cache=True, nogil=True)
+def orient3(Y, i, j, k, q):
+    """Exact sign of ((p_j − p_i) × (p_k − p_i)) · (p_q − p_i) for rows of Y."""
+    C = np.empty((3, 16))
+    nC = np.empty(3, dtype=np.int64)
+    _normal3(Y, i, j, k, C, nC)
+    d = np.empty(2)
+    S = np.empty(3 * 2 * 2 * 16)
+    n = 0
+    for c in range(3):
+        difference(Y[q, c], Y[i, c], d)
+        n += product(C[c], nC[c], d, 2, S[n:])
+    return sign(S, compress(S, n))
+
+
+@njit(cache=True, nogil=True)
+def exact_mean(Y, mean, err):
+    """The mean of the rows of Y per coordinate: the exact sum (an expansion) rounded,
+    then divided by the row count, into mean; err bounds |mean − exact mean| (2 ulps
+    from the two roundings, plus the smallest normal for an underflowing quotient)."""
+    m = Y.shape[0]
+    e = np.empty(m)
+    for c in range(Y.shape[1]):
+        for q in range(m):
+            e[q] = Y[q, c]
+        mean[c] = approximate(e, compress(e, m)) / m
+        err[c] = 4.0 * EPS * abs(mean[c]) + MIN_NORMAL
+
+
+@njit(cache=True, nogil=True)
 def approximate(e, n):
     """The value of an expansion, rounded (summed from its smallest component)."""
     s = 0.0
@@ -194,16 +225,22 @@ def approximate(e, n):
 
 
 @njit(cache=True, nogil=True)
-def normals3(Y, subsets, out):
-    """For each triple of ``subsets``: its normal (p_j − p_i) × (p_k − p_i), each
-    component its exact value rounded (relative error a few ulps, however close to
-    collinear the triple is), into out."""
+def normal3(Y, i, j, k, out):
+    """The normal (p_j − p_i) × (p_k − p_i), each component its exact value rounded
+    (within 3 ulps, however close to collinear the triple is; exactly 0 only when the
+    component is), into out."""
     C = np.empty((3, 16))
     nC = np.empty(3, dtype=np.int64)
+    _normal3(Y, i, j, k, C, nC)
+    for c in range(3):
+        out[c] = approximate(C[c], nC[c])
+
+
+@njit(cache=True, nogil=True)
+def normals3(Y, subsets, out):
+    """normal3 for each triple of ``subsets``, into the rows of out."""
     for t in range(subsets.shape[0]):
-        _normal3(Y, subsets[t, 0], subsets[t, 1], subsets[t, 2], C, nC)
-        for c in range(3):
-            out[t, c] = approximate(C[c], nC[c])
+        normal3(Y, subsets[t, 0], subsets[t, 1], subsets[t, 2], out[t])
 
 
 @njit(cache=True, nogil=True)

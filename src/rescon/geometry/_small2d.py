@@ -19,10 +19,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._rounding import UNIT_ROUNDOFF as EPS
 from ._expansions import PARALLEL, difference, in_range, orient, side_of_meet
 
-EPS = 2.0**-53
 OK = 0
+#: a batch answer x is used only if its certified error bound is at most this times
+#: ‖x‖_∞: relative to the answer itself, so no far point of the set can loosen it
+#: (the sets that fail it are computed exactly)
+ACCEPT_REL = 2.0**-40
 #: why a problem fell back to the exact path (status ≥ 1): a meeting point of nearly
 #: parallel lines, a flat kernel the path does not handle, the nearest feature
 #: undecided, coordinates outside the range where expansions are exact (in_range)
