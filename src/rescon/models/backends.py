@@ -18,12 +18,8 @@ from typing import Any
 
 from ..errors import SolverNotFound
 
-__all__ = ["BACKENDS", "STATUSES", "Backend", "available_backends", "require_backend",
+__all__ = ["BACKENDS", "Backend", "available_backends", "require_backend",
            "silent_highs", "silent_highs_inside"]
-
-#: The shared status set every backend's native statuses map onto.
-STATUSES = ("optimal", "infeasible", "time_limit", "error")
-
 
 @dataclass(frozen=True)
 class Backend:
