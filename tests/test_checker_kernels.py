@@ -869,6 +869,22 @@ def test_polytope_enumeration_limit():
     assert "enumerating 11153835 subsets of the 406 facets" in res.unchecked[0]
 
 
+def test_vertex_test_beyond_its_limit_leaves_the_enumeration_unchecked(monkeypatch):
+    cube = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+    facets = [{"a": [s if j == i else 0 for j in range(3)], "b": max(s, 0)}
+              for i in range(3) for s in (1, -1)]
+    cert = {"rescon_certificate": 1, "kind": "safe_kernel", "points": [list(p) for p in cube],
+            "F": 0, "dim": 3, "vertices": [list(p) for p in cube], "equalities": [],
+            "facets": facets, "proof": {"method": "halfspaces"}}
+    assert check(cert).verdict == "valid"
+    monkeypatch.setattr(K, "MAX_EVAL_WORK", 100)  # 8 vertices x (6 + 9) = 120 > 100
+    res = check(cert)
+    assert res.verdict == "unchecked", res
+    assert res.trusted == ("vertex test", "vertex enumeration"), res.trusted
+    cert["vertices"][0] = [0, 0, 2]  # a wrong vertex is still refuted by the cheap parts
+    assert check(cert).verdict == "invalid"
+
+
 def test_resource_limits():
     c = square_point()
     c["points"] = [[0, 0]] * (K.MAX_POINTS + 1)
