@@ -331,6 +331,18 @@ def test_adversary_messages_errors():
         adversary_messages({8: Constant([1, 1])}, {}, make_view())
 
 
+def test_adversary_messages_that_are_not_numbers_are_named():
+    class Words(Behaviour):
+        def messages(self, sender, receivers, view):
+            return [["a", "b"]] * len(receivers)
+
+        def to_dict(self):
+            return {}
+
+    with pytest.raises(InputError, match=r"Words of sender 0 must return real numbers"):
+        adversary_messages({0: Words()}, {0: np.array([1, 2])}, make_view())
+
+
 def test_step_view_validation():
     v = make_view()
     assert (v.N, v.d) == (N, D)

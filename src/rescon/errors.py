@@ -14,6 +14,7 @@ __all__ = [
     "SolverNotFound",
     "CertificateError",
     "TimeLimitReached",
+    "EmptyKernel",
     "MissingDependency",
 ]
 

@@ -817,7 +817,12 @@ def adversary_messages(behaviours: Mapping[int, Behaviour],
         if not 0 <= int(s) < view.N:
             raise InputError(f"behaviours key {s!r} must be an agent index in [0, {view.N})")
         rec = _receivers(out_neighbours.get(s, np.empty(0, dtype=np.intp)))
-        msg = np.asarray(b.messages(int(s), rec, view), dtype=float)
+        raw = b.messages(int(s), rec, view)
+        try:
+            msg = np.asarray(raw, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"{type(b).__name__} of sender {s} must return real numbers, "
+                             f"shape ({rec.size}, {view.d}); got {_summary(raw)}") from None
         if msg.shape != (rec.size, view.d):
             raise InputError(
                 f"{type(b).__name__} of sender {s} must return shape ({rec.size}, {view.d}); "
@@ -834,3 +839,9 @@ def _demo_view(k: int = 0, t: float = 0.0, seed: int = 0) -> StepView:
     nbrs = [np.array([j for j in range(4) if j != i]) for i in range(4)]
     return StepView(k, t, states, np.array([False, True, True, True]), nbrs,
                     np.random.default_rng(seed))
+
+
+def _summary(value: Any) -> str:
+    """A short description of what a behaviour returned, for an error message."""
+    text = repr(value)
+    return text if len(text) <= 60 else f"{type(value).__name__} {text[:57]}..."
