@@ -66,7 +66,7 @@ class Call:
 
     fn: str
     args: list[Expr]
-    pos: int | None
+    pos: int | None = field(compare=False)
     param: Fraction | None = None
 
 
@@ -74,7 +74,7 @@ class Call:
 class Expr:
     """const + Σ lin[i] x_i + Σ_{i≤j} quad[i, j] x_i x_j + Σ coef · call."""
 
-    pos: int | None = None
+    pos: int | None = field(default=None, compare=False)
     const: Fraction = Fraction(0)
     lin: dict[int, Fraction] = field(default_factory=dict)
     quad: dict[tuple[int, int], Fraction] = field(default_factory=dict)
@@ -122,8 +122,16 @@ class Expr:
     # -- arithmetic -------------------------------------------------------- #
 
     def __add__(self, other: Expr) -> Expr:
+        """The sum; equal call terms are merged (so m − m cancels)."""
+        terms = list(self.terms)
+        for coef, call in other.terms:
+            k = next((k for k, (_, t) in enumerate(terms) if t == call), None)
+            if k is None:
+                terms.append((coef, call))
+            else:
+                terms[k] = (terms[k][0] + coef, call)
         out = Expr(self.pos, self.const + other.const, dict(self.lin), dict(self.quad),
-                   self.terms + other.terms)
+                   [(c, t) for c, t in terms if c])
         for k, v in other.lin.items():
             out.lin[k] = out.lin.get(k, 0) + v
         for k, v in other.quad.items():
