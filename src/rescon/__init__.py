@@ -34,6 +34,7 @@ from .consensus.trajectory import Trajectory
 from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kernel
 from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.sarymsakov import is_sarymsakov
+from .optim import check_subgradient, cost
 
 __version__ = "0.1.0"
 
@@ -58,6 +59,8 @@ __all__ = [
     "check_assumption2",
     "check_attack_model",
     "check_certificate",
+    "check_subgradient",
+    "cost",
     "is_r_robust",
     "is_rs_robust",
     "is_sarymsakov",
