@@ -22,6 +22,7 @@ __all__ = [
     "bareiss_rank",
     "exact_points",
     "float_view",
+    "fraction_str",
     "int_vector",
     "nullspace_exact",
     "solve_exact",
@@ -211,6 +212,31 @@ def solve_exact(M: list[list[Fraction]], rhs: list[Fraction]) -> list[Fraction] 
     if any(A[i][-1] != 0 for i in range(ncols, len(A))):  # extra rows: consistent?
         return None
     return [A[i][-1] for i in range(ncols)]
+
+
+#: below this many bits an int's decimal string is well inside Python's default limit on
+#: int → str conversions (4300 digits ≈ 14 284 bits)
+_STR_BITS = 14_000
+
+
+def _int_str(n: int) -> str:
+    """Decimal digits of n at any size: halves by a power of ten (divmod) until each
+    part is below the limit on int → str."""
+    if n < 0:
+        return "-" + _int_str(-n)
+    if n.bit_length() < _STR_BITS:
+        return str(n)
+    k = int(n.bit_length() * 0.30103) // 2  # about half the digits
+    high, low = divmod(n, 10**k)
+    return _int_str(high) + _int_str(low).zfill(k)
+
+
+def fraction_str(x: Fraction) -> str:
+    """x as str(Fraction) writes it ("p/q", or "p" for an integer), at any size (a
+    kernel of points spanning the exponent range can have vertices of > 4300 digits)."""
+    x = Fraction(x)
+    num = _int_str(x.numerator)
+    return num if x.denominator == 1 else f"{num}/{_int_str(x.denominator)}"
 
 
 def nullspace_exact(M: list[list[Fraction]]) -> list[list[Fraction]]:

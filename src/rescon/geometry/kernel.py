@@ -20,8 +20,16 @@ import numpy as np
 
 from ..errors import EmptyKernel, InputError
 from .emptiness import empty_certificate, empty_from_halfspaces
-from .exact import (AffineHull, ExactPoints, affine_hull, exact_points, float_view,
-                    nullspace_exact, solve_exact)
+from .exact import (
+    AffineHull,
+    ExactPoints,
+    affine_hull,
+    exact_points,
+    float_view,
+    fraction_str,
+    nullspace_exact,
+    solve_exact,
+)
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .polytope import ExactPolytope, clip_to_fixpoint
@@ -199,7 +207,7 @@ class SafeKernel:
 
 
 def _q(x: Fraction) -> str:
-    return str(x)
+    return fraction_str(x)
 
 
 def _ambient(hull: AffineHull, d: int, a: tuple[int, ...], b: int, scale: int
@@ -370,6 +378,17 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     return poly
 
 
+def _direction_floats(rows) -> np.ndarray:
+    """Nonzero rational rows as floats, each divided exactly by its largest |entry|
+    first (entries in [−1, 1]: no overflow, and tiny rows keep their precision) — for
+    rows that stand for directions, whose length is free."""
+    out = []
+    for row in rows:
+        top = max(map(abs, row))
+        out.append([float(v / top) for v in row])
+    return np.array(out, dtype=np.float64)
+
+
 def _affine_of(verts, d: int, full: bool):
     """dim, origin, orthonormal basis and equalities (floats, and exact) of
     aff(vertices); ``full``: already known to be d-dimensional."""
@@ -385,13 +404,12 @@ def _affine_of(verts, d: int, full: bool):
     if dim == 0:
         basis = np.zeros((0, d))
     else:
-        D = np.array([[float(v) for v in row] for row in diffs])
-        _, _, vt = np.linalg.svd(D, full_matrices=False)
+        _, _, vt = np.linalg.svd(_direction_floats(diffs), full_matrices=False)
         basis = vt[:dim]
     kernel_eqs = tuple((tuple(row), sum(r * v for r, v in zip(row, v0, strict=True)))
                        for row in ns)
     if ns:
-        Aeq = np.array([[float(v) for v in row] for row in ns])
+        Aeq = _direction_floats(ns)
         Aeq /= np.linalg.norm(Aeq, axis=1)[:, None]
         beq = Aeq @ origin
     else:

@@ -14,13 +14,14 @@
 from __future__ import annotations
 
 import itertools
+import math
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import EmptyKernel, InputError, SolverError
-from .exact import solve_exact
+from .exact import fraction_str, solve_exact
 
 if TYPE_CHECKING:
     from .kernel import SafeKernel
@@ -39,7 +40,7 @@ def _dot(a, x) -> Fraction:
 
 def point_certificate(K: SafeKernel, x: Vec) -> dict[str, Any]:
     return {"rescon_certificate": 1, "kind": "kernel_point", "points": K.points.tolist(),
-            "F": K.F, "x": [str(v) for v in x], "proof": {"method": "halfspaces"}}
+            "F": K.F, "x": [fraction_str(v) for v in x], "proof": {"method": "halfspaces"}}
 
 
 def kernel_point_of(K: SafeKernel, *, method: str, backend: str, target: Any
@@ -122,6 +123,25 @@ def _vertex_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
     return o + s * (U.T @ lam) / total if total > 0 else o
 
 
+def _frame(K: SafeKernel) -> tuple[np.ndarray, float]:
+    """o, s: the mean of Ψ's float vertices and a power of two about its extent. The
+    float QP/LP guides are solved for y = (x − o)/s, where Ψ has unit size whatever
+    its magnitude (HiGHS reads |b| ≥ 1e20 as infinite; absolute tolerances swamp a
+    kernel at 1e-300), and — s a power of two — the same numbers for X and 2^j X."""
+    V = K.vertices
+    o = (V / len(V)).sum(axis=0)  # no overflow near the largest floats
+    ext = float(np.abs(V - o).max())
+    if not np.isfinite(ext):
+        ext = float(np.abs(V).max())
+    return o, (math.ldexp(1.0, math.frexp(ext)[1]) if ext > 0 else 1.0)
+
+
+def _framed_rows(K: SafeKernel, o: np.ndarray, s: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A, b, origin, basis of Ψ in the frame y = (x − o)/s (:func:`_frame`)."""
+    return K.A, (K.b - K.A @ o) / s, (K.affine_origin - o) / s, K.affine_basis
+
+
 def _guides(K: SafeKernel, m: Vec, backend: str):
     """Float points near the projection, best first. An explicit backend is the only
     guide (its failure is the user's answer); "auto" tries the geometric guide (dim ≤
@@ -129,14 +149,16 @@ def _guides(K: SafeKernel, m: Vec, backend: str):
     from ..models.kernel_models import project
 
     mf = np.array([float(v) for v in m])
+    o, s = _frame(K)
+    rows = _framed_rows(K, o, s)
     if backend not in ("auto", "exact"):
-        yield project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend=backend)
+        yield o + s * project(*rows, (mf - o) / s, backend=backend)
         return
     if backend == "auto" and K.dim <= 2 and len(K.vertices) <= GEOMETRIC_GUIDE_VERTICES:
         yield _geometric_guide(K, mf)
     else:
         try:
-            guess = project(K.A, K.b, K.affine_origin, K.affine_basis, mf, backend="clarabel")
+            guess = o + s * project(*rows, (mf - o) / s, backend="clarabel")
         except SolverError:  # a hint only: the next guide and the exact search decide
             pass
         else:
@@ -231,7 +253,9 @@ def _chebyshev(K: SafeKernel, backend: str) -> Vec:
     if K.dim == 0:
         return ex.vertices[0]
     name = "highs" if backend in ("auto", "exact") else backend
-    centre, _ = chebyshev(K.A, K.b, K.affine_origin, K.affine_basis, backend=name)
+    o, s = _frame(K)
+    centre, _ = chebyshev(*_framed_rows(K, o, s), backend=name)
+    centre = o + s * centre
     x = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre))
     if ex.contains(x):
         return x
