@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .._rounding import UNIT_ROUNDOFF as EPS
-from ._expansions import PARALLEL, difference, in_range, orient, side_of_meet
+from ._expansions import PARALLEL, difference, exact_mean, in_range, orient, side_of_meet
 
 OK = 0
 #: a batch answer x is used only if its certified error bound is at most this times
@@ -32,6 +32,32 @@ ACCEPT_REL = 2.0**-40
 #: undecided, coordinates outside the range where expansions are exact (in_range)
 CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED, OUT_OF_RANGE = 2, 3, 4, 5
 
+
+
+@njit(cache=True, nogil=True)
+def cluster_box(Y, F, out):
+    """Ψ(Y, F) ⊂ conv(S) ⊂ box(S) for every m − F of the points S (Ψ is the intersection
+    of those hulls): with S the m − F points nearest the coordinate-wise median (max
+    norm), the point of S nearest it is within w — box(S)'s largest side, rounded up —
+    of every point of Ψ, the exact projection included (max norm). Writes that point,
+    returns w; converged states make w a few ulps whatever the set's degeneracy."""
+    m, d = Y.shape
+    med = np.empty(d)
+    for c in range(d):
+        med[c] = np.median(Y[:, c])
+    dist = np.empty(m)
+    for q in range(m):
+        dist[q] = np.abs(Y[q] - med).max()
+    order = np.argsort(dist)
+    w = 0.0
+    for c in range(d):
+        lo = hi = Y[order[0], c]
+        for r in range(m - F):
+            lo = min(lo, Y[order[r], c])
+            hi = max(hi, Y[order[r], c])
+        w = max(w, hi - lo)
+    out[:] = Y[order[0]]
+    return w * (1.0 + 2.0 * EPS)
 
 
 @njit(cache=True, nogil=True)
@@ -108,7 +134,7 @@ def _lines(Y, F, rep, A, C, Aerr, Cerr, ends, sgn):
 
 
 @njit(cache=True, nogil=True)
-def _collinear(Y, F, rep, merr, out):
+def _collinear(Y, F, rep, mean, merr, out):
     """When all distinct points lie on one line, Ψ is the segment between the
     (F+1)-th smallest and the (F+1)-th largest point along it (points with multiplicity,
     ordered by x, or by y on a vertical line), and the point nearest the mean (which lies
@@ -128,7 +154,7 @@ def _collinear(Y, F, rep, merr, out):
     lo, hi = vals[F], vals[m - 1 - F]
     if lo > hi:
         return -1.0
-    mp = Y[:, p].mean()
+    mp = mean[p]
     if mp + merr < lo or mp - merr > hi:
         target = lo if mp < lo else hi
         for q in range(m):
@@ -136,7 +162,7 @@ def _collinear(Y, F, rep, merr, out):
                 out[0], out[1] = Y[q, 0], Y[q, 1]
                 return 0.0
     if lo < mp - merr and mp + merr < hi:
-        out[0], out[1] = Y[:, 0].mean(), Y[:, 1].mean()
+        out[0], out[1] = mean[0], mean[1]
         return merr
     return -1.0
 
@@ -332,9 +358,12 @@ def _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
 
 
 @njit(cache=True, nogil=True)
-def _project(P, E, nv, m0, m1, merr, out):
+def _project(P, E, EL, nv, Y, ends, box, m0, m1, merr, out):
     """Nearest point of the polygon P[:nv] to (m0, m1), if the nearest feature (inside,
-    an edge's interior, a vertex) is decided; returns its error bound or −1."""
+    an edge's interior, a vertex) is decided; returns its error bound or −1. Outside,
+    the float-nearest feature is certified: a vertex by its normal cone, an edge by m
+    lying outside its line and between its ends along it (then the answer is computed
+    on the edge's own data line, not from the computed vertices)."""
     # inside: every edge (counter-clockwise) has the point on its left
     inside = True
     undecided = False
@@ -356,9 +385,8 @@ def _project(P, E, nv, m0, m1, merr, out):
     if inside and undecided:
         return -1.0
     best = np.inf
-    bx = 0.0
-    by = 0.0
-    be = 0.0
+    bv = 0
+    bt = 0.0
     for v in range(nv):
         w = (v + 1) % nv
         ex = P[w, 0] - P[v, 0]
@@ -368,19 +396,76 @@ def _project(P, E, nv, m0, m1, merr, out):
         if ll > 0:
             t = ((m0 - P[v, 0]) * ex + (m1 - P[v, 1]) * ey) / ll
         t = min(1.0, max(0.0, t))
-        px = P[v, 0] + t * ex
-        py = P[v, 1] + t * ey
-        dist = np.sqrt((px - m0) ** 2 + (py - m1) ** 2)
+        dist = np.hypot(P[v, 0] + t * ex - m0, P[v, 1] + t * ey - m1)
         if dist < best:
             best = dist
-            bx, by = px, py
-            be = 2.0 * max(E[v], E[w])
-    # a point of P within δ of the minimal distance d lies within √(2δ(2d + δ)) of the
-    # nearest point (parallelogram law), so a near-tie costs at most that much
-    out[0] = bx
-    out[1] = by
-    delta = 2.0 * be + 2.0 * merr + 8.0 * EPS * (abs(bx) + abs(by) + abs(m0) + abs(m1))
-    return be + merr + np.sqrt(2.0 * delta * (2.0 * best + delta)) + delta
+            bv = v
+            bt = t
+    if 0.0 < bt < 1.0:
+        return _edge_nearest(P, E, EL, nv, bv, Y, ends, box, m0, m1, merr, out)
+    return _vertex_nearest(P, E, nv, bv if bt == 0.0 else (bv + 1) % nv, m0, m1, merr, out)
+
+
+@njit(cache=True, nogil=True)
+def _dot_bound(a0, a1, ea, b0, b1, eb):
+    """fl(a · b) and a bound on its distance to a* · b* for |a* − a|, |b* − b| ≤ ea, eb
+    per coordinate (a, b themselves rounded differences: their u|·| is added here)."""
+    e0a, e1a = ea + EPS * abs(a0), ea + EPS * abs(a1)
+    e0b, e1b = eb + EPS * abs(b0), eb + EPS * abs(b1)
+    bound = (e0a * abs(b0) + e0b * abs(a0) + e0a * e0b + e1a * abs(b1) + e1b * abs(a1)
+             + e1a * e1b + 4.0 * EPS * (abs(a0 * b0) + abs(a1 * b1)))
+    return a0 * b0 + a1 * b1, bound * (1.0 + 8.0 * EPS)
+
+
+@njit(cache=True, nogil=True)
+def _vertex_nearest(P, E, nv, c, m0, m1, merr, out):
+    """Vertex c is the nearest point iff m − P_c makes an angle ≥ 90° with both edges
+    at c (its normal cone); decided strictly from the bounds, then the answer is P_c
+    (error E[c]); else −1."""
+    for nb in ((c + nv - 1) % nv, (c + 1) % nv):
+        val, bnd = _dot_bound(m0 - P[c, 0], m1 - P[c, 1], merr + E[c],
+                              P[nb, 0] - P[c, 0], P[nb, 1] - P[c, 1], E[nb] + E[c])
+        if not val < -bnd:
+            return -1.0
+    out[0] = P[c, 0]
+    out[1] = P[c, 1]
+    return E[c]
+
+
+@njit(cache=True, nogil=True)
+def _edge_nearest(P, E, EL, nv, v, Y, ends, box, m0, m1, merr, out):
+    """The edge v → v+1 holds the nearest point in its interior iff m lies strictly
+    outside its line and strictly between its ends along it (convex polygon). Then the
+    answer is m projected onto the edge's line (through its data point b nearer m,
+    direction u of exact components rounded): b + ((m − b)·u / u·u) u, within merr + 16u‖m − b‖ +
+    4u‖answer‖ of the exact projection (u's direction is within 2u relative). −1 if
+    undecided."""
+    w = (v + 1) % nv
+    g = EL[v]
+    base = np.empty(2)
+    u2 = np.empty((2, 2))
+    _line_of(g, Y, ends, box, base, u2)
+    if g >= 0:  # anchored at the line's data point nearer m (the bounds scale with it)
+        q = ends[g, 1]
+        if np.hypot(m0 - Y[q, 0], m1 - Y[q, 1]) < np.hypot(m0 - base[0], m1 - base[1]):
+            base[0], base[1] = Y[q, 0], Y[q, 1]
+    u0, u1 = u2[0, 0] + u2[0, 1], u2[1, 0] + u2[1, 1]
+    ue = 2.0 * EPS * max(abs(u0), abs(u1))
+    sm, em = _dot_bound(m0 - base[0], m1 - base[1], merr, u0, u1, ue)
+    sv, ev = _dot_bound(P[v, 0] - base[0], P[v, 1] - base[1], E[v], u0, u1, ue)
+    sw, ew = _dot_bound(P[w, 0] - base[0], P[w, 1] - base[1], E[w], u0, u1, ue)
+    lo, elo, hi, ehi = (sv, ev, sw, ew) if sv < sw else (sw, ew, sv, ev)
+    if not (lo + elo < sm - em and sm + em < hi - ehi):
+        return -1.0
+    cr, ecr = _dot_bound(P[w, 0] - P[v, 0], P[w, 1] - P[v, 1], E[v] + E[w],
+                         m1 - P[v, 1], -(m0 - P[v, 0]), merr + E[v])
+    if not cr < -ecr:  # (w − v) × (m − v) < 0: m right of a counter-clockwise edge
+        return -1.0
+    t = sm / (u0 * u0 + u1 * u1)
+    out[0] = base[0] + t * u0
+    out[1] = base[1] + t * u1
+    dm = np.hypot(m0 - base[0], m1 - base[1])
+    return merr + 16.0 * EPS * dm + 4.0 * EPS * max(abs(out[0]), abs(out[1]))
 
 
 @njit(cache=True, nogil=True)
@@ -455,8 +540,16 @@ def project_small_2d(Ys, F, out, err, status):
     VB = np.empty(cap, dtype=np.int64)
     QVA = np.empty(cap, dtype=np.int64)
     QVB = np.empty(cap, dtype=np.int64)
+    mean = np.empty(2)
+    merrs = np.empty(2)
     for b in range(B):
         Y = Ys[b]
+        if m >= 3 * F + 1:  # (Ψ ≠ ∅) a converged cluster: any of its points will do
+            e = cluster_box(Y, F, out[b])
+            if e <= ACCEPT_REL * np.abs(out[b]).max():
+                err[b] = e
+                status[b] = OK
+                continue
         if not in_range(Y):
             status[b] = OUT_OF_RANGE
             continue
@@ -467,13 +560,14 @@ def project_small_2d(Ys, F, out, err, status):
                 status[b] = OK
                 continue
         status[b] = FLAT
-        merr = 2.0 * m * EPS * np.abs(Y).max()  # the float mean vs the exact one
+        exact_mean(Y, mean, merrs)  # (the exact mean rounded: 2 ulps of itself)
+        merr = max(merrs[0], merrs[1])
         if _representatives(Y, rep) == 1:  # every point the same: Ψ is that point
             out[b, 0], out[b, 1] = Y[0, 0], Y[0, 1]
             err[b] = 0.0
             status[b] = OK
             continue
-        e = _collinear(Y, F, rep, merr, out[b])
+        e = _collinear(Y, F, rep, mean, merr, out[b])
         if e != -2.0:
             if e >= 0:
                 err[b] = e
@@ -537,9 +631,7 @@ def project_small_2d(Ys, F, out, err, status):
             continue
         if nv < 3:
             continue
-        m0 = Y[:, 0].mean()
-        m1 = Y[:, 1].mean()
-        e = _project(P, E, nv, m0, m1, merr, out[b])
+        e = _project(P, E, EL, nv, Y, ends, box, mean[0], mean[1], merr, out[b])
         if e < 0:
             status[b] = NEAREST_UNDECIDED
             continue

@@ -46,7 +46,7 @@ from numba import njit
 from .._rounding import MIN_NORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
 from ._expansions import TINY, exact_mean, normal3, orient3
-from ._small2d import ACCEPT_REL
+from ._small2d import ACCEPT_REL, cluster_box
 
 #: rounding-error factor of the 3 × 3 orientation (as in _candidates for k = 3)
 C_ERR = 4.0 * (3 * 3 + math.factorial(3) + 4) * EPS
@@ -290,8 +290,28 @@ def project_small_3d(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np
     """For each set Ys[b] ((B, m, 3)): the point of Ψ(Ys[b], F) nearest its mean, a
     bound on its distance to the exact point (2-norm), and whether it was certified
     (False: compute that set exactly)."""
-    B, m, _ = Ys.shape
     Ys = np.ascontiguousarray(Ys, dtype=np.float64)
+    out = np.zeros((len(Ys), 3))
+    err = np.full(len(Ys), np.inf)
+    if Ys.shape[1] >= 4 * F + 1:  # (Ψ ≠ ∅) converged clusters: any of their points
+        cluster_boxes(Ys, F, out, err)
+    found = err <= ACCEPT_REL * np.abs(out).max(axis=1)
+    rest = np.flatnonzero(~found)
+    if len(rest):
+        out[rest], err[rest], found[rest] = _project(Ys[rest], F)
+    return out, err, found
+
+
+@njit(cache=True, nogil=True)
+def cluster_boxes(Ys, F, out, err):
+    """cluster_box for every set; err in the 2-norm (√3 times the max norm)."""
+    for b in range(Ys.shape[0]):
+        err[b] = cluster_box(Ys[b], F, out[b]) * math.sqrt(3.0) * (1.0 + 4.0 * EPS)
+
+
+def _project(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """project_small_3d by the certified KKT route (module docstring)."""
+    B, m, _ = Ys.shape
     with np.errstate(invalid="ignore", over="ignore"):
         big = np.abs(Ys).max(axis=(1, 2)) if m else np.zeros(B)
     exps = np.where(np.isfinite(big), np.frexp(np.where(np.isfinite(big), big, 1.0))[1], 0)
