@@ -14,7 +14,11 @@ One step k (t_k = k T), for every benign agent i (SPEC §3):
    coordinate, what the agreement proof computes) may leave conv Λ and, with it, the
    benign hull. With fewer than m usable values the agent holds its state this step
    (counted in ``starved``);
-3. x_i ← α_i x_i + (1 − α_i) x̃_i + ε(t_k)·1.
+3. the update rule on z_i = α_i x_i + (1 − α_i) x̃_i: Algorithm 1's x_i ← z_i + ε(t_k)·1
+   (:class:`ConvexStep`, what :func:`simulate` runs); Algorithm 2's subgradient step
+   x_i ← z_i − β_k d_i, d_i ∈ ∂f_i(z_i), lives in :mod:`rescon.optim.rmdo` and is
+   passed to the same loop (:func:`run`), as are the per-step monitors (consensus
+   metrics here, RMDO's cost metrics there): ``consensus`` never imports ``optim``.
 
 Links are kept as flat arrays (receiver, sender) sorted by receiver, so gathering,
 DoS masks and the hold-last memory are array operations; the kernel points of a step
@@ -24,7 +28,8 @@ are computed together (:func:`_kernel_points`).
 from __future__ import annotations
 
 import time
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -37,7 +42,7 @@ from .metrics import ValidityMonitor, diameter, spread
 from .scenario import Scenario
 from .trajectory import Trajectory
 
-__all__ = ["simulate"]
+__all__ = ["ConsensusMonitor", "ConvexStep", "Monitor", "UpdateRule", "run", "simulate"]
 
 
 class _Links:
@@ -56,34 +61,117 @@ class _Links:
 
 
 def simulate(scenario: Scenario, *, progress: bool | None = None) -> Trajectory:
-    """Run the scenario; see the module docstring for one step.
+    """Run the scenario (Algorithm 1 or a baseline); see the module docstring for one step.
 
     Returns
     -------
     Trajectory (states, metrics per step, the violated assumptions in ``info``).
     """
     t0 = time.perf_counter()
+    problems = scenario.warn()
+    return run(scenario, ConvexStep(scenario.residual), progress=progress, started=t0,
+               info={"assumptions_violated": problems})
+
+
+class UpdateRule(Protocol):
+    """Step 3 of an algorithm: the new states of the benign agents that move at step k
+    from z = α x + (1 − α) x̃ (rows of ``z``, (R, d)); ``agents`` (R,) are their row
+    indices in the scenario's node order. ``name`` labels the run."""
+
+    name: str
+
+    def __call__(self, k: int, t: float, z: np.ndarray, agents: np.ndarray) -> np.ndarray: ...
+
+
+class Monitor(Protocol):
+    """Per-step metrics: ``metrics`` maps names to arrays whose first axis is the step
+    k = 0..K; ``record`` fills row k from the benign states (|B|, d) at t_k."""
+
+    metrics: dict[str, np.ndarray]
+
+    def record(self, k: int, t: float, xb: np.ndarray) -> None: ...
+
+
+class ConvexStep:
+    """Algorithm 1's update x ← z + ε(t_k)·1, z = α x + (1 − α) x̃ (the residual
+    ``residual`` is the scenario's t ↦ ε(t))."""
+
+    name = "simulate"
+
+    def __init__(self, residual: Callable[[float], float]) -> None:
+        self.residual = residual
+
+    def __call__(self, k: int, t: float, z: np.ndarray, agents: np.ndarray) -> np.ndarray:
+        return z + self.residual(t)
+
+
+class ConsensusMonitor:
+    """``spread`` (K+1, d), ``diameter`` (K+1,), ``validity`` (K+1,) and
+    ``validity_per_agent`` (K+1, |B|) of the benign states (:mod:`.metrics`)."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        benign = _benign_rows(scenario)
+        K, d = scenario.steps, scenario.d
+        self.validity = ValidityMonitor(scenario.x0[benign])
+        self.metrics = {"spread": np.empty((K + 1, d)), "diameter": np.empty(K + 1),
+                        "validity": np.empty(K + 1),
+                        "validity_per_agent": np.empty((K + 1, len(benign)))}
+
+    def record(self, k: int, t: float, xb: np.ndarray) -> None:
+        m = self.metrics
+        m["spread"][k] = spread(xb)
+        m["diameter"][k] = diameter(xb)
+        dist = self.validity.distances(xb)
+        m["validity_per_agent"][k] = dist
+        m["validity"][k] = dist.max()
+
+
+def _benign_rows(sc: Scenario) -> np.ndarray:
+    """Row indices (node order) of the benign agents."""
+    return np.array([r for r, v in enumerate(sc.nodes) if v not in sc.adversaries],
+                    dtype=np.int64)
+
+
+def run(scenario: Scenario, rule: UpdateRule, *, monitors: Sequence[Monitor] | None = None,
+        progress: bool | None = None, info: dict[str, Any] | None = None,
+        started: float | None = None) -> Trajectory:
+    """The one loop behind :func:`simulate` and :func:`rescon.rmdo`: receive (adversary
+    messages, DoS, policy), filter (the scenario's ``algorithm``: x̃_i, or hold when
+    starved), then x_i ← ``rule(k, t_k, α x_i + (1 − α) x̃_i, i)`` for the agents that
+    move, and every monitor records the benign states at every t_k.
+
+    Parameters
+    ----------
+    monitors : per-step metrics (default: :class:`ConsensusMonitor` of the scenario);
+        their arrays come first in ``Trajectory.metrics``, then ``blocked_links`` and
+        ``starved``.
+    info : entries added to the trajectory's ``info``.
+    started : ``time.perf_counter()`` at which the caller's work began (for
+        ``Trajectory.seconds``).
+    """
+    t0 = time.perf_counter() if started is None else started
     sc = scenario
-    problems = sc.warn()
     nodes = sc.nodes
     n, d, K = len(nodes), sc.d, sc.steps
     links = _Links(sc)
     adv_idx = {nodes.index(a): beh for a, beh in sc.adversaries.items()}
-    benign_mask = np.ones(n, dtype=bool)
-    benign_mask[list(adv_idx)] = False
-    benign = np.flatnonzero(benign_mask)
+    benign = _benign_rows(sc)
+    benign_mask = np.zeros(n, dtype=bool)
+    benign_mask[benign] = True
     rng = np.random.default_rng(sc.seed)
     x = np.array(sc.x0, dtype=np.float64)
     last = np.zeros((len(links.recv), d))
     has_last = np.zeros(len(links.recv), dtype=bool)
     states = np.empty((K + 1, n, d))
-    monitor = ValidityMonitor(sc.x0[benign])
-    metrics = {"spread": np.empty((K + 1, d)), "diameter": np.empty(K + 1),
-               "validity": np.empty(K + 1), "validity_per_agent": np.empty((K + 1, len(benign))),
-               "blocked_links": np.zeros(K + 1, dtype=np.int64),
-               "starved": np.zeros(K + 1, dtype=np.int64)}
+    monitors = [ConsensusMonitor(sc)] if monitors is None else list(monitors)
+    metrics: dict[str, np.ndarray] = {}
+    for mon in monitors:
+        metrics.update(mon.metrics)
+    metrics.update({"blocked_links": np.zeros(K + 1, dtype=np.int64),
+                    "starved": np.zeros(K + 1, dtype=np.int64)})
+    alpha = sc.alpha[benign][:, None]
     exact_cache: dict = {}
-    bar = _bar(progress, K)
+    bar = _bar(progress, K, rule.name)
     for k in range(K + 1):
         t = k * sc.T
         values, usable, sent = _receive(sc, links, x, adv_idx, benign_mask, k, t, rng,
@@ -92,30 +180,26 @@ def simulate(scenario: Scenario, *, progress: bool | None = None) -> Trajectory:
         for a, msg in sent.items():
             states[k, a] = msg
         xb = x[benign]
-        metrics["spread"][k] = spread(xb)
-        metrics["diameter"][k] = diameter(xb)
-        dist = monitor.distances(xb)
-        metrics["validity_per_agent"][k] = dist
-        metrics["validity"][k] = dist.max()
+        for mon in monitors:
+            mon.record(k, t, xb)
         if k == K:
             break
         aux, starved = _auxiliary(sc, links, x, values, usable, benign, d, exact_cache)
         metrics["starved"][k] = len(starved)
-        alpha = sc.alpha[benign][:, None]
-        new = alpha * x[benign] + (1 - alpha) * aux + sc.residual(t)
-        if starved:
-            new[starved] = x[benign][starved]
+        moving = np.ones(len(benign), dtype=bool)
+        moving[starved] = False  # starved agents hold their state
+        z = alpha[moving] * xb[moving] + (1 - alpha[moving]) * aux[moving]
         x = x.copy()
-        x[benign] = new
+        if moving.any():
+            x[benign[moving]] = rule(k, t, z, benign[moving])
         if bar is not None:
             bar.update(1)
     if bar is not None:
         bar.close()
-    info = {"algorithm": sc.algorithm, "policy": sc.policy, "centre": sc.centre, "F": sc.F,
-            "T": sc.T, "steps": K, "kernel_point": sc.kernel_point, "seed": sc.seed,
-            "assumptions_violated": problems}
-    return Trajectory(np.arange(K + 1) * sc.T, states, tuple(nodes), benign, metrics, info,
-                      time.perf_counter() - t0)
+    base = {"algorithm": sc.algorithm, "policy": sc.policy, "centre": sc.centre, "F": sc.F,
+            "T": sc.T, "steps": K, "kernel_point": sc.kernel_point, "seed": sc.seed}
+    return Trajectory(np.arange(K + 1) * sc.T, states, tuple(nodes), benign, metrics,
+                      {**base, **(info or {})}, time.perf_counter() - t0)
 
 
 def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metrics, d):
@@ -273,7 +357,7 @@ def _wmsr(own: np.ndarray, X: np.ndarray, F: int) -> np.ndarray:
     return out
 
 
-def _bar(progress: bool | None, total: int) -> Any:
+def _bar(progress: bool | None, total: int, desc: str = "simulate") -> Any:
     import sys
 
     if progress is None:
@@ -282,4 +366,4 @@ def _bar(progress: bool | None, total: int) -> Any:
         return None
     from tqdm import tqdm
 
-    return tqdm(total=total, desc="simulate", unit="step", leave=False)
+    return tqdm(total=total, desc=desc, unit="step", leave=False)
