@@ -148,7 +148,7 @@ class Quadratic(Atom):
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         W = Z - self.c
-        return 0.5 * np.einsum("bi,ij,bj->b", W, self.Q, W) + Z @ self.q + self.const
+        return 0.5 * ((W @ self.Q) * W).sum(axis=1) + Z @ self.q + self.const
 
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
         return (Z - self.c) @ self.Q + self.q
@@ -180,9 +180,10 @@ class _Residual(Atom):
         self.A = _matrix("A", A)
         super().__init__(self.A.shape[1], name)
         self.b = _vector("b", b, self.A.shape[0])
+        self._At = np.ascontiguousarray(self.A.T)  # Z @ A.T is ~100x slower than this
 
     def _r(self, Z: np.ndarray) -> np.ndarray:
-        return Z @ self.A.T - self.b
+        return Z @ self._At - self.b
 
 
 class AbsAffine(_Residual):
@@ -263,9 +264,10 @@ class MaxAffine(Atom):
         self.A = _matrix("A", A)
         super().__init__(self.A.shape[1], name)
         self.b = _vector("b", b, self.A.shape[0])
+        self._At = np.ascontiguousarray(self.A.T)
 
     def _pieces(self, Z: np.ndarray) -> np.ndarray:
-        return Z @ self.A.T + self.b
+        return Z @ self._At + self.b
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         return self._pieces(Z).max(axis=1)

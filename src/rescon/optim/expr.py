@@ -311,7 +311,9 @@ def _affine_rows(args: list[Expr], d: int) -> tuple[np.ndarray, np.ndarray]:
 
 def lower(e: Expr, d: int) -> Oracle:
     """The atom (tree) computing the convex expression ``e`` over x ∈ R^d
-    (:meth:`Expr.check_convex` must have passed)."""
+    (:meth:`Expr.check_convex` must have passed): the polynomial part as one
+    Quadratic (or Affine), two or more positive ``abs`` terms as one Norm1 (one
+    matrix product instead of one per term), each other term as its atom."""
     parts: list[Oracle] = []
     if any(e.quad.values()):
         Q = np.array([[_float(v) for v in row] for row in e.hessian(d)])
@@ -320,7 +322,14 @@ def lower(e: Expr, d: int) -> Oracle:
     elif any(e.lin.values()) or e.const or not e.terms:
         A, c = _affine_rows([_linear(e)], d)
         parts.append(atoms.Affine(A[0], c[0]))
+    absolute = [(coef, call) for coef, call in e.terms if coef > 0 and call.fn == "abs"]
+    if len(absolute) > 1:  # Σ c_i |a_iᵀx + k_i| = ‖Ax − b‖₁ with rows scaled by c_i
+        A, c = _affine_rows([call.args[0] for _, call in absolute], d)
+        w = np.array([_float(coef) for coef, _ in absolute])
+        parts.append(atoms.Norm1(A * w[:, None], -c * w))
     for coef, call in e.terms:
+        if len(absolute) > 1 and call.fn == "abs" and coef > 0:
+            continue
         atom = _lower_call(call, d) if coef > 0 else _lower_negated_min(call, d)
         parts.append(atom if abs(coef) == 1 else atoms.Scaled(_float(abs(coef)), atom))
     return parts[0] if len(parts) == 1 else atoms.Sum(parts)
