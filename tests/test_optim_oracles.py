@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 import rescon
 from rescon.errors import InputError
-from rescon.optim import atoms
+from rescon.optim import atoms, casadi_adapter, cvxpy_adapter
 from rescon.optim.oracle import CallableOracle, Oracle
 
 ca = pytest.importorskip("casadi")
@@ -315,3 +315,17 @@ def test_oracles_pass_through_and_protocol_objects_are_checked():
 def test_docstring_examples(name):
     result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
     assert result.failed == 0 and result.attempted > 0
+
+
+@pytest.mark.parametrize("module, make", [
+    ("casadi", lambda: casadi_adapter.casadi_cost(ca.SX.sym("x"))),
+    ("cvxpy", lambda: cvxpy_adapter.cvxpy_cost(cp.Variable())),
+])
+def test_missing_package_raises_the_registry_error(monkeypatch, module, make):
+    from rescon.models import backends
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(backends.importlib.util, "find_spec",
+                        lambda name, *a: None if name == module else real(name, *a))
+    with pytest.raises(rescon.SolverNotFound, match=f"backend '{module}' is not installed"):
+        make()
