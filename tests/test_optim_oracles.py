@@ -265,6 +265,8 @@ def test_dimension_errors():
         o.value([[1.0, 2.0, 3.0]])
     with pytest.raises(InputError, match="finite"):
         o.value([[1.0, np.nan]])
+    with pytest.raises(InputError, match="must be a real"):
+        o.value(np.array([[1.0, 1j]]))
     with pytest.raises(InputError, match="x3 is used but d = 2"):
         rescon.cost("x3", d=2)
     x = ca.SX.sym("x", 3)

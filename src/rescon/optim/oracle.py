@@ -86,6 +86,8 @@ class Oracle:
     def _points(self, Z: Any) -> np.ndarray:
         """``Z`` as a finite float (B, d) array of this oracle's dimension."""
         try:
+            if np.iscomplexobj(Z):
+                raise TypeError
             A = np.asarray(Z, dtype=float)
         except (TypeError, ValueError):
             raise InputError(f"{self.name}: points must be a real (B, d) array; "
