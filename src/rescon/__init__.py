@@ -35,6 +35,7 @@ from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kerne
 from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.sarymsakov import is_sarymsakov
 from .optim import check_subgradient, cost
+from .optim.rmdo import rmdo
 
 __version__ = "0.1.0"
 
@@ -67,6 +68,7 @@ __all__ = [
     "kernel_point",
     "kernel_points",
     "max_s",
+    "rmdo",
     "robustness",
     "safe_kernel",
     "simulate",

@@ -28,7 +28,9 @@ class Trajectory:
         agents, ``diameter`` (K+1,), ``validity`` (K+1,) the largest distance of a benign
         state to conv(benign initial states), ``validity_per_agent`` (K+1, |B|),
         ``blocked_links`` (K+1,) links under DoS at t_k, ``starved`` (K+1,) benign
-        agents that held their state for lack of usable values.
+        agents that held their state for lack of usable values; an RMDO run
+        (:func:`rescon.rmdo`) adds ``cost`` (K+1, |B|), ``cost_at_mean``, ``cost_rate``
+        and, when X* is known, ``distance_to_optimum`` and ``optimality_gap``.
     info : the scenario's settings and the assumptions it violates.
     """
 
@@ -84,7 +86,8 @@ class Trajectory:
 
     def plot(self, path: str | Path | None = None, *, log_diameter: bool = True) -> Any:
         """x(1), x(2), ... against t (benign blue, adversaries red, as the paper's
-        Figs. 3–4) and the diameter (log scale). Returns the matplotlib Figure."""
+        Figs. 3–4) and the diameter (log scale); for an RMDO run also the global cost
+        and its change rate (Figs. 6–7). Returns the matplotlib Figure."""
         from ..plot.consensus import plot_trajectory
 
         return plot_trajectory(self, path=path, log_diameter=log_diameter)

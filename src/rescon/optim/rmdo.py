@@ -1,0 +1,368 @@
+"""Algorithm 2 (RMDO) on the consensus engine, and its cost metrics.
+
+Steps 1–3 of Algorithm 1 give every benign agent its auxiliary point x̃_i; then
+
+    z_i = α_i x_i + (1 − α_i) x̃_i,     x_i ← z_i − β_k d_i,     d_i ∈ ∂f_i(z_i)
+
+(SPEC §4; no residual ε: Algorithm 2 has none). :class:`SubgradientStep` is that
+update rule and :class:`CostMonitor` the per-step cost metrics; both are passed to
+:func:`rescon.consensus.engine.run`, the one loop behind :func:`rescon.simulate`
+(``optim`` imports ``consensus``, never the reverse).
+
+Subgradients of a step are computed for all moving agents together: one vectorised
+call per distinct oracle on the stacked points of the agents that share it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from collections.abc import Callable, Hashable, Mapping
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..consensus.engine import ConsensusMonitor, run
+from ..consensus.scenario import Scenario, ScenarioWarning
+from ..consensus.trajectory import Trajectory
+from ..errors import InputError
+from . import atoms
+from .cost import cost
+from .oracle import Oracle
+from .steps import step_size as as_step_size
+
+__all__ = ["CostMonitor", "Optimum", "SubgradientStep", "rmdo"]
+
+
+def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = "paper",
+         optimum: Any = None, progress: bool | None = None) -> Trajectory:
+    """Run Algorithm 2 (resilient multi-dimensional distributed optimisation).
+
+    Parameters
+    ----------
+    scenario : the graph, attacks, filter (``algorithm``), α, T and steps; its
+        ``residual`` is not used (Algorithm 2 has no ε).
+    costs : mapping node → f_i, every benign node included (adversaries' entries are
+        ignored); each value is anything :func:`rescon.cost` accepts. Agents given the
+        same Oracle object (or the same expression string) share one oracle, called
+        once per step on their stacked points.
+    step_size : "paper" (β_k = 1/(5 t_k + 1)), a positive number (constant), a callable
+        k ↦ β_k or a :class:`rescon.optim.steps.StepSize`. Violations of Assumption 5
+        (non-increasing, Σβ = ∞, Σβ² < ∞) are issued as :class:`ScenarioWarning`.
+    optimum : a point of X* = argmin Σ_{i∈B} f_i if known (then X* is taken to be that
+        point). Otherwise X* is computed exactly when every cost is a quadratic or affine
+        atom (rational linear algebra on the atoms' data), else numerically
+        (:class:`Optimum`; ``info["optimum"]`` says which).
+    progress : a progress bar on stderr (default: when stderr is a terminal).
+
+    Returns
+    -------
+    Trajectory whose ``metrics`` hold, besides the consensus metrics, ``cost``
+    (K+1, |B|) the global cost F(x_i) = Σ_{j∈B} f_j(x_i) at every benign state,
+    ``cost_at_mean`` (K+1,) F at the benign mean x̄, ``cost_rate`` (K+1,)
+    (F(x̄(t_k)) − F(x̄(t_{k−1})))/T (NaN at k = 0), and when X* is known and nonempty
+    ``distance_to_optimum`` (K+1,) max_i dist(x_i, X*) and ``optimality_gap`` (K+1,)
+    max_i F(x_i) − F*.
+
+    Raises
+    ------
+    InputError
+        ``costs`` not a mapping, a benign agent without a cost, a cost of the wrong
+        dimension, a bad step size, a bad ``optimum``, or an oracle that fails, returns
+        NaN/inf or the wrong shape during the run (the message names the agent, the
+        step and the point; nothing reaches the states).
+
+    Examples
+    --------
+    >>> import networkx as nx, rescon
+    >>> sc = rescon.Scenario(graph=nx.complete_graph(4), x0=[[0.0], [1.0], [2.0], [3.0]],
+    ...                      F=0, steps=300, check_robustness=False)
+    >>> tr = rescon.rmdo(sc, {i: "(x1 - 1)^2" for i in range(4)})
+    >>> bool(tr.metrics["distance_to_optimum"][-1] < 1e-3)
+    True
+    """
+    t0 = time.perf_counter()
+    sc = scenario
+    if not isinstance(sc, Scenario):
+        raise InputError(f"scenario must be a rescon.Scenario; got {type(sc).__name__}")
+    problems = sc.warn()
+    groups = _groups(sc, costs)
+    beta = as_step_size(step_size)
+    betas = beta.values(np.arange(sc.steps), sc.T)
+    violated = beta.assumption5(sc.T)
+    for msg in violated:
+        warnings.warn(f"Assumption 5: {msg}", ScenarioWarning, stacklevel=2)
+    benign = [v for v in sc.nodes if v not in sc.adversaries]
+    opt = Optimum.find(groups, sc.d, optimum, sc.x0[[sc.nodes.index(v) for v in benign]])
+    rule = SubgradientStep(groups, len(sc.nodes), betas, sc.nodes)
+    monitor = CostMonitor(groups, sc.steps, sc.T, len(benign), opt)
+    info = {"assumptions_violated": problems, "update": "rmdo", "step_size": repr(beta),
+            "assumption5_violated": violated, "oracles": len(groups), "optimum": opt.info}
+    return run(sc, rule, monitors=[ConsensusMonitor(sc), monitor], progress=progress,
+               info=info, started=t0)
+
+
+class _Group:
+    """One oracle and the agents (row indices in node order, and labels) that use it."""
+
+    def __init__(self, oracle: Oracle) -> None:
+        self.oracle = oracle
+        self.rows = np.empty(0, dtype=np.int64)
+        self.labels: list[Hashable] = []
+
+    def add(self, row: int, label: Hashable) -> None:
+        self.rows = np.append(self.rows, row)
+        self.labels.append(label)
+
+
+def _groups(sc: Scenario, costs: Any) -> list[_Group]:
+    """The benign agents' oracles, one group per distinct oracle (same object, or the
+    same expression string), in node order."""
+    if not isinstance(costs, Mapping):
+        raise InputError(f"costs must be a mapping node -> cost; got {type(costs).__name__}")
+    unknown = [v for v in costs if v not in sc.graph]
+    if unknown:
+        raise InputError(f"costs: {unknown[:5]} are not nodes of the graph")
+    benign = [v for v in sc.nodes if v not in sc.adversaries]
+    missing = [v for v in benign if v not in costs]
+    if missing:
+        raise InputError(f"costs: no cost for benign agent(s) {missing[:5]}")
+    made: dict[Any, _Group] = {}
+    for v in benign:
+        spec = costs[v]
+        key = spec if isinstance(spec, str) else id(spec)
+        if key not in made:
+            made[key] = _Group(cost(spec, d=sc.d, name=f"cost of agent {v!r}"))
+        made[key].add(sc.nodes.index(v), v)
+    return list(made.values())
+
+
+def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hashable],
+          where: str) -> np.ndarray:
+    """``oracle.<method>(Z)`` (checked by the oracle); on failure an InputError naming
+    the agent ``who(r)`` of the first row r that fails on its own, ``where`` (the step)
+    and the point."""
+    try:
+        return getattr(oracle, method)(Z)
+    except Exception as exc:  # a user's oracle may raise anything: report where
+        r = next((r for r in range(len(Z)) if not _works(oracle, method, Z[r:r + 1])), 0)
+        raise InputError(f"{method} of the cost of agent {who(r)!r} {where}, point "
+                         f"{Z[r].tolist()}: {type(exc).__name__}: {exc}") from exc
+
+
+def _works(oracle: Oracle, method: str, Z: np.ndarray) -> bool:
+    try:
+        getattr(oracle, method)(Z)
+    except Exception:  # noqa: BLE001 (only locating the row; the caller reports the error)
+        return False
+    return True
+
+
+class SubgradientStep:
+    """Algorithm 2's update x_i ← z_i − β_k d_i, d_i ∈ ∂f_i(z_i) (``betas[k]`` = β_k).
+
+    The rows of a step are grouped by oracle, each group evaluated in one call. A
+    subgradient that is not finite or of the wrong shape, or a step that overflows, is
+    an InputError naming the agent, the step and the point."""
+
+    name = "rmdo"
+
+    def __init__(self, groups: list[_Group], n: int, betas: np.ndarray,
+                 nodes: list[Hashable]) -> None:
+        self.groups, self.betas, self.nodes = groups, betas, nodes
+        self.group_of = np.full(n, -1, dtype=np.int64)
+        for g, grp in enumerate(groups):
+            self.group_of[grp.rows] = g
+
+    def __call__(self, k: int, t: float, z: np.ndarray, agents: np.ndarray) -> np.ndarray:
+        D = np.empty_like(z)
+        gid = self.group_of[agents]
+        for g in np.unique(gid):
+            sel = np.flatnonzero(gid == g)
+            D[sel] = _call(self.groups[g].oracle, "subgradient", z[sel],
+                           lambda r, sel=sel: self.nodes[agents[sel[r]]], _at(k, t))
+        with np.errstate(over="ignore", invalid="ignore"):
+            new = z - self.betas[k] * D
+        bad = np.flatnonzero(~np.isfinite(new).all(axis=1))
+        if bad.size:
+            r = int(bad[0])
+            raise InputError(f"the subgradient step of agent {self.nodes[agents[r]]!r} at step "
+                             f"{k} (t = {t:g}) overflows: point {z[r].tolist()}, β = "
+                             f"{self.betas[k]:g}, subgradient {D[r].tolist()}")
+        return new
+
+
+class CostMonitor:
+    """Per step: F(x_i) = Σ_{j∈B} f_j(x_i) for every benign state (``cost``), F at the
+    benign mean (``cost_at_mean``), its change rate (``cost_rate``), and with a known
+    nonempty X* ``distance_to_optimum`` and ``optimality_gap`` (see :func:`rmdo`). Each
+    distinct oracle is called once per step on all benign states and their mean."""
+
+    def __init__(self, groups: list[_Group], steps: int, T: float, n_benign: int,
+                 optimum: Optimum) -> None:
+        self.groups, self.T, self.optimum = groups, T, optimum
+        K = steps
+        self.metrics = {"cost": np.empty((K + 1, n_benign)), "cost_at_mean": np.empty(K + 1),
+                        "cost_rate": np.full(K + 1, np.nan)}
+        if optimum.known:
+            self.metrics["distance_to_optimum"] = np.empty(K + 1)
+            self.metrics["optimality_gap"] = np.empty(K + 1)
+
+    def record(self, k: int, t: float, xb: np.ndarray) -> None:
+        P = np.vstack([xb, xb.mean(axis=0)])
+        F = global_cost(self.groups, P, _at(k, t))
+        m = self.metrics
+        m["cost"][k], m["cost_at_mean"][k] = F[:-1], F[-1]
+        if k:
+            m["cost_rate"][k] = (F[-1] - m["cost_at_mean"][k - 1]) / self.T
+        if self.optimum.known:
+            m["distance_to_optimum"][k] = self.optimum.distance(xb).max()
+            m["optimality_gap"][k] = F[:-1].max() - self.optimum.value
+
+
+def _at(k: int, t: float) -> str:
+    return f"at step {k} (t = {t:g})"
+
+
+def global_cost(groups: list[_Group], P: np.ndarray, where: str = "while computing X*"
+                ) -> np.ndarray:
+    """F(p) = Σ_{j∈B} f_j(p) at every row of ``P``: Σ over distinct oracles of
+    (number of agents sharing it) × its values (one call per oracle)."""
+    F = np.zeros(len(P))
+    for grp in groups:
+        F += len(grp.rows) * _call(grp.oracle, "value", P, lambda r, grp=grp: grp.labels[0],
+                                   where)
+    return F
+
+
+class Optimum:
+    """X* = argmin F, F = Σ_{i∈B} f_i, as far as it is known.
+
+    ``known`` (X* nonempty and found), ``value`` F* (F at the float point of X* used),
+    ``distance(X)`` (rows' distances to X*), ``info`` (JSON-ready: ``method`` "given",
+    "exact (quadratic)" or "numerical (...)", ``exact``, ``point``, ``value``, and
+    ``dimension`` of X* or ``reason`` when X* is empty or not found)."""
+
+    def __init__(self, point: np.ndarray | None, basis: np.ndarray | None, value: float,
+                 info: dict[str, Any]) -> None:
+        self.point, self.basis, self.value, self.info = point, basis, value, info
+        self.known = point is not None
+
+    def distance(self, X: np.ndarray) -> np.ndarray:
+        """‖(x − x₀) − U Uᵀ(x − x₀)‖ for X* = x₀ + range(U) (U orthonormal, maybe empty)."""
+        R = X - self.point
+        if self.basis is not None and self.basis.size:
+            R = R - (R @ self.basis) @ self.basis.T
+        return np.linalg.norm(R, axis=1)
+
+    @classmethod
+    def find(cls, groups: list[_Group], d: int, given: Any, x0: np.ndarray) -> Optimum:
+        """From ``given`` (a point), else exactly for quadratic/affine atoms, else
+        numerically from the benign initial states ``x0``."""
+        if given is not None:
+            p = _given_point(given, d)
+            val = float(global_cost(groups, p[None])[0])
+            return cls(p, None, val, {"method": "given", "exact": False, "point": p.tolist(),
+                                      "value": val})
+        H = _quadratic_hessian(groups, d)
+        if H is not None:
+            return cls._exact(groups, d, *H)
+        return cls._numerical(groups, x0)
+
+    @classmethod
+    def _exact(cls, groups: list[_Group], d: int, H: list[list[Fraction]],
+               g: list[Fraction]) -> Optimum:
+        """F(x) = ½ xᵀHx + gᵀx + const with H ⪰ 0 (exact rationals of the atoms' float
+        data): X* = {x : Hx = −g}, solved by exact row reduction; empty (F unbounded
+        below) when −g ∉ range(H)."""
+        from ..geometry.exact import _rref, nullspace_exact
+
+        A = [row + [-gi] for row, gi in zip(H, g, strict=True)]
+        pivots = _rref(A, d)
+        info: dict[str, Any] = {"method": "exact (quadratic)", "exact": True}
+        if any(A[i][d] != 0 for i in range(len(pivots), d)):
+            info["reason"] = "F is unbounded below (−∇ of its linear part ∉ range of its Hessian)"
+            return cls(None, None, -math.inf, info)
+        x = [Fraction(0)] * d
+        for i, c in enumerate(pivots):
+            x[c] = A[i][d]
+        p = np.array([float(v) for v in x])
+        null = nullspace_exact(H)
+        U = np.linalg.qr(np.array(null, dtype=float).T)[0] if null else None
+        val = float(global_cost(groups, p[None])[0])
+        info.update(point=p.tolist(), value=val, dimension=len(null))
+        return cls(p, U, val, info)
+
+    @classmethod
+    def _numerical(cls, groups: list[_Group], x0: np.ndarray) -> Optimum:
+        """Nelder–Mead (scipy) from the benign mean, restarted from its answer until F
+        stops decreasing; X* is taken as the point found (a numerical estimate)."""
+        from scipy.optimize import minimize
+
+        def F(x: np.ndarray) -> float:
+            return float(global_cost(groups, x[None])[0])
+
+        x, best = x0.mean(axis=0), math.inf
+        scale = 1.0 + float(np.abs(x0).max())
+        for _ in range(10):
+            res = minimize(F, x, method="Nelder-Mead",
+                           options={"xatol": 1e-12 * scale, "fatol": 0.0,
+                                    "maxiter": 4000 * len(x), "maxfev": 8000 * len(x)})
+            if not res.fun < best:
+                break
+            x, best = res.x, float(res.fun)
+        info: dict[str, Any] = {"method": "numerical (scipy Nelder-Mead, restarted)",
+                                "exact": False}
+        if not (math.isfinite(best) and np.abs(x).max() < 1e12 * scale):
+            info["reason"] = "no minimiser found: F may be unbounded below"
+            return cls(None, None, -math.inf, info)
+        info.update(point=x.tolist(), value=best,
+                    note="distances are to this point; X* may contain more")
+        return cls(np.asarray(x, dtype=float), None, best, info)
+
+
+def _given_point(value: Any, d: int) -> np.ndarray:
+    try:
+        p = np.array(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError(f"optimum must be a point of R^{d}; got {type(value).__name__}") from None
+    if p.shape != (d,) or not np.isfinite(p).all():
+        raise InputError(f"optimum must be a finite point of R^{d}; got {value!r}")
+    return p
+
+
+def _quadratic_hessian(groups: list[_Group], d: int
+                       ) -> tuple[list[list[Fraction]], list[Fraction]] | None:
+    """(H, g) with Σ_{i∈B} f_i = ½ xᵀHx + gᵀx + const, exactly from the atoms' float
+    data, when every cost is built of Quadratic / Affine atoms, sums and scalings;
+    else None."""
+    H = [[Fraction(0)] * d for _ in range(d)]
+    g = [Fraction(0)] * d
+    for grp in groups:
+        if not _add_quadratic(grp.oracle, Fraction(len(grp.rows)), H, g):
+            return None
+    return H, g
+
+
+def _add_quadratic(o: Any, w: Fraction, H: list[list[Fraction]], g: list[Fraction]) -> bool:
+    """Add w·f's (Hessian, linear part) to (H, g); False when f is not a known quadratic.
+    Quadratic ½(x − c)ᵀQ(x − c) + qᵀx: Hessian Q, linear part q − Qc; Affine aᵀx + b: a."""
+    if isinstance(o, atoms.Quadratic):
+        Q = [[Fraction(v) for v in row] for row in o.Q.tolist()]
+        c = [Fraction(v) for v in o.c.tolist()]
+        for i, row in enumerate(Q):
+            g[i] += w * (Fraction(o.q[i]) - sum(a * b for a, b in zip(row, c, strict=True)))
+            for j, v in enumerate(row):
+                H[i][j] += w * v
+        return True
+    if isinstance(o, atoms.Affine):
+        for i, v in enumerate(o.a.tolist()):
+            g[i] += w * Fraction(v)
+        return True
+    if isinstance(o, atoms.Scaled):
+        return _add_quadratic(o.term, w * Fraction(o.coef), H, g)
+    if isinstance(o, atoms.Sum):
+        return all(_add_quadratic(t, w, H, g) for t in o.terms)
+    return False
