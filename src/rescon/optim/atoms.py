@@ -173,8 +173,9 @@ class Affine(Atom):
         return np.broadcast_to(self.a, Z.shape).copy()
 
 
-class _Residual(Atom):
-    """Atoms of the residual r = A x − b (A: (m, d), b: (m,))."""
+class _Rows(Atom):
+    """Atoms of the rows of A x with data (A: (m, d), b: (m,)): residual atoms use
+    r = A x − b, piece atoms A x + b."""
 
     def __init__(self, A: Any, b: Any = None, *, name: str = "cost") -> None:
         self.A = _matrix("A", A)
@@ -185,9 +186,12 @@ class _Residual(Atom):
     def _r(self, Z: np.ndarray) -> np.ndarray:
         return Z @ self._At - self.b
 
+    def _pieces(self, Z: np.ndarray) -> np.ndarray:
+        return Z @ self._At + self.b
 
-class AbsAffine(_Residual):
-    """f(x) = |aᵀx − b|; subgradient sign(r)·a, 0 at r = 0 (minimum norm)."""
+
+class _OneRow(_Rows):
+    """Atoms of one residual r = aᵀx − b."""
 
     polyhedral = True
 
@@ -196,6 +200,10 @@ class AbsAffine(_Residual):
         if self.A.shape[0] != 1:
             raise InputError(f"a must be a vector; got shape {self.A.shape}")
 
+
+class AbsAffine(_OneRow):
+    """f(x) = |aᵀx − b|; subgradient sign(r)·a, 0 at r = 0 (minimum norm)."""
+
     def _value(self, Z: np.ndarray) -> np.ndarray:
         return np.abs(self._r(Z))[:, 0]
 
@@ -203,7 +211,7 @@ class AbsAffine(_Residual):
         return np.sign(self._r(Z)) @ self.A
 
 
-class Norm1(_Residual):
+class Norm1(_Rows):
     """f(x) = ‖Ax − b‖₁; subgradient Aᵀ sign(r) with sign(0) = 0."""
 
     polyhedral = True
@@ -215,7 +223,7 @@ class Norm1(_Residual):
         return np.sign(self._r(Z)) @ self.A
 
 
-class Norm2(_Residual):
+class Norm2(_Rows):
     """f(x) = ‖Ax − b‖₂; subgradient Aᵀ r/‖r‖, and 0 at r = 0 (minimum norm).
 
     The residual is divided by max|r_i| before squaring, so neither the value nor the
@@ -237,7 +245,7 @@ class Norm2(_Residual):
         return (u / np.where(n > 0, n, 1.0)[:, None]) @ self.A
 
 
-class NormInf(_Residual):
+class NormInf(_Rows):
     """f(x) = ‖Ax − b‖∞; subgradient Aᵀ of the mean of sign(r_i) e_i over the entries
     attaining max|r_i|, and 0 at r = 0."""
 
@@ -254,20 +262,11 @@ class NormInf(_Residual):
         return w @ self.A
 
 
-class MaxAffine(Atom):
+class MaxAffine(_Rows):
     """f(x) = max_i (a_iᵀx + b_i) (pieces, so b enters with a plus sign); subgradient
     the mean of the active a_i."""
 
     polyhedral = True
-
-    def __init__(self, A: Any, b: Any = None, *, name: str = "cost") -> None:
-        self.A = _matrix("A", A)
-        super().__init__(self.A.shape[1], name)
-        self.b = _vector("b", b, self.A.shape[0])
-        self._At = np.ascontiguousarray(self.A.T)
-
-    def _pieces(self, Z: np.ndarray) -> np.ndarray:
-        return Z @ self._At + self.b
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         return self._pieces(Z).max(axis=1)
@@ -276,7 +275,7 @@ class MaxAffine(Atom):
         return _mean_active(self._pieces(Z), self.A)
 
 
-class Hinge(AbsAffine):
+class Hinge(_OneRow):
     """f(x) = max(0, aᵀx − b); subgradient a where r > 0, else 0 (minimum norm)."""
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
@@ -286,7 +285,7 @@ class Hinge(AbsAffine):
         return (self._r(Z) > 0).astype(float) @ self.A
 
 
-class Huber(_Residual):
+class Huber(_Rows):
     """f(x) = Σ_i h_M(a_iᵀx − b_i), h_M(u) = u² for |u| ≤ M, 2M|u| − M² otherwise
     (CVXPY's convention); gradient Aᵀ clip(2r, −2M, 2M)."""
 
@@ -304,10 +303,8 @@ class Huber(_Residual):
         return np.clip(2 * self._r(Z), -2 * self.M, 2 * self.M) @ self.A
 
 
-class LogSumExp(MaxAffine):
+class LogSumExp(_Rows):
     """f(x) = log Σ_i exp(a_iᵀx + b_i); gradient Aᵀ softmax (shifted by the max)."""
-
-    polyhedral = False
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         P = self._pieces(Z)
