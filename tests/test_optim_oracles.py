@@ -331,3 +331,27 @@ def test_missing_package_raises_the_registry_error(monkeypatch, module, make):
                         lambda name, *a: None if name == module else real(name, *a))
     with pytest.raises(rescon.SolverNotFound, match=f"backend '{module}' is not installed"):
         make()
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(1, 3), st.integers(1, 3), st.integers(0, 2**32 - 1))
+def test_random_residual_norms_agree_across_kinds(m, d, seed):
+    """‖Ax − b‖ (1, 2, ∞) and max(Ax + b) from atoms, CasADi (lowered) and CVXPY
+    (lowered): equal values, valid subgradients at the kinks A x = b."""
+    rng = np.random.default_rng(seed)
+    A = rng.integers(-3, 4, size=(m, d)).astype(float)
+    b = rng.integers(-2, 3, size=m).astype(float)
+    P = np.vstack([np.linalg.lstsq(A, b, rcond=None)[0], np.zeros(d),
+                   rng.normal(size=(3, d))])
+    xs, xv = ca.SX.sym("x", d), cp.Variable(d)
+    r_ca, r_cp = ca.mtimes(A, xs) - b, A @ xv - b
+    for atom, e_ca, e_cp in (
+            (atoms.Norm1(A, b), ca.norm_1(r_ca), cp.norm1(r_cp)),
+            (atoms.Norm2(A, b), ca.norm_2(r_ca), cp.norm(r_cp, 2)),
+            (atoms.NormInf(A, b), ca.norm_inf(r_ca), cp.norm_inf(r_cp)),
+            (atoms.MaxAffine(A, b), ca.mmax(ca.mtimes(A, xs) + b), cp.max(A @ xv + b))):
+        ref = atom.value(P)
+        for o in (rescon.cost(e_ca, x=xs), rescon.cost(e_cp, x=xv)):
+            assert o.path == "lowered"
+            assert np.allclose(o.value(P), ref, rtol=1e-12, atol=1e-12)
+            assert valid(o, P, samples=16)
