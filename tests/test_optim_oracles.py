@@ -222,6 +222,8 @@ def test_casadi_ad_is_nan_at_the_kink_and_the_adapter_repairs_it():
     g = o.subgradient(np.zeros((1, 2)))
     assert np.isfinite(g).all() and valid(o)
     assert 0 <= o.kink_error < 1e-12
+    assert o.value(np.zeros((0, 2))).shape == (0,) and o.subgradient(np.zeros((0, 2))).shape \
+        == (0, 2)
 
 
 def test_lowered_casadi_norm_at_zero_is_the_minimum_norm_element():

@@ -185,6 +185,8 @@ class CasadiOracle(Oracle):
 
     def _both(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         B = Z.shape[0]
+        if B == 0:
+            return np.zeros(0), np.zeros((0, self.d))
         if B not in self._maps:
             self._maps[B] = self._fg.map(B)
         v, J = self._maps[B](Z.T)

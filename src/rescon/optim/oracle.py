@@ -47,7 +47,9 @@ class Oracle:
     name : str
         How error messages call this cost (e.g. ``"cost of agent 3"``).
     kind : str
-        The adapter that made it: "atom", "expression", "callable", "casadi", "cvxpy".
+        The adapter that made it: "atom", "expression", "callable", "casadi", "cvxpy"
+        ("cvxpy-grad" for a summand CVXPY evaluates itself). CasADi and CVXPY oracles
+        also say which ``path`` they took ("lowered" to atoms, "ad", "grad", "mixed").
     quadratic, polyhedral : bool
         f is a convex quadratic polynomial (argmin by linear algebra) / a polyhedral
         function (argmin by an LP). Only atoms and their sums say True.
