@@ -263,6 +263,7 @@ def test_callable_oracle_bad_outputs_are_named():
 
 def test_dimension_errors():
     o = rescon.cost("x1 + x2")
+    assert o.value(np.zeros((0, 2))).shape == (0,)  # an empty batch is fine
     with pytest.raises(InputError, match=r"\(B, 2\) array; got shape \(1, 3\)"):
         o.value([[1.0, 2.0, 3.0]])
     with pytest.raises(InputError, match="finite"):

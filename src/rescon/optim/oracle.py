@@ -112,6 +112,8 @@ class Oracle:
         if R.shape != tuple(shape):
             raise InputError(f"{self.name}: {what} of {Z.shape[0]} point(s) returned shape "
                              f"{R.shape}; expected {tuple(shape)}")
+        if R.size == 0:
+            return R
         bad = ~np.isfinite(R.reshape(Z.shape[0], -1)).all(axis=1)
         if bad.any():
             b = int(np.argmax(bad))
