@@ -148,3 +148,30 @@ def test_random_sums_of_terms(terms, seed):
     ref = sum(w * f(pts[:, 0], pts[:, 1], c) for (_, f), w, c in terms)
     assert np.allclose(o.value(pts), ref, rtol=1e-12, atol=1e-12)
     assert rescon.check_subgradient(o, pts, samples=16) <= 1e-9 * (1 + np.abs(ref).max())
+
+
+@pytest.mark.parametrize("p, q", [(1, 5), (1, 10), (2, 7), (13, 3), (7, 29)])
+def test_singular_convex_quadratics_survive_float_rounding(p, q):
+    """(x1 + (p/q) x2)² has a singular PSD Hessian; rounded to floats it can be
+    indefinite by one ulp (these were refused as non-convex). Convexity is decided on
+    the exact data, which the atom keeps."""
+    from fractions import Fraction
+
+    o = rescon.cost(f"(x1 + {p}/{q}*x2)^2")
+    a = Fraction(p, q)
+    assert o.exact["Q"] == [[2, 2 * a], [2 * a, 2 * a * a]]
+    assert o.value([[1.0, 2.0]])[0] == pytest.approx((1 + 2 * p / q) ** 2, rel=1e-14)
+
+
+def test_atoms_keep_exact_data():
+    from fractions import Fraction
+
+    o = rescon.cost("3*abs(x1 - 0.1) + abs(x2)/3 + huber(x1, 0.3) + max(x1, x2 + 0.7)")
+    data = {type(t).__name__: t.exact for t in o.terms}
+    assert data["Norm1"] == {"A": [[3, 0], [0, Fraction(1, 3)]], "b": [Fraction(3, 10), 0]}
+    assert data["Huber"]["M"] == Fraction(3, 10)
+    assert data["MaxAffine"] == {"A": [[1, 0], [0, 1]], "b": [0, Fraction(7, 10)]}
+    f = atoms.AbsAffine([0.1, 1.0], 0.2)  # floats: their exact binary values
+    assert f.exact == {"A": [[Fraction(0.1), 1]], "b": [Fraction(0.2)]}
+    with pytest.raises(InputError, match="symmetric"):
+        atoms.Quadratic([[1.0, 2.0], [0.0, 1.0]])

@@ -4,7 +4,12 @@ Every atom is an :class:`~rescon.optim.oracle.Oracle` evaluated with vectorised 
 stacked points Z (B, d), keeps its data (``Q``, ``c``, ``q``, ``A``, ``b``, …) as
 attributes, and says whether it is ``quadratic`` (a convex polynomial of degree ≤ 2:
 argmin from linear algebra) or ``polyhedral`` (piecewise affine: argmin from an LP),
-so that a redundancy check can compute argmin sets exactly.
+so that a redundancy check can compute argmin sets exactly. ``exact`` holds the same
+data as given, in rationals (a dict of Fractions keyed like the float attributes):
+the float attributes are its correctly rounded values. A cost string's decimals reach
+the atoms as exact fractions, so e.g. (x1 + x2/5)² keeps its singular PSD Hessian in
+``exact`` even where the rounded float Hessian is (by 1 ulp) indefinite — the
+convexity of Quadratic is decided on ``exact``.
 
 Subgradient conventions (r = A z − b, the residual; ties are decided on the computed
 float values, and any element chosen is a subgradient up to that rounding):
@@ -84,10 +89,22 @@ def is_psd(M: Sequence[Sequence[Any]]) -> bool:
     return ldl_psd(M) is not None
 
 
+def _rational(value: Any, shape: tuple[int, ...]) -> Any:
+    """``value`` (numbers, Fractions or an array of them; None: zeros) as Fractions
+    in nested lists of ``shape`` (a Fraction for shape ())."""
+    if value is None:
+        return np.vectorize(Fraction, otypes=[object])(np.zeros(shape, dtype=int)).tolist()
+    arr = np.asarray(value, dtype=object).reshape(shape)
+    out = np.vectorize(lambda v: Fraction(v), otypes=[object])(arr) if arr.size else arr
+    return out.tolist() if shape else Fraction(arr.reshape(()).item())
+
+
 def _matrix(name: str, value: Any, *, cols: int | None = None) -> np.ndarray:
     """``value`` as a finite float 2-D array (a 1-D array is one row)."""
     try:
         A = np.array(value, dtype=float, ndmin=2)
+    except OverflowError:
+        raise InputError(f"{name} must be finite (a number does not fit a float)") from None
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a real matrix; got {type(value).__name__}") from None
     if A.ndim != 2 or A.shape[1] == 0 or (cols is not None and A.shape[1] != cols):
@@ -98,14 +115,20 @@ def _matrix(name: str, value: Any, *, cols: int | None = None) -> np.ndarray:
 
 
 def _vector(name: str, value: Any, n: int) -> np.ndarray:
-    v = np.zeros(n) if value is None else np.array(value, dtype=float).reshape(-1)
+    try:
+        v = np.zeros(n) if value is None else np.array(value, dtype=float).reshape(-1)
+    except (OverflowError, TypeError, ValueError):
+        v = np.full(1, np.nan)
     if v.shape != (n,) or not np.isfinite(v).all():
         raise InputError(f"{name} must be a finite vector of length {n}; got {value!r}")
     return v
 
 
 def _scalar(name: str, value: Any) -> float:
-    v = np.asarray(value, dtype=float)
+    try:
+        v = np.asarray(value, dtype=float)
+    except (OverflowError, TypeError, ValueError):
+        v = np.full(1, np.nan)
     if v.size != 1 or not np.isfinite(v).all():
         raise InputError(f"{name} must be a finite real number; got {value!r}")
     return float(v.reshape(()))
@@ -122,29 +145,36 @@ def _mean_active(vals: np.ndarray, grads: np.ndarray) -> np.ndarray:
 
 
 class Atom(Oracle):
-    """Base of the library atoms (``kind = "atom"``)."""
+    """Base of the library atoms (``kind = "atom"``); ``exact``: the data as given, in
+    Fractions (None for composites)."""
 
     kind = "atom"
+    exact: dict[str, Any] | None = None
 
 
 class Quadratic(Atom):
     """f(x) = ½(x − c)ᵀQ(x − c) + qᵀx + const, Q symmetric positive semidefinite
-    (checked exactly); ∇f = Q(x − c) + q."""
+    (both checked exactly on the given data); ∇f = Q(x − c) + q."""
 
     quadratic = True
 
-    def __init__(self, Q: Any, c: Any = None, q: Any = None, const: float = 0.0, *,
+    def __init__(self, Q: Any, c: Any = None, q: Any = None, const: Any = 0.0, *,
                  name: str = "cost") -> None:
-        Q = _matrix("Q", Q)
-        d = Q.shape[0]
-        if Q.shape != (d, d) or not np.array_equal(Q, Q.T):
-            raise InputError(f"Q must be a symmetric (d, d) matrix; got shape {Q.shape}")
-        if not is_psd(Q.tolist()):
-            raise InputError("Q must be positive semidefinite (the quadratic is not convex)")
+        Qf = _matrix("Q", Q)
+        d = Qf.shape[0]
+        if Qf.shape != (d, d):
+            raise InputError(f"Q must be a symmetric (d, d) matrix; got shape {Qf.shape}")
         super().__init__(d, name)
-        self.Q, self.c, self.q = Q, _vector("c", c, d), _vector("q", q, d)
+        self.Q, self.c, self.q = Qf, _vector("c", c, d), _vector("q", q, d)
         self.const = _scalar("const", const)
-        self.polyhedral = not Q.any()
+        Qx = _rational(Q, (d, d))
+        if any(Qx[i][j] != Qx[j][i] for i in range(d) for j in range(i)):
+            raise InputError("Q must be a symmetric (d, d) matrix")
+        if not is_psd(Qx):
+            raise InputError("Q must be positive semidefinite (the quadratic is not convex)")
+        self.exact = {"Q": Qx, "c": _rational(c, (d,)), "q": _rational(q, (d,)),
+                      "const": _rational(const, ())}
+        self.polyhedral = not Qf.any()
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         W = Z - self.c
@@ -159,12 +189,13 @@ class Affine(Atom):
 
     quadratic = polyhedral = True
 
-    def __init__(self, a: Any, b: float = 0.0, *, name: str = "cost") -> None:
-        a = _matrix("a", a)
+    def __init__(self, a: Any, b: Any = 0.0, *, name: str = "cost") -> None:
+        a_in, a = a, _matrix("a", a)
         if a.shape[0] != 1:
             raise InputError(f"a must be a vector; got shape {a.shape}")
         super().__init__(a.shape[1], name)
         self.a, self.b = a[0], _scalar("b", b)
+        self.exact = {"a": _rational(a_in, (self.d,)), "b": _rational(b, ())}
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         return Z @ self.a + self.b
@@ -182,6 +213,7 @@ class _Rows(Atom):
         super().__init__(self.A.shape[1], name)
         self.b = _vector("b", b, self.A.shape[0])
         self._At = np.ascontiguousarray(self.A.T)  # Z @ A.T is ~100x slower than this
+        self.exact = {"A": _rational(A, self.A.shape), "b": _rational(b, self.b.shape)}
 
     def _r(self, Z: np.ndarray) -> np.ndarray:
         return Z @ self._At - self.b
@@ -195,8 +227,9 @@ class _OneRow(_Rows):
 
     polyhedral = True
 
-    def __init__(self, a: Any, b: float = 0.0, *, name: str = "cost") -> None:
-        super().__init__(a, [_scalar("b", b)], name=name)
+    def __init__(self, a: Any, b: Any = 0.0, *, name: str = "cost") -> None:
+        _scalar("b", b)
+        super().__init__(a, [b], name=name)
         if self.A.shape[0] != 1:
             raise InputError(f"a must be a vector; got shape {self.A.shape}")
 
@@ -294,6 +327,7 @@ class Huber(_Rows):
         self.M = _scalar("M", M)
         if self.M <= 0:
             raise InputError(f"M must be a positive number; got {M!r}")
+        self.exact["M"] = _rational(M, ())
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
         a = np.abs(self._r(Z))
@@ -361,8 +395,9 @@ class Scaled(Atom):
 
     def __init__(self, coef: float, term: Oracle, *, name: str = "cost") -> None:
         self.coef = _scalar("coef", coef)
-        if self.coef < 0:
+        if _rational(coef, ()) < 0:
             raise InputError(f"coef must be >= 0 (a negative scaling is not convex); got {coef}")
+        self.exact = {"coef": _rational(coef, ())}
         self.term = _oracles([term], "Scaled")[0]
         super().__init__(term.d, name)
         self.quadratic, self.polyhedral = term.quadratic, term.polyhedral

@@ -300,12 +300,15 @@ def _float(v: Fraction) -> float:
 
 
 def _affine_rows(args: list[Expr], d: int) -> tuple[np.ndarray, np.ndarray]:
-    """A, c with args[i] = A[i] x + c[i] (affine args)."""
-    A = np.zeros((len(args), d))
-    c = np.array([_float(a.const) for a in args])
+    """A, c (object arrays of Fractions, each fitting a float) with
+    args[i] = A[i] x + c[i] (affine args)."""
+    A = np.full((len(args), d), Fraction(0), dtype=object)
+    c = np.array([a.const for a in args] + [None], dtype=object)[:-1]
     for r, a in enumerate(args):
+        _float(a.const)
         for i, v in a.lin.items():
-            A[r, i] = _float(v)
+            _float(v)
+            A[r, i] = v
     return A, c
 
 
@@ -315,23 +318,23 @@ def lower(e: Expr, d: int) -> Oracle:
     Quadratic (or Affine), two or more positive ``abs`` terms as one Norm1 (one
     matrix product instead of one per term), each other term as its atom."""
     parts: list[Oracle] = []
+    A, c = _affine_rows([_linear(e)], d)
     if any(e.quad.values()):
-        Q = np.array([[_float(v) for v in row] for row in e.hessian(d)])
-        parts.append(atoms.Quadratic(Q, q=_affine_rows([_linear(e)], d)[0][0],
-                                     const=_float(e.const)))
+        Q = e.hessian(d)
+        for v in (v for row in Q for v in row):
+            _float(v)
+        parts.append(atoms.Quadratic(Q, q=A[0], const=c[0]))
     elif any(e.lin.values()) or e.const or not e.terms:
-        A, c = _affine_rows([_linear(e)], d)
         parts.append(atoms.Affine(A[0], c[0]))
     absolute = [(coef, call) for coef, call in e.terms if coef > 0 and call.fn == "abs"]
     if len(absolute) > 1:  # Σ c_i |a_iᵀx + k_i| = ‖Ax − b‖₁ with rows scaled by c_i
-        A, c = _affine_rows([call.args[0] for _, call in absolute], d)
-        w = np.array([_float(coef) for coef, _ in absolute])
-        parts.append(atoms.Norm1(A * w[:, None], -c * w))
+        A, c = _affine_rows([call.args[0].scale(coef) for coef, call in absolute], d)
+        parts.append(atoms.Norm1(A, -c))
     for coef, call in e.terms:
         if len(absolute) > 1 and call.fn == "abs" and coef > 0:
             continue
         atom = _lower_call(call, d) if coef > 0 else _lower_negated_min(call, d)
-        parts.append(atom if abs(coef) == 1 else atoms.Scaled(_float(abs(coef)), atom))
+        parts.append(atom if abs(coef) == 1 else atoms.Scaled(abs(coef), atom))
     return parts[0] if len(parts) == 1 else atoms.Sum(parts)
 
 
@@ -362,7 +365,7 @@ def _lower_call(call: Call, d: int) -> Oracle:
     if fn == "abs":
         return atoms.AbsAffine(A[0], -c[0])
     if fn == "huber":
-        return atoms.Huber(A, -c, _float(call.param))
+        return atoms.Huber(A, -c, call.param)
     if fn == "logsumexp":
         return atoms.LogSumExp(A, c)
     return {"norm1": atoms.Norm1, "norm2": atoms.Norm2, "norminf": atoms.NormInf}[fn](A, -c)
