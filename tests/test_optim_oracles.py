@@ -128,6 +128,10 @@ def test_check_subgradient_reports_a_wrong_subgradient():
     assert rescon.check_subgradient(bad, KINKS) > 0.1
     good = rescon.cost((lambda z: float(np.abs(z).sum()), np.sign), d=2)
     assert valid(good)
+    with pytest.raises(InputError, match="at least one point"):
+        rescon.check_subgradient(good, np.zeros((0, 2)))
+    with pytest.raises(InputError, match="samples must be an integer >= 1"):
+        rescon.check_subgradient(good, KINKS, samples=0)
 
 
 # --------------------------------------------------------------------------- #

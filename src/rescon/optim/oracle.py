@@ -206,6 +206,8 @@ def check_subgradient(oracle: Any, points: Any, *, samples: int = 64, seed: int 
     n = _validate.integer("samples", samples, low=1)
     rng = np.random.default_rng(_validate.integer("seed", seed))
     X = o._points(points)
+    if not len(X):
+        raise InputError("points must hold at least one point; got shape (0, d)")
     fx, G = o.value(X), o.subgradient(X)
     B, d = X.shape
     U = rng.standard_normal((B, n, d))
