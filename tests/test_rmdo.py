@@ -221,6 +221,14 @@ def test_exact_optimum_of_non_redundant_quadratics():
     assert tr.info["optimum"]["point"] == exact and tr.info["optimum"]["dimension"] == 0
 
 
+def test_exact_optimum_reads_the_decimals_of_cost_strings_exactly():
+    """x1* = (0.1 + 0.3 + 1.1 + 0.2)/4 = 0.425 exactly; from the float-rounded data the
+    rounded answer is one ulp above it."""
+    sc = small()
+    costs = {v: f"(x1 - {c})^2 + x2^2" for v, c in enumerate(["0.1", "0.3", "1.1", "0.2"])}
+    assert rmdo(sc, costs).info["optimum"]["point"] == [0.425, 0.0]
+
+
 def test_exact_optimum_set_of_dimension_one():
     sc = scenario(None, steps=5, dos=False)
     tr = rmdo(sc, {v: "(x1 - 1)^2" for v in sc.benign})

@@ -282,6 +282,7 @@ class Optimum:
         A = [row + [-gi] for row, gi in zip(H, g, strict=True)]
         pivots = _rref(A, d)
         info: dict[str, Any] = {"method": "exact (quadratic)", "exact": True}
+        # X* exactly; ``point`` is its float rounding (distances are float computations)
         if any(A[i][d] != 0 for i in range(len(pivots), d)):
             info["reason"] = "F is unbounded below (−∇ of its linear part ∉ range of its Hessian)"
             return cls(None, None, -math.inf, info)
@@ -335,9 +336,9 @@ def _given_point(value: Any, d: int) -> np.ndarray:
 
 def _quadratic_hessian(groups: list[_Group], d: int
                        ) -> tuple[list[list[Fraction]], list[Fraction]] | None:
-    """(H, g) with Σ_{i∈B} f_i = ½ xᵀHx + gᵀx + const, exactly from the atoms' float
-    data, when every cost is built of Quadratic / Affine atoms, sums and scalings;
-    else None."""
+    """(H, g) with Σ_{i∈B} f_i = ½ xᵀHx + gᵀx + const, exactly from the atoms' data as
+    given (``Atom.exact``: a cost string's 0.3 is 3/10), when every cost is built of
+    Quadratic / Affine atoms, sums and scalings; else None."""
     H = [[Fraction(0)] * d for _ in range(d)]
     g = [Fraction(0)] * d
     for grp in groups:
@@ -350,19 +351,18 @@ def _add_quadratic(o: Any, w: Fraction, H: list[list[Fraction]], g: list[Fractio
     """Add w·f's (Hessian, linear part) to (H, g); False when f is not a known quadratic.
     Quadratic ½(x − c)ᵀQ(x − c) + qᵀx: Hessian Q, linear part q − Qc; Affine aᵀx + b: a."""
     if isinstance(o, atoms.Quadratic):
-        Q = [[Fraction(v) for v in row] for row in o.Q.tolist()]
-        c = [Fraction(v) for v in o.c.tolist()]
+        Q, c, q = o.exact["Q"], o.exact["c"], o.exact["q"]
         for i, row in enumerate(Q):
-            g[i] += w * (Fraction(o.q[i]) - sum(a * b for a, b in zip(row, c, strict=True)))
+            g[i] += w * (q[i] - sum(a * b for a, b in zip(row, c, strict=True)))
             for j, v in enumerate(row):
                 H[i][j] += w * v
         return True
     if isinstance(o, atoms.Affine):
-        for i, v in enumerate(o.a.tolist()):
-            g[i] += w * Fraction(v)
+        for i, v in enumerate(o.exact["a"]):
+            g[i] += w * v
         return True
     if isinstance(o, atoms.Scaled):
-        return _add_quadratic(o.term, w * Fraction(o.coef), H, g)
+        return _add_quadratic(o.term, w * o.exact["coef"], H, g)
     if isinstance(o, atoms.Sum):
         return all(_add_quadratic(t, w, H, g) for t in o.terms)
     return False
