@@ -366,6 +366,9 @@ def test_bad_step_sizes_and_assumption5_warning():
         rmdo(sc, costs, step_size=harmonic(1.0, 1.0))  # Assumption 5 holds: no warning
         with pytest.raises(ScenarioWarning, match="Assumption 5.*constant step size"):
             rmdo(sc, costs, step_size=0.1)
+    with pytest.warns(ScenarioWarning, match=r"Assumption 5: step size .*√\(k\+1\)") as record:
+        rmdo(sc, costs, step_size=rescon.optim.steps.sqrt_decay(1.0))
+    assert record[0].filename == __file__  # attributed to the caller
 
 
 def test_bad_optimum():
