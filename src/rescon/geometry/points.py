@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._rounding import MAX_FINITE
 from ..errors import EmptyKernel, InputError, SolverError
 from .exact import fraction_str, solve_exact
 
@@ -88,15 +89,49 @@ NEAR_SLACK = 1e-6
 MAX_NEAR = 10
 
 
-def _geometric_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
-    """Nearest point of conv(V) to m for a kernel of dimension 1 or 2, in floats: m
-    itself (moved onto aff Ψ) if inside, else the nearest point of the segments between
-    vertices (every edge is one of them)."""
-    o, B = K.affine_origin, K.affine_basis
-    y = o + B.T @ (B @ (m - o))
-    if K.contains(y, tol=1e-12) and K.dim == 2:
-        return y
+#: the float guides see the target at most 2^FAR_TARGET kernel sizes away
+FAR_TARGET = 600
+
+
+def _frame(K: SafeKernel, m: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """o, e: the mean of Ψ's float vertices and an exponent with 2^e about Ψ's extent
+    (or 2^-FAR_TARGET times the distance to the target m, if larger). The float guides
+    work in y = (x − o) / 2^e (:func:`_to_frame`), where Ψ has unit size whatever its
+    magnitude (HiGHS reads |b| ≥ 1e20 as infinite; absolute tolerances swamp a
+    kernel at 1e-300; nothing overflows near the largest floats) — and, 2^e a power
+    of two, on the same numbers for X and 2^j X."""
     V = K.vertices
+    o = (V / len(V)).sum(axis=0)
+    ext = float(np.abs(V / 4 - o / 4).max())
+    if m is not None:
+        ext = max(ext, math.ldexp(float(np.abs(m / 4 - o / 4).max()), -FAR_TARGET))
+    return o, (math.frexp(ext)[1] + 2 if ext > 0 else 0)
+
+
+def _to_frame(x: np.ndarray, c: np.ndarray, e: int) -> np.ndarray:
+    """(x − c) / 2^e in floats, without overflow in between (a hint's precision)."""
+    return np.ldexp(x / 4 - c / 4, 2 - e)
+
+
+def _from_frame(y: np.ndarray, o: np.ndarray, e: int) -> np.ndarray:
+    """o + 2^e y, held within the finite floats."""
+    return np.clip(o + np.ldexp(y, e), -MAX_FINITE, MAX_FINITE)
+
+
+def _framed(K: SafeKernel, o: np.ndarray, e: int):
+    """A, b, origin, basis and vertices of Ψ in the frame y = (x − o) / 2^e: the rows
+    A y ≤ (b − A o) / 2^e."""
+    return (K.A, np.ldexp(K.b / 4 - K.A @ (o / 4), 2 - e),
+            _to_frame(K.affine_origin, o, e), K.affine_basis, _to_frame(K.vertices, o, e))
+
+
+def _geometric_guide(A, b, origin, B, V, dim: int, m: np.ndarray) -> np.ndarray:
+    """Nearest point of conv(V) to m for a kernel of dimension 1 or 2 (unit frame,
+    :func:`_frame`), in floats: m itself (moved onto aff Ψ) if inside, else the
+    nearest point of the segments between vertices (every edge is one of them)."""
+    y = origin + B.T @ (B @ (m - origin))
+    if dim == 2 and np.all(A @ y - b <= 1e-12):
+        return y
     i, j = np.triu_indices(len(V), 1)
     P, Q = V[i], V[j]
     D = Q - P
@@ -106,68 +141,47 @@ def _geometric_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
     return C[np.argmin(np.linalg.norm(C - m, axis=1))]
 
 
-def _vertex_guide(K: SafeKernel, m: np.ndarray) -> np.ndarray:
-    """Nearest point of conv(V) to m in floats, as min ‖Vᵀλ − m‖ over λ ≥ 0 with
-    Σλ = 1 weighted in (Lawson–Hanson NNLS, scipy), at the kernel's own scale: a
+def _vertex_guide(V: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Nearest point of conv(V) to m in floats (unit frame, :func:`_frame`), as
+    min ‖Vᵀλ − m‖ over λ ≥ 0 with Σλ = 1 weighted in (Lawson–Hanson NNLS, scipy): a
     kernel 1e-7 wide a million sizes away from m, where the QP solvers stop short of
     optimal, still gives the face it lands on."""
     from scipy.optimize import nnls
 
-    V = K.vertices
-    o = V.mean(axis=0)
-    s = float(np.abs(V - o).max()) or 1.0
-    U, c = (V - o) / s, (m - o) / s
-    w = max(1.0, float(np.abs(c).max()))
-    lam, _ = nnls(np.vstack([U.T, np.full(len(U), w)]), np.r_[c, w])
+    w = max(1.0, float(np.abs(m).max()))
+    lam, _ = nnls(np.vstack([V.T, np.full(len(V), w)]), np.r_[m, w])
     total = lam.sum()
-    return o + s * (U.T @ lam) / total if total > 0 else o
-
-
-def _frame(K: SafeKernel) -> tuple[np.ndarray, float]:
-    """o, s: the mean of Ψ's float vertices and a power of two about its extent. The
-    float QP/LP guides are solved for y = (x − o)/s, where Ψ has unit size whatever
-    its magnitude (HiGHS reads |b| ≥ 1e20 as infinite; absolute tolerances swamp a
-    kernel at 1e-300), and — s a power of two — the same numbers for X and 2^j X."""
-    V = K.vertices
-    o = (V / len(V)).sum(axis=0)  # no overflow near the largest floats
-    ext = float(np.abs(V - o).max())
-    if not np.isfinite(ext):
-        ext = float(np.abs(V).max())
-    return o, (math.ldexp(1.0, math.frexp(ext)[1]) if ext > 0 else 1.0)
-
-
-def _framed_rows(K: SafeKernel, o: np.ndarray, s: float
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """A, b, origin, basis of Ψ in the frame y = (x − o)/s (:func:`_frame`)."""
-    return K.A, (K.b - K.A @ o) / s, (K.affine_origin - o) / s, K.affine_basis
+    return (V.T @ lam) / total if total > 0 else V.mean(axis=0)
 
 
 def _guides(K: SafeKernel, m: Vec, backend: str):
     """Float points near the projection, best first. An explicit backend is the only
     guide (its failure is the user's answer); "auto" tries the geometric guide (dim ≤
-    2) or Clarabel, then the vertex guide."""
+    2) or Clarabel, then the vertex guide. All are solved in the unit frame."""
     from ..models.kernel_models import project
 
     mf = np.array([float(v) for v in m])
-    o, s = _frame(K)
-    rows = _framed_rows(K, o, s)
+    o, e = _frame(K, mf)
+    A, b, origin, B, V = _framed(K, o, e)
+    mf = _to_frame(mf, o, e)
+    back = lambda y: _from_frame(y, o, e)
     if backend not in ("auto", "exact"):
-        yield o + s * project(*rows, (mf - o) / s, backend=backend)
+        yield back(project(A, b, origin, B, mf, backend=backend))
         return
-    if backend == "auto" and K.dim <= 2 and len(K.vertices) <= GEOMETRIC_GUIDE_VERTICES:
-        yield _geometric_guide(K, mf)
+    if backend == "auto" and K.dim <= 2 and len(V) <= GEOMETRIC_GUIDE_VERTICES:
+        yield back(_geometric_guide(A, b, origin, B, V, K.dim, mf))
     else:
         try:
-            guess = o + s * project(*rows, (mf - o) / s, backend="clarabel")
+            guess = project(A, b, origin, B, mf, backend="clarabel")
         except SolverError:  # a hint only: the next guide and the exact search decide
             pass
         else:
-            yield guess
+            yield back(guess)
     try:
-        guess = _vertex_guide(K, mf)
+        guess = _vertex_guide(V, mf)
     except (RuntimeError, ValueError):  # scipy's NNLS at its iteration limit: no hint
         return
-    yield guess
+    yield back(guess)
 
 
 def _near_active_sets(K: SafeKernel, guess: np.ndarray) -> list[tuple[int, ...]]:
@@ -253,9 +267,9 @@ def _chebyshev(K: SafeKernel, backend: str) -> Vec:
     if K.dim == 0:
         return ex.vertices[0]
     name = "highs" if backend in ("auto", "exact") else backend
-    o, s = _frame(K)
-    centre, _ = chebyshev(*_framed_rows(K, o, s), backend=name)
-    centre = o + s * centre
+    o, e = _frame(K)
+    centre, _ = chebyshev(*_framed(K, o, e)[:4], backend=name)
+    centre = _from_frame(centre, o, e)
     x = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre))
     if ex.contains(x):
         return x
