@@ -148,8 +148,9 @@ def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hasha
         return getattr(oracle, method)(Z)
     except Exception as exc:  # a user's oracle may raise anything: report where
         r = next((r for r in range(len(Z)) if not _works(oracle, method, Z[r:r + 1])), 0)
+        why = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
         raise InputError(f"{method} of the cost of agent {who(r)!r} {where}, point "
-                         f"{Z[r].tolist()}: {type(exc).__name__}: {exc}") from exc
+                         f"{Z[r].tolist()}: {why}") from exc
 
 
 def _works(oracle: Oracle, method: str, Z: np.ndarray) -> bool:
