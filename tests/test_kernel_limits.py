@@ -3,6 +3,9 @@ QP backends on thin kernels, certificates that list only facets."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import textwrap
 from fractions import Fraction
 
 import numpy as np
@@ -10,6 +13,7 @@ import pytest
 
 import rescon
 from rescon.errors import EmptyKernel, InputError
+from rescon.geometry import halfspaces
 from rescon.models.kernel_models import lp_backends
 
 FLAT = [[i, 0.1 * i] for i in range(6)]  # not exactly collinear in floats: a segment
@@ -81,3 +85,96 @@ def test_kernel_points_empty_kernel_per_item():
     assert np.array_equal(out[0], rescon.kernel_point(full, 1)[0])
     with pytest.raises(InputError, match="on_empty"):
         rescon.kernel_points([full], 1, on_empty="skip")
+
+
+# --------------------------------------------------------------------------- #
+# exponential tables: one budget (geometry/_budget.py), refused or skipped early
+# --------------------------------------------------------------------------- #
+
+
+def _run_limited(code: str, gib: float = 2.5, seconds: float = 120):
+    """``code`` in a fresh interpreter whose address space is capped at ``gib`` GiB
+    (what used to take 5–18 GB dies there with MemoryError)."""
+    cap = int(gib * 2**30)
+    pre = ("import resource\n"
+           f"resource.setrlimit(resource.RLIMIT_AS, ({cap}, {cap}))\n"
+           "import numpy as np, rescon\n")
+    return subprocess.run([sys.executable, "-c", pre + textwrap.dedent(code)],
+                          check=False, capture_output=True, text=True, timeout=seconds)
+
+
+@pytest.mark.slow
+def test_quick_emptiness_directions_skipped_in_high_dimension():
+    # 3^16 directions took 10.5 GB; the full algorithm decides instead
+    out = _run_limited("""
+        K = rescon.safe_kernel(np.random.default_rng(0).normal(size=(2, 16)), 1)
+        print(K.is_empty, K.certificate["kind"])
+    """)
+    assert out.returncode == 0, out.stderr[-500:]
+    assert out.stdout.split() == ["True", "kernel_empty"]  # (the checker takes d ≤ 8)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("n,d,F", [(13, 12, 0), (25, 20, 0)])
+def test_high_dimension_refused_by_the_budget(n, d, F):
+    # (d−1)! permutations took 5.5 GB (13 in R^12) and 18 GB (25 in R^20)
+    out = _run_limited(f"""
+        import time
+        from rescon.errors import InputError
+        t = time.perf_counter()
+        try:
+            rescon.safe_kernel(np.random.default_rng(0).normal(size=({n}, {d})), {F})
+        except InputError as exc:
+            print("refused", round(time.perf_counter() - t, 1), exc)
+    """)
+    assert out.returncode == 0, out.stderr[-500:]
+    assert out.stdout.startswith("refused"), out.stdout
+    assert float(out.stdout.split()[1]) < 30 and "steps" in out.stdout
+
+
+def test_bareiss_determinant_matches_fractions():
+    rng = np.random.default_rng(4)
+    for m in range(1, 8):
+        for _ in range(5):
+            M = rng.integers(-3, 4, size=(m, m)).tolist()
+            if m > 2:
+                M[1][0] = 0  # zero pivots: row swaps
+                M[0][0] = 0
+            assert halfspaces._int_det(M) == _fraction_det(M)
+
+
+def _fraction_det(M) -> int:
+    A = [[Fraction(v) for v in row] for row in M]
+    det = Fraction(1)
+    for c in range(len(A)):
+        p = next((i for i in range(c, len(A)) if A[i][c]), None)
+        if p is None:
+            return 0
+        if p != c:
+            A[c], A[p] = A[p], A[c]
+            det = -det
+        det *= A[c][c]
+        for i in range(c + 1, len(A)):
+            f = A[i][c] / A[c][c]
+            A[i] = [x - f * y for x, y in zip(A[i], A[c], strict=True)]
+    return int(det)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_exact_only_candidates_give_the_same_kernel(monkeypatch, seed):
+    # the path taken where a (k−1)!-term expansion costs more (k ≥ 10), forced at k = 4
+    X = np.random.default_rng(seed).normal(size=(14, 4))
+    ref = rescon.safe_kernel(X, 1)
+    monkeypatch.setattr(halfspaces, "PYTHON_STEP", 0)
+    assert halfspaces._scan_plan(14, 4, False)[0]
+    K = rescon.safe_kernel(X, 1)
+    assert set(K.exact_vertices) == set(ref.exact_vertices)
+    assert K.certificate == ref.certificate
+
+
+def test_planar_estimate_is_the_sweeps():
+    # 3000 distinct points in the plane: C(n,2)·(n−2) ≈ 1.3e10 tests refused them,
+    # the angular sweep needs ~n² log n
+    exact_only, work, nbytes = halfspaces._scan_plan(3000, 2, True)
+    assert not exact_only and work < 1e9 and nbytes < 2**30
+    assert halfspaces._scan_plan(3000, 2, False)[1] > 4e9  # the direct scan would not fit

@@ -9,7 +9,10 @@ multipliers prove Ψ = ∅ without enumerating the candidate hyperplanes:
 1. floats choose β_u, the value of one data point: for small-integer data the values
    are exact (at most F lie strictly above β_u); otherwise a direction whose
    (F+1)-th value is not separated from its neighbours by more than the rounding
-   error is skipped, so exactly F points lie strictly above it;
+   error is skipped, so exactly F points lie strictly above it. The values are taken
+   of X / 2^e (max |X| / 2^e in [1/2, 1)), so they cannot overflow at any scale of
+   X; the error bound adds the underflow term (entries rounded into the subnormal
+   range included), and an inf or NaN separation never counts as separated;
 2. the LP max t s.t. u·x + t ≤ β_u (HiGHS) with t* < 0 proposes the directions that
    matter — the support of its dual solution, at most d + 1 of them;
 3. exact multipliers λ ≥ 0 with Σ λ_u u = 0, Σ λ_u = 1 are solved in rationals on
@@ -29,11 +32,15 @@ from typing import Any
 
 import numpy as np
 
+from .._rounding import UNIT_ROUNDOFF as _EPS
+from .._rounding import underflow_floor
+from ._budget import PYTHON_STEP, fits
 from .exact import solve_exact
 
-_EPS = 2.0**-53
 #: component range of the directions tried: {−R..R}^d (primitive vectors), by dimension
 _RANGE = {1: 1, 2: 3, 3: 2, 4: 1, 5: 1}
+#: share of the budget the directions may take (they are only a shortcut)
+QUICK_SHARE = 1 / 64
 
 
 def _directions(d: int) -> np.ndarray:
@@ -46,6 +53,15 @@ def _directions(d: int) -> np.ndarray:
     return np.array(out, dtype=np.float64)
 
 
+def _directions_fit(n: int, d: int) -> bool:
+    """Whether the (2R+1)^d candidate directions, listed in Python, and the (n, m)
+    tables of their values fit in :data:`QUICK_SHARE` of the budget (:mod:`._budget`);
+    beyond it the step is skipped — it is only a shortcut (3^16 directions in R^16
+    took 10 GB)."""
+    m = (2 * _RANGE.get(d, 1) + 1) ** d
+    return fits(m * (PYTHON_STEP * d + n * d), m * (64 + 8 * d + 24 * n), QUICK_SHARE)
+
+
 def empty_certificate(X: np.ndarray, F: int
                       ) -> tuple[dict[str, Any], list[tuple[tuple[Fraction, ...], Fraction]]] | None:
     """A ``kernel_empty`` certificate for Ψ(X, F) from directional halfspaces and those
@@ -53,13 +69,16 @@ def empty_certificate(X: np.ndarray, F: int
 
     X: (n, d) finite floats, 0 ≤ F < n."""
     n, d = X.shape
-    if n > (d + 1) * F:
+    if n > (d + 1) * F or not _directions_fit(n, d):
         return None
     U = _directions(d)
-    V = X @ U.T  # (n, m)
-    err = 4.0 * d * _EPS * (np.abs(U).sum(axis=1) * np.abs(X).max())  # per direction
-    if np.all(X == np.round(X)) and np.abs(X).max() * np.abs(U).sum(axis=1).max() < 2.0**52:
-        err[:] = 0.0  # small integers: the values are exact, ties are real ties
+    top = float(np.abs(X).max())
+    Xs = np.ldexp(X, -np.frexp(top)[1]) if top > 0 else X  # max |Xs| in [1/2, 1)
+    V = Xs @ U.T  # (n, m)
+    Usum = np.abs(U).sum(axis=1)
+    err = 4.0 * d * _EPS * Usum * np.abs(Xs).max() + underflow_floor(d, Usum.max())
+    if np.all(X == np.round(X)) and top * Usum.max() < 2.0**52:
+        err[:] = 0.0  # small integers (exact over 2^e too): exact values, real ties
     order = np.argsort(-V, axis=0, kind="stable")
     ranked = np.take_along_axis(V, order, axis=0)
     beta = ranked[F]
@@ -68,8 +87,8 @@ def empty_certificate(X: np.ndarray, F: int
     keep = np.flatnonzero(((above > 2 * err) & (below > 2 * err)) | (err == 0.0))
     if len(keep) < d + 1:
         return None
-    support = _lp_support(U[keep], beta[keep], X.min(axis=0), X.max(axis=0),
-                          np.median(X, axis=0))
+    support = _lp_support(U[keep], beta[keep], Xs.min(axis=0), Xs.max(axis=0),
+                          np.median(Xs, axis=0))
     if support is None:
         return None
     rows = keep[support]

@@ -21,14 +21,15 @@ from typing import Any
 
 import numpy as np
 
+from .._rounding import MIN_NORMAL, underflow_floor
 from .._rounding import UNIT_ROUNDOFF as _EPS
-from .._rounding import underflow_floor
-from ..errors import InputError
+from ._budget import MAX_WORK, PYTHON_STEP, require
 
 __all__ = ["MAX_CANDIDATE_COST", "Halfspaces", "candidate_cost", "valid_halfspaces"]
 
-#: refuse inputs whose candidate enumeration needs more point tests than this
-MAX_CANDIDATE_COST = 4_000_000_000
+#: refuse inputs whose candidate enumeration needs more point tests than this (the
+#: budget of every exponential table, :mod:`._budget`)
+MAX_CANDIDATE_COST = MAX_WORK
 #: from this many distinct points on, lines in the plane are counted by the angular
 #: sweep (O(n² log n)) instead of the direct scan (O(n³))
 SWEEP_MIN_POINTS = 150
@@ -94,6 +95,23 @@ def candidate_cost(n_unique: int, k: int) -> int:
     return comb(n_unique, k) * max(n_unique - k, 0)
 
 
+def _scan_plan(m: int, k: int, sweep: bool) -> tuple[bool, float, float]:
+    """(exact_only, work, bytes) of classifying the C(m, k) candidates by the method
+    that will run (:mod:`._budget` units): the angular sweep in the plane,
+    ~m² log₂ m; else the float scan, C(m, k) · (m − k) tests plus, for k ≥ 4, a
+    (k − 1)!-term cofactor expansion per subset — or, when that costs more, every
+    subset in Python integers (Bareiss cofactors, O(k⁴), and an exact scan)."""
+    count = comb(m, k)
+    tables = count * (4 * k + 25 + 16 * k)  # subsets, counts, flags, cofactors
+    if sweep:
+        return False, 4.0 * m * m * max(m.bit_length(), 1), tables
+    expand = (k - 1) * factorial(k - 1) if k >= 4 else 0
+    exact = PYTHON_STEP * (k**4 + (m - k) * k)
+    if k >= 4 and exact < expand:
+        return True, count * exact, tables
+    return False, count * (m - k + expand), tables + 8.0 * k * factorial(max(k - 1, 0))
+
+
 def _permutations(m: int) -> tuple[np.ndarray, np.ndarray]:
     """All permutations of range(m) (rows) and their signs; one dummy row for m = 0."""
     if m == 0:
@@ -110,7 +128,25 @@ def _exact_float_bits(k: int) -> int:
     return int((53 - np.log2(factorial(k))) // k) - 2
 
 
+def _rounded_normals(Yi, through: np.ndarray, sign: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, float]:
+    """Float rows for exact-only candidates: each exact normal sign · C (integers),
+    scaled by a power of two to max |·| ∈ [1/2, 1) and correctly rounded, so
+    |af − a| ≤ ε|a| + 2^-1075 componentwise (a the scaled exact normal); returns
+    (af, af_abs, c_err) with af_abs = |af|(1 + 4ε) + 2^-1022 and c_err = 8ε, the
+    convention of :class:`Halfspaces`."""
+    af = np.zeros((len(sign), through.shape[1] if len(sign) else 0))
+    for r, (sub, s) in enumerate(zip(through.tolist(), sign.tolist(), strict=True)):
+        normal = exact_normal(Yi, sub)
+        unit = 1 << max(map(abs, normal)).bit_length()
+        af[r] = [s * v / unit for v in normal]
+    return af, np.abs(af) * (1.0 + 4 * _EPS) + MIN_NORMAL, 8 * _EPS
+
+
 def _int_det(rows: list[list[int]]) -> int:
+    """det of a square integer matrix: closed forms up to 3 × 3, beyond them Bareiss's
+    fraction-free elimination (O(m³) steps; each entry after step c is a minor of
+    order c + 1, so every division is exact) — never an m!-term expansion."""
     m = len(rows)
     if m == 0:
         return 1
@@ -121,12 +157,22 @@ def _int_det(rows: list[list[int]]) -> int:
     if m == 3:
         (a, b, c), (d, e, f), (g, h, i) = rows
         return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-    total = 0
-    for j in range(m):
-        if rows[0][j]:
-            minor = [r[:j] + r[j + 1:] for r in rows[1:]]
-            total += (-1) ** j * rows[0][j] * _int_det(minor)
-    return total
+    M = [list(r) for r in rows]
+    sign, prev = 1, 1
+    for c in range(m - 1):
+        p = next((i for i in range(c, m) if M[i][c]), None)
+        if p is None:
+            return 0
+        if p != c:
+            M[c], M[p] = M[p], M[c]
+            sign = -sign
+        piv, top = M[c][c], M[c]
+        for row in M[c + 1:]:
+            f = row[c]
+            for j in range(c + 1, m):
+                row[j] = (row[j] * piv - f * top[j]) // prev
+        prev = piv
+    return sign * M[m - 1][m - 1]
 
 
 def exact_normal(Yi: list[tuple[int, ...]], subset) -> tuple[int, ...]:
@@ -167,12 +213,11 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     m, k = Y.shape
     count = comb(m, k)
-    cost = candidate_cost(m, k)
-    if cost > MAX_CANDIDATE_COST:
-        raise InputError(f"the safe kernel of {m} distinct points in dimension {k} needs "
-                         f"C({m},{k})·{m - k} ≈ {cost:.2e} point tests (limit "
-                         f"{MAX_CANDIDATE_COST:.0e}); reduce n or d")
-    perms, signs = _permutations(k - 1)
+    sweep = k == 2 and m >= SWEEP_MIN_POINTS and exact_view
+    exact_only, work, nbytes = _scan_plan(m, k, sweep)
+    require(f"the safe kernel of {m} distinct points in dimension {k}", work, nbytes,
+            "reduce n or d")
+    perms, signs = _permutations(0 if exact_only else k - 1)
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     exact_floats = k == 1 or bits <= _exact_float_bits(k)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
@@ -185,7 +230,6 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
     # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
     # window is exactly on the line
-    sweep = k == 2 and m >= SWEEP_MIN_POINTS and exact_view
     separated = sweep and exact_floats and 16 * ANGLE_ERR * 2 * max(
         max(col) - min(col) for col in zip(*Yi)) ** 2 < 1
     if sweep and (separated or not exact_floats):
@@ -194,6 +238,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         if separated:
             unc[:] = 0  # on the line: on neither side
     else:
+    elif exact_only:  # no float filter: every subset is decided exactly below
+        plus, minus, degenerate = (np.zeros(count, dtype=t) for t in (np.int64, np.int64, np.bool_))
+        unc = np.full(count, int(W.sum()), dtype=np.int64)
+        cof = cof_abs = np.zeros((count, k))
         plus, minus, unc, degenerate, cof, cof_abs = classify(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms,
             signs, c_err, F, floor)
@@ -229,6 +277,8 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
             af[ill] = exact * sign[ill, None]
             af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
     bf = np.einsum("ij,ij->i", af, p0)
+    if exact_only:
+        af, af_abs, c_err = _rounded_normals(Yi, through, sign)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
     if c_err == 0.0 and k >= 3:  # exact rows: drop repeats (coplanar data: one plane many times)
         keep = _distinct_rows(af, bf)

@@ -27,6 +27,7 @@ import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
 from .._rounding import underflow_floor
+from ._budget import PYTHON_STEP, require
 from .exact import bareiss_rank, nullspace_exact
 
 __all__ = ["ExactPolytope", "Farkas"]
@@ -79,12 +80,15 @@ class ExactPolytope:
     farkas: Farkas | None = None  # set when a clip empties the polytope
     unit: int = 1  # a power of two: the float vertices are y / (w · unit)
     _fv: np.ndarray | None = field(default=None, repr=False)  # float vertices (cache)
+    work: int = 0  # estimated steps spent clipping so far (:mod:`._budget`)
 
     @classmethod
     def box(cls, lo: list[int], hi: list[int], unit: int = 1) -> ExactPolytope:
         """The box lo ≤ y ≤ hi (lo_j < hi_j), constraints 2j: −y_j ≤ −lo_j and
         2j+1: y_j ≤ hi_j."""
         k = len(lo)
+        require(f"the bounding box in dimension {k}", PYTHON_STEP * k * 2**k,
+                40 * (k + 1) * 2**k, "reduce d")
         P = cls(k, unit=unit)
         for j in range(k):
             e = [0] * k
@@ -149,6 +153,7 @@ class ExactPolytope:
         sign, exact = self._signs(a, b)
         if not (sign > 0).any():
             return False
+        self._spend(int((sign > 0).sum()))
         hid = len(self.a)
         bit = 1 << hid
         if (sign > 0).all():
@@ -195,6 +200,17 @@ class ExactPolytope:
         self.a.append(a)
         self.b.append(b)
         return True
+
+    def _spend(self, cut: int) -> None:
+        """Add the estimated cost of a clip cutting off ``cut`` vertices to ``work`` and
+        refuse beyond the budget (:mod:`._budget`): the edge search meets, for each
+        cut-off vertex, the members of each constraint tight at it — on average
+        (I/|V|)·(I/#constraints) Python steps, I the number of incidences."""
+        incidences = sum(t.bit_count() for t in self.tight)
+        per_vertex = incidences / max(len(self.verts), 1)
+        self.work += int(PYTHON_STEP * cut * per_vertex * incidences / max(len(self.a), 1))
+        require(f"the exact vertex enumeration of the kernel in dimension {self.k}",
+                self.work, 0, "reduce d, or n")
 
     def _edge(self, u: int, v: int, z: int, members: _Members) -> bool:
         """u, v span an edge: no other vertex is tight on all of z."""
@@ -368,7 +384,8 @@ def _clip_rounds(P: ExactPolytope, H, ids: np.ndarray) -> None:
             return
         picks = []
         if violated.any():
-            score = np.where(sure, S / norms[:, None], -np.inf)
+            with np.errstate(divide="ignore", invalid="ignore"):  # rows rounded to 0
+                score = np.where(sure, S / norms[:, None], -np.inf)
             picks = [int(ids[h]) for h in np.unique(score.argmax(axis=0)[sure.any(axis=0)])]
         for g in picks + exact_cuts:
             P.clip(*H.exact(g))
