@@ -219,7 +219,8 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
             "reduce n or d")
     perms, signs = _permutations(0 if exact_only else k - 1)
     bits = max(abs(v) for row in Yi for v in row).bit_length()
-    exact_floats = k == 1 or bits <= _exact_float_bits(k)
+    # k = 1: the sign of a float difference is exact — of exact floats
+    exact_floats = exact_view and (k == 1 or bits <= _exact_float_bits(k))
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
     # exact floats: Y holds small integers over a unit ≤ 2^(bits + 32), so no product of
     # k + 1 of them underflows either
@@ -237,11 +238,11 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
         if separated:
             unc[:] = 0  # on the line: on neither side
-    else:
     elif exact_only:  # no float filter: every subset is decided exactly below
         plus, minus, degenerate = (np.zeros(count, dtype=t) for t in (np.int64, np.int64, np.bool_))
         unc = np.full(count, int(W.sum()), dtype=np.int64)
         cof = cof_abs = np.zeros((count, k))
+    else:
         plus, minus, unc, degenerate, cof, cof_abs = classify(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms,
             signs, c_err, F, floor)
@@ -276,9 +277,9 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
             normals3(np.ascontiguousarray(Y, dtype=np.float64), through[ill], exact)
             af[ill] = exact * sign[ill, None]
             af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
-    bf = np.einsum("ij,ij->i", af, p0)
     if exact_only:
         af, af_abs, c_err = _rounded_normals(Yi, through, sign)
+    bf = np.einsum("ij,ij->i", af, p0)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
     if c_err == 0.0 and k >= 3:  # exact rows: drop repeats (coplanar data: one plane many times)
         keep = _distinct_rows(af, bf)
