@@ -178,3 +178,34 @@ def test_planar_estimate_is_the_sweeps():
     exact_only, work, nbytes = halfspaces._scan_plan(3000, 2, True)
     assert not exact_only and work < 1e9 and nbytes < 2**30
     assert halfspaces._scan_plan(3000, 2, False)[1] > 4e9  # the direct scan would not fit
+
+
+# --------------------------------------------------------------------------- #
+# certificates: only the rows the claim needs
+# --------------------------------------------------------------------------- #
+
+#: integer clouds whose kernels have degenerate vertices: 11 rows tight at a vertex for
+#: 6 facets, and 19 for 12
+DEGENERATE = [
+    ([[1, 1, 1], [2, 1, 2], [1, 0, 0], [2, 1, 0], [2, 2, 0], [0, 2, 1], [1, 0, 0], [2, 2, 2],
+      [1, 0, 0], [1, 2, 0], [1, 1, 1], [1, 2, 0], [2, 2, 2], [0, 1, 1], [0, 0, 2], [0, 2, 0]],
+     2),
+    ([[0, 1, 1, 0], [1, 1, 0, 0], [1, 1, 0, 1], [1, 1, 1, 1], [1, 0, 1, 1], [1, 0, 0, 1],
+      [0, 1, 1, 0], [0, 1, 1, 1], [1, 1, 0, 0], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], 1),
+]
+
+
+@pytest.mark.parametrize("X,F", DEGENERATE)
+def test_certificate_lists_only_the_facets(X, F):
+    K = rescon.safe_kernel(X, F)
+    cert = K.certificate
+    assert K.dim == len(X[0])  # full-dimensional: the facets are all it needs
+    assert len(cert["facets"]) == len(K.b)
+    assert rescon.check_certificate(cert).valid
+
+
+def test_flat_kernel_certificate_keeps_its_equalities():
+    K = rescon.safe_kernel(FLAT, 1)
+    rows = K.certificate["facets"]
+    assert len(rows) == 4  # the segment's line (both sides) and its two ends
+    assert rescon.check_certificate(K.certificate).valid

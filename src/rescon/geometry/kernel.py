@@ -243,15 +243,22 @@ def _along_hull(rows: list[tuple[tuple[Fraction, ...], Fraction]], eqs, v0
 def _unit_rows(rows: list[tuple[tuple[Fraction, ...], Fraction]], d: int
                ) -> tuple[np.ndarray, np.ndarray]:
     """Float rows a/‖a‖, b/‖a‖ (each row first divided exactly by its largest |a_j|, so
-    the float conversion cannot overflow in a)."""
+    the float conversion cannot overflow in a; b/‖a‖ is rounded once from the exact
+    quotient by the float norm, so it overflows only when the facet's distance from
+    the origin does: InputError, as no float row can state it)."""
     if not rows:
         return np.zeros((0, d)), np.zeros(0)
     rows = [(tuple(v / top for v in a), bb / top)
             for a, bb in rows for top in (max(map(abs, a)),)]
     A = np.array([[float(v) for v in a] for a, _ in rows])
-    b = np.array([float(v) for _, v in rows])
     norm = np.linalg.norm(A, axis=1)
-    return A / norm[:, None], b / norm
+    try:
+        b = np.array([float(bb / Fraction(float(nv))) for (_, bb), nv in zip(rows, norm)])
+    except OverflowError:
+        raise InputError("X: a facet of the safe kernel lies farther than 1.8e308 from the "
+                         "origin, so its float row (A, b) cannot be represented; translate "
+                         "X towards the origin") from None
+    return A / norm[:, None], b
 
 
 def safe_kernel(X: Any, F: Any) -> SafeKernel:
@@ -316,6 +323,8 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     full = poly is not None and hull.dim == d and poly.dim() == d
     dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d, full)
     facets = _relative_facets(poly, ambient, dim) if poly is not None else []
+    if poly is not None:
+        constraints = _needed_rows(poly, ambient, facets)
     A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts[0]), d)
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
 
@@ -432,6 +441,18 @@ def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
                 poly.clear_rank(members) >= dim - 1 or poly.face_dim(members) == dim - 1):
             out.append(ambient[h])
     return out
+
+
+def _needed_rows(poly: ExactPolytope, ambient: dict, facets: list) -> tuple:
+    """The constraints that state Ψ: those tight at every vertex (they cut out aff Ψ
+    within aff X) and the relative facets. A polytope is the intersection of its
+    facets within its affine hull, and each vertex is the meet of the facets through
+    it, so the rows tight only on smaller faces (the fast path's extra supporting
+    planes at degenerate vertices) are redundant — the certificate leaves them out."""
+    nv = len(poly.verts)
+    implicit = [ambient[h] for h, members in sorted(poly.incidence().items())
+                if len(members) == nv]
+    return tuple(implicit + facets)
 
 
 def _empty_certificate(Xa, F, hull, poly, scale, d) -> dict[str, Any]:
