@@ -436,11 +436,11 @@ def test_project_survives_a_failing_guide(monkeypatch):
     with pytest.raises(SolverError, match="AlmostSolved"):
         K.point("project", backend="clarabel")
     # no usable guide at all: the exhaustive exact search still answers
-    monkeypatch.setattr(points, "_vertex_guide", lambda K, m: np.full(K.dim, np.nan))
+    monkeypatch.setattr(points, "_vertex_guide", lambda V, m: np.full(len(m), np.nan))
     x, cert = K.point("project")
     assert np.array_equal(x, expected) and rescon.check_certificate(cert).valid
 
-    def nnls_limit(K, m):
+    def nnls_limit(V, m):
         raise RuntimeError("Maximum number of iterations reached.")
 
     monkeypatch.setattr(points, "_vertex_guide", nnls_limit)  # scipy's NNLS giving up

@@ -55,6 +55,7 @@ def _point(X, F):
     [[1e-300, 2.0], [0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]],
     [[1e-300, 1e300], [-1e300, 5e-324], [3.0, -7.0], [1e-310, 1e-310], [2.0, 2.0]],
     [[-0.0, 3e-311], [-0.0, -0.0], [-0.0, -8.5e+307]],  # collinear: 3e-311 vs 0 in 1-D
+    [[0.0, 0.0], [-1e-310, 0.0], [-1.0, 0.0], [0.0, 0.0]],  # Ψ 1e-310 long, target far
 ])
 def test_points_spanning_the_exponent_range_give_exact_checked_answers(X):
     K = rescon.safe_kernel(X, 1)
@@ -159,6 +160,39 @@ def test_kernel_point_with_more_than_4300_digits():
     xq = [_parse(v) for v in cert["x"]]
     assert x.tolist() == [float(v) for v in xq]
     assert rescon.safe_kernel(X, 1)._exact.contains(tuple(xq))
+
+
+def test_near_the_largest_floats():
+    """Points up to 1.8e308: every point method answers (the guides' frame, sums and
+    squared distances do not overflow) with certificates that check."""
+    M = 1.7976931348623157e308
+    X = [[M, 7.539858393500878e+307], [-M, -1.0664471603681233e+307],
+         [-M, 3.203156529627997e+307], [-M, 9.001509230066127e+307],
+         [M, 5.225055269170945e+307], [-M, -1.5407846165241795e+308],
+         [-M, -1.7660707030873052e+308]]
+    K = rescon.safe_kernel(X, 1)
+    _not_invalid(K.certificate)
+    for method in ("project", "chebyshev", "vertex-mean"):
+        x, cert = K.point(method)
+        _not_invalid(cert)
+        assert np.isfinite(x).all()
+
+
+def test_facet_beyond_the_float_range_is_an_input_error():
+    """A facet farther than 1.8e308 from the origin has no float row (A, b): a clear
+    InputError naming X (was OverflowError)."""
+    X = [[-2.272956801015845e+307, -1.710713625959321e+308, -1.5775076933864834e+308],
+         [-9.046334991928531e+307, -1.6587419007340286e+308, -1.191681222943448e+308],
+         [-1.5696120464382734e+308, -1.2903053238039122e+308, -1.4426235833087205e+308],
+         [-2.701117294305795e+307, 1.1723228828124586e+308, 1.0196944313068759e+308],
+         [1.0738971835495317e+307, -1.5742804080770382e+308, 1.6103484333392725e+308],
+         [-1.5601797632008004e+308, -1.7525193314787036e+308, 8.939936037146471e+307],
+         [4.522609685852205e+307, 9.26896478035055e+307, -8.09681361301021e+307],
+         [1.4126998329289943e+308, 1.3365735683933705e+308, -1.6389939781711726e+308],
+         [1.641828548899451e+308, 9.671762013930054e+307, 1.2712555719317322e+308],
+         [-7.53386258035707e+306, 1.0605146072666493e+308, 1.479140203799131e+308]]
+    with pytest.raises(rescon.errors.InputError, match="^X: a facet of the safe kernel"):
+        rescon.safe_kernel(X, 1)
 
 
 # --------------------------------------------------------------------------- #

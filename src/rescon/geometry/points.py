@@ -89,8 +89,9 @@ NEAR_SLACK = 1e-6
 MAX_NEAR = 10
 
 
-#: the float guides see the target at most 2^FAR_TARGET kernel sizes away
-FAR_TARGET = 600
+#: the float guides see the target at most 2^FAR_TARGET kernel sizes away (squared
+#: distances stay finite)
+FAR_TARGET = 400
 
 
 def _frame(K: SafeKernel, m: np.ndarray | None = None) -> tuple[np.ndarray, int]:
