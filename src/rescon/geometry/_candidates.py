@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .._rounding import UNIT_ROUNDOFF
+
 
 @njit(cache=True)
 def _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols):
@@ -254,7 +256,7 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
 #: angle error bound of atan2 on a correctly rounded difference vector (radians):
 #: the difference has relative error ≤ ε per component (≤ √2 ε in direction), atan2
 #: a few ulps of π; 64 ε is a wide margin.
-ANGLE_ERR = 64.0 * 2.0**-53 * np.pi
+ANGLE_ERR = 64.0 * UNIT_ROUNDOFF * np.pi
 
 
 @njit(cache=True, parallel=True)
