@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -157,24 +158,34 @@ def _cmd_kernel(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_simulate(args: argparse.Namespace) -> int:
-    import warnings
-
-    from .consensus.engine import simulate
-    from .consensus.scenario import Scenario, ScenarioWarning
+def _run_outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
+    """--out DIR and, with --plot, DIR/trajectory.png: checked before any work."""
     from .plot import figure_path
 
     if args.plot and not args.out:
         raise RESCONError("--plot needs --out DIR (where the figure is written)")
     out_dir = _output(args.out, "--out", directory=True)
-    plot = figure_path(out_dir / "trajectory.png", "--plot") if args.plot else None
-    sc = Scenario.from_toml(args.scenario)
+    return out_dir, figure_path(out_dir / "trajectory.png", "--plot") if args.plot else None
+
+
+def _warned(run: Callable[[], Any]) -> Any:
+    """``run()``, its ScenarioWarnings (the assumptions it violates) on stderr."""
+    import warnings
+
+    from .consensus.scenario import ScenarioWarning
+
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScenarioWarning)
-        traj = simulate(sc)
+        result = run()
     for w in caught:
         if issubclass(w.category, ScenarioWarning):
             print(f"rescon: warning: {w.message}", file=sys.stderr)
+    return result
+
+
+def _run_summary(args: argparse.Namespace, sc: Any, traj: Any, out_dir: Path | None,
+                 plot: Path | None) -> tuple[dict[str, Any], list[str]]:
+    """The JSON keys and text lines shared by simulate and rmdo; writes DIR's files."""
     out = {"steps": sc.steps, "N": len(sc.nodes), "d": sc.d, "F": sc.F,
            "algorithm": sc.algorithm, "policy": sc.policy,
            "final_diameter": traj.final_diameter, "max_validity": traj.max_validity,
@@ -193,8 +204,57 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
               f"initial benign hull {traj.max_validity:.3e}")]
     if args.out:
         lines.append(f"written to {args.out}")
+    return out, lines
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .consensus.engine import simulate
+    from .consensus.scenario import Scenario
+
+    out_dir, plot = _run_outputs(args)
+    sc = Scenario.from_toml(args.scenario)
+    traj = _warned(lambda: simulate(sc))
+    out, lines = _run_summary(args, sc, traj, out_dir, plot)
     _emit(out, args.json, lines)
     return 0
+
+
+def _cmd_rmdo(args: argparse.Namespace) -> int:
+    """simulate's keys plus ``final_cost`` (F = Σ_{i∈B} f_i at the final benign mean),
+    ``optimum`` (how X* was found: ``point`` or null, ``exact``, ``value`` F* or null,
+    ``method``, ``dimension`` or ``reason``), ``final_distance_to_optimum`` (max_i
+    dist(x_i, X*)) and ``final_gap`` (max_i F(x_i) − F*), null when X* is not known,
+    and ``step_size``."""
+    from .optim.files import read_rmdo
+    from .optim.rmdo import rmdo
+
+    out_dir, plot = _run_outputs(args)
+    f = read_rmdo(args.scenario)
+    traj = _warned(lambda: rmdo(f.scenario, f.costs, step_size=f.step_size))
+    out, lines = _run_summary(args, f.scenario, traj, out_dir, plot)
+    m, opt = traj.metrics, dict(traj.info["optimum"])
+    opt.setdefault("point", None)
+    opt["value"] = _finite_or_none(opt.get("value"))
+    known = "distance_to_optimum" in m
+    out.update(final_cost=_finite_or_none(float(m["cost_at_mean"][-1])), optimum=opt,
+               final_distance_to_optimum=float(m["distance_to_optimum"][-1]) if known else None,
+               final_gap=float(m["optimality_gap"][-1]) if known else None,
+               step_size=traj.info["step_size"])
+    lines.insert(1, f"step size {out['step_size']}; final global cost at the benign mean "
+                    f"{m['cost_at_mean'][-1]:.6g}")
+    if known:
+        lines.insert(2, f"X* ({opt['method']}): F* = {opt['value']:.6g}; final distance to "
+                        f"X* {out['final_distance_to_optimum']:.3e}, optimality gap "
+                        f"{out['final_gap']:.3e}")
+    else:
+        lines.insert(2, f"X* not known ({opt['method']}): {opt.get('reason', '')}")
+    _emit(out, args.json, lines)
+    return 0
+
+
+def _finite_or_none(x: Any) -> Any:
+    """A float for JSON: ±inf and NaN (not JSON) become null."""
+    return x if x is None or math.isfinite(x) else None
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
@@ -279,6 +339,13 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--plot", action="store_true", help="with --out: draw the trajectory")
     sim.add_argument("--json", action="store_true", help="one JSON object on stdout")
     sim.set_defaults(func=_cmd_simulate)
+
+    opt = sub.add_parser("rmdo", help="run Algorithm 2 (RMDO) on a scenario with [costs]")
+    opt.add_argument("scenario", help="scenario TOML file with [costs] (and [step_size])")
+    opt.add_argument("--out", metavar="DIR", help="write trajectory.json/.csv (and .png)")
+    opt.add_argument("--plot", action="store_true", help="with --out: draw the trajectory")
+    opt.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    opt.set_defaults(func=_cmd_rmdo)
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")

@@ -422,18 +422,27 @@ class Scenario:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Scenario:
-        """Read a scenario file (format: README, "Scenario files")."""
+        """Read a scenario file (format: README, "Scenario files"). A file with
+        [costs] or [step_size] describes an RMDO run and is refused here: read it with
+        :func:`rescon.optim.read_rmdo` (``rescon rmdo``)."""
         p = Path(path)
-        try:
-            data = tomllib.loads(p.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise InputError(f"{p}: no such scenario file") from None
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise InputError(f"{p}: malformed TOML ({exc})") from None
-        return _from_dict(data, p.parent, str(p))
+        return _from_dict(read_toml(p), p.parent, str(p))
+
+
+def read_toml(path: Path) -> dict:
+    """The parsed TOML of a scenario (or costs) file; missing, undecodable or
+    malformed files are an InputError naming the file."""
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such scenario file") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: malformed TOML ({exc})") from None
 
 
 _TOP = {"scenario", "graph", "initial", "adversaries", "dos"}
+#: top-level tables of an RMDO file (:func:`rescon.optim.read_rmdo`), not of a scenario
+RMDO_TABLES = ("costs", "step_size")
 _SCENARIO = {"F", "T", "steps", "model", "policy", "algorithm", "centre", "alpha", "c",
              "residual", "seed", "kernel_point", "paper_example", "check_robustness"}
 _GRAPH = {"edgelist", "edges", "undirected"}
@@ -479,7 +488,13 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
 
     ``paper_example = true`` takes the paper's graph, states, adversaries and DoS
     attacks: a file that also gives [graph], [initial], [adversaries] or [[dos]] is
-    refused rather than half used."""
+    refused rather than half used. [costs] / [step_size] (an RMDO file) are refused,
+    not ignored: Algorithm 1 would silently run without the costs."""
+    rmdo = [f"[{k}]" for k in RMDO_TABLES if k in data]
+    if rmdo:
+        raise InputError(f"{where}: {' and '.join(rmdo)} make this an RMDO file: run it with "
+                         "`rescon rmdo` (rescon.optim.read_rmdo); `rescon simulate` runs "
+                         "Algorithm 1, which has no costs")
     _keys(data, _TOP, where)
     sc = dict(_table(data, "scenario", where))
     _keys(sc, _SCENARIO, f"{where} [scenario]")
