@@ -8,6 +8,7 @@ floats are exact — and every certificate must still check. Clouds mixing magni
 
 from __future__ import annotations
 
+import math
 import sys
 from fractions import Fraction
 
@@ -192,6 +193,15 @@ def test_facet_beyond_the_float_range_is_an_input_error():
          [1.641828548899451e+308, 9.671762013930054e+307, 1.2712555719317322e+308],
          [-7.53386258035707e+306, 1.0605146072666493e+308, 1.479140203799131e+308]]
     with pytest.raises(rescon.errors.InputError, match="^X: a facet of the safe kernel"):
+        rescon.safe_kernel(X, 1)
+
+
+def test_flat_kernel_whose_hull_is_beyond_the_float_range():
+    """Collinear points on x + y = 3·2^1023 (every coordinate finite): the line's
+    distance from the origin exceeds 1.8e308, so (Aeq, beq) cannot be floats —
+    InputError (beq was inf, silently)."""
+    X = [[math.ldexp(a, 1023), math.ldexp(3 - a, 1023)] for a in (1.75, 1.5, 1.25, 1.625)]
+    with pytest.raises(rescon.errors.InputError, match="^X: the affine hull"):
         rescon.safe_kernel(X, 1)
 
 

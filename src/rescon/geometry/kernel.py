@@ -252,13 +252,20 @@ def _unit_rows(rows: list[tuple[tuple[Fraction, ...], Fraction]], d: int
             for a, bb in rows for top in (max(map(abs, a)),)]
     A = np.array([[float(v) for v in a] for a, _ in rows])
     norm = np.linalg.norm(A, axis=1)
+    return A / norm[:, None], _unit_offsets([bb for _, bb in rows], norm, "a facet")
+
+
+def _unit_offsets(offsets: list[Fraction], norms: np.ndarray, what: str) -> np.ndarray:
+    """b / ‖a‖ for exact offsets b and the float norms of their rows, each rounded once
+    from the exact quotient: it overflows only when the plane's distance from the
+    origin does, and then no float row can state it — InputError naming ``what``."""
     try:
-        b = np.array([float(bb / Fraction(float(nv))) for (_, bb), nv in zip(rows, norm)])
+        return np.array([float(b / Fraction(float(nv))) for b, nv in zip(offsets, norms)],
+                        dtype=np.float64)
     except OverflowError:
-        raise InputError("X: a facet of the safe kernel lies farther than 1.8e308 from the "
-                         "origin, so its float row (A, b) cannot be represented; translate "
-                         "X towards the origin") from None
-    return A / norm[:, None], b
+        raise InputError(f"X: {what} of the safe kernel lies farther than 1.8e308 from the "
+                         "origin, so its float row cannot be represented; translate X "
+                         "towards the origin") from None
 
 
 def safe_kernel(X: Any, F: Any) -> SafeKernel:
@@ -419,8 +426,10 @@ def _affine_of(verts, d: int, full: bool):
                        for row in ns)
     if ns:
         Aeq = _direction_floats(ns)
-        Aeq /= np.linalg.norm(Aeq, axis=1)[:, None]
-        beq = Aeq @ origin
+        norms = np.linalg.norm(Aeq, axis=1)
+        Aeq /= norms[:, None]
+        beq = _unit_offsets([b / max(map(abs, a)) for a, b in kernel_eqs], norms,
+                            "the affine hull")
     else:
         Aeq, beq = np.zeros((0, d)), np.zeros(0)
     return dim, origin, basis, Aeq, beq, kernel_eqs
