@@ -1,5 +1,7 @@
 """Consensus engine benchmark (BENCHMARKS.md §3): steps per second of rescon.simulate
-against the naive per-agent CVXPY loop (benchmarks/consensus_naive.py), same run.
+against the naive per-agent CVXPY loop (benchmarks/consensus_naive.py), same run; and
+long runs in R³ (issue 10 §1: they crashed as the states converged), which must finish
+with every benign state inside the benign hull.
 
     python -m benchmarks.consensus_bench [--quick] [--out benchmarks/results]
 
@@ -19,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.consensus_naive import simulate_naive
-from rescon.consensus.adversaries import FunctionOfTime
+from rescon.consensus.adversaries import Constant, FunctionOfTime
 from rescon.consensus.engine import simulate
 from rescon.consensus.scenario import Scenario
 from rescon.graphs.generators import circulant
@@ -89,6 +91,34 @@ def run(quick: bool) -> list[dict]:
             rows.append({"case": f"N={N}, d={d}, F={F}", "steps": steps, "engine_s": sec,
                          "engine_steps_per_s": eng, "naive_steps_per_s": naive,
                          "ratio": ratio, "target": target, "met": met})
+        rows.extend(long_runs(quick))
+    return rows
+
+
+#: long runs in R³ (N, F, steps, seed, adversary value or None): 5-robust ring lattices
+#: with F = 1 (no adversary, or one constant far value), and the §3 case run 80 steps
+LONG_RUNS = [(20, 1, 200, 0, None), (20, 1, 200, 1, None), (25, 1, 200, 2, None),
+             (30, 1, 200, 3, None), (20, 1, 200, 4, 1e20), (100, 2, 80, 1, None)]
+
+
+def long_runs(quick: bool) -> list[dict]:
+    """Each long run timed; met if it finished with max validity ≤ 1e-9."""
+    rows = []
+    for N, F, steps, seed, far in LONG_RUNS[:2] if quick else LONG_RUNS:
+        if N == 100:
+            sc = case(N, 3, F, steps, seed)
+        else:
+            x0 = np.random.default_rng(seed).uniform(-10, 10, size=(N, 3))
+            adv = {0: Constant([far] * 3)} if far else {}
+            sc = Scenario(graph=circulant(N, 5), x0=x0, F=F, adversaries=adv, steps=steps,
+                          residual="none", check_robustness=False)
+        sec, tr = timed(lambda sc=sc: simulate(sc))
+        validity = float(tr.metrics["validity"].max())
+        name = f"long: N={N}, d=3, F={F}, seed {seed}" + (f", adversary {far:g}" if far else "")
+        rows.append({"case": name, "steps": steps, "engine_s": sec,
+                     "engine_steps_per_s": steps / sec, "naive_steps_per_s": None,
+                     "ratio": None, "target": "finishes, validity <= 1e-9",
+                     "met": validity <= 1e-9})
     return rows
 
 
@@ -106,7 +136,9 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
               f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
               "loop checked to agree to 1e-6 before timing is reported."),
              ("- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
-              "(benchmarks/consensus_naive.py), run for 1 step."), "",
+              "(benchmarks/consensus_naive.py), run for 1 step."),
+             ("- Long runs: d = 3 as the states converge (they crashed with LinAlgError "
+              "before issue 10); met = finished with max validity <= 1e-9."), "",
              "| case | steps | engine s | engine steps/s | naive steps/s | ratio | target | met |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -11,7 +11,13 @@ tracked geometric error (returned per problem, typically ~1e-15 of the data scal
 Error bookkeeping: every float vertex v carries e_v ≥ ‖v − v_exact‖_∞. A value
 a·v − c (a, c from the data, with their own rounding bounds) is decided when its
 magnitude exceeds |a|_1 e_v + its rounding bound; an intersection of an edge with a
-line inherits a bound from its endpoints and from the error of the parameter t.
+line inherits a bound from its endpoints and from the error of the parameter t. The
+mean is the exact sum rounded (2 ulps of itself); the nearest feature is certified
+(a vertex by its normal cone, an edge's interior by the mean lying outside its line
+and between its ends, the point then computed on the edge's own data line). A
+converged cluster — m − F points in a box a few ulps wide — is answered by one of its
+points (Ψ lies in that box) before any of this. Callers use an answer only if its
+bound is at most ACCEPT_REL of its magnitude.
 """
 
 from __future__ import annotations

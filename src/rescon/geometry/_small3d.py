@@ -34,6 +34,9 @@ certified by :func:`_certify`, with rigorous rounding bounds throughout:
   nonempty), so no other check is needed;
 * the point is accepted if its bound is at most ACCEPT_REL of its magnitude; anything
   undecided, singular or non-finite is declined (the exact path computes it).
+
+Before all this, a converged cluster — m − F points in a box a few ulps wide — is
+answered by one of its points (:func:`._small2d.cluster_box`: Ψ lies in that box).
 """
 
 from __future__ import annotations
@@ -321,8 +324,8 @@ def _project(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
     offsets = np.empty((B, H))
     count = np.zeros(B, dtype=np.int64)
     status = np.empty(B, dtype=np.int64)
-    origin = np.empty((B, 3))
-    scale = np.empty(B)
+    origin = np.zeros((B, 3))  # (left 0 for declined sets)
+    scale = np.zeros(B)
     planes = _planes(B, H)
     halfspaces_3d(Zs, F, normals, offsets, count, status, origin, scale, planes)
     out = np.zeros((B, 3))
