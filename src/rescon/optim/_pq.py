@@ -1,0 +1,412 @@
+"""Exact argmin sets of piecewise-quadratic convex costs (used by check_redundancy).
+
+A cost is *piecewise quadratic* (PQ) here when it is, exactly in rationals,
+
+    F(x) = ½ xᵀHx + gᵀx + Σ_k max_{j ∈ J_k} (a_kjᵀx + b_kj) + Σ_l ‖A_l x − c_l‖₂,  H ⪰ 0,
+
+up to a constant (constants never matter: only argmins and differences of values are
+used). Quadratic / Affine atoms give H and g; |aᵀx − b|, hinge, ‖Ax − b‖₁ (one block per
+row), ‖Ax − b‖∞, max of affine functions and MaxOf of polyhedral terms (expanded) give
+the blocks k; ‖Ax − c‖₂ gives a norm term l; sums and nonnegative scalings add and scale.
+Values are computed exactly only without norm terms (a norm of rationals is irrational).
+
+**Optimality certificate.** A point x̄ and multipliers λ_kj ≥ 0 with Σ_j λ_kj = 1 for
+every block, stationarity  Hx̄ + g + Σ λ_kj a_kj = 0  and complementary slackness
+(λ_kj > 0 ⇒ piece j attains the block's max at x̄); for each norm term, A_l x̄ = c_l
+exactly and a multiplier μ_l with μ_lᵀμ_l ≤ 1, and stationarity
+Hx̄ + g + Σ λ_kj a_kj + Σ A_lᵀμ_l = 0. Then for every y, by convexity of the quadratic
+part, max ≥ any convex combination and ‖v‖ ≥ μᵀv (Cauchy–Schwarz),
+
+    F(y) ≥ q(x̄) + ∇q(x̄)ᵀ(y − x̄) + Σ λ_kj (a_kjᵀy + b_kj) + Σ μ_lᵀ(A_l y − c_l) = F(x̄),
+
+with equality iff H(y − x̄) = 0 (for H ⪰ 0, (y−x̄)ᵀH(y−x̄) = 0 ⇔ H(y−x̄) = 0), the same
+complementary slackness holds at y, and ‖A_l y − c_l‖ = μ_lᵀ(A_l y − c_l) — which for
+μ_lᵀμ_l < 1 means A_l y = c_l. Hence, exactly,
+
+    argmin F = { y : H y = H x̄,  a_kjᵀy + b_kj ≥ a_kj'ᵀy + b_kj'  (λ_kj > 0, all j'),
+                 A_l y = c_l (μ_lᵀμ_l < 1),  ‖A_l y − c_l‖ = μ_lᵀ(A_l y − c_l) (else) }.
+
+It is the affine set E = {y : M(y − x̄) = 0}, M = the rows of H, the differences
+a_kj − a_kj₀ of the pieces in the support of λ_k and the rows of A_l with μ_lᵀμ_l < 1,
+whenever every remaining inequality's normal a_kj' − a_kj₀ lies in the row space of M
+(then it is constant on E) and no μ_l has norm 1; or when rank M = d (a single point). Two such affine sets are equal iff the reduced row
+echelon forms of their M agree and each contains the other's point.
+
+**Unboundedness certificate.** A direction v with Hv = 0 and gᵀv + Σ_k max_j a_kjᵀv < 0:
+F(x + tv) decreases without bound in t.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..geometry.exact import _rref, nullspace_exact, solve_exact
+from . import atoms
+
+Piece = tuple[tuple[Fraction, ...], Fraction]  # (a, b): a·x + b
+MAX_PIECES = 256  # a MaxOf expanded beyond this many pieces is not treated as PQ
+_FREE_DEN = 10**6  # free coordinates of a rounded solution: denominators up to this
+
+
+@dataclass
+class PQ:
+    """½xᵀHx + gᵀx + Σ_k max_j (a_kjᵀx + b_kj), exact (Fractions)."""
+
+    H: list[list[Fraction]]
+    g: list[Fraction]
+    blocks: list[list[Piece]] = field(default_factory=list)
+    norms: list[tuple[list[tuple[Fraction, ...]], list[Fraction]]] = field(default_factory=list)
+
+    @classmethod
+    def zero(cls, d: int) -> PQ:
+        return cls([[Fraction(0)] * d for _ in range(d)], [Fraction(0)] * d, [], [])
+
+    @property
+    def d(self) -> int:
+        return len(self.g)
+
+    def add(self, other: PQ) -> None:
+        for i, row in enumerate(other.H):
+            self.g[i] += other.g[i]
+            for j, v in enumerate(row):
+                self.H[i][j] += v
+        self.blocks.extend(other.blocks)
+        self.norms.extend(other.norms)
+
+    def value(self, x: list[Fraction]) -> Fraction:
+        """F(x) exactly, up to the constant (only without norm terms)."""
+        assert not self.norms, "a norm term has no exact value"
+        quad = sum((xi * _dot(row, x) for xi, row in zip(x, self.H, strict=True)), Fraction(0))
+        return quad / 2 + _dot(self.g, x) + sum((max(_dot(a, x) + b for a, b in blk)
+                                                 for blk in self.blocks), Fraction(0))
+
+    def float_data(self) -> dict[str, Any]:
+        """H, g, pieces A, b with their block index, and per norm term (A_l, c_l), as
+        float arrays."""
+        pieces = [(k, a, b) for k, blk in enumerate(self.blocks) for a, b in blk]
+        return {"H": np.array(self.H, dtype=float), "g": np.array(self.g, dtype=float),
+                "A": np.array([[float(v) for v in a] for _, a, _ in pieces]).reshape(-1, self.d),
+                "b": np.array([float(b) for _, _, b in pieces]),
+                "block": np.array([k for k, _, _ in pieces], dtype=int),
+                "norms": [(np.array(A, dtype=float), np.array(c, dtype=float))
+                          for A, c in self.norms]}
+
+
+def _dot(a: Any, x: Any) -> Fraction:
+    return sum((u * v for u, v in zip(a, x, strict=True)), Fraction(0))
+
+
+# --------------------------------------------------------------------------- #
+# atoms -> PQ
+# --------------------------------------------------------------------------- #
+
+
+def of_oracle(o: Any, d: int) -> PQ | None:
+    """The exact PQ form of an atom tree, or None when some term is not PQ (Norm2, Huber,
+    log-sum-exp, non-atom oracles, a MaxOf of quadratics or of too many pieces)."""
+    F = PQ.zero(d)
+    return F if _add(o, Fraction(1), F) else None
+
+
+def _add(o: Any, w: Fraction, F: PQ) -> bool:
+    """F += w·o; False when o is not PQ."""
+    if isinstance(o, atoms.Quadratic):
+        Q, c, q = o.exact["Q"], o.exact["c"], o.exact["q"]
+        for i, row in enumerate(Q):
+            F.g[i] += w * (q[i] - _dot(row, c))
+            for j, v in enumerate(row):
+                F.H[i][j] += w * v
+        return True
+    if isinstance(o, atoms.Affine):
+        F.g[:] = [gi + w * ai for gi, ai in zip(F.g, o.exact["a"], strict=True)]
+        return True
+    if isinstance(o, atoms.Scaled):
+        return _add(o.term, w * o.exact["coef"], F)
+    if isinstance(o, atoms.Sum):
+        return all(_add(t, w, F) for t in o.terms)
+    if isinstance(o, atoms.Norm2):
+        if w:
+            F.norms.append(([tuple(w * v for v in a) for a in o.exact["A"]],
+                            [w * v for v in o.exact["b"]]))
+        return True
+    blocks = _blocks(o, F.d)
+    if blocks is None:
+        return False
+    if w:
+        F.blocks.extend([[(tuple(w * v for v in a), w * b) for a, b in blk] for blk in blocks])
+    return True
+
+
+def _blocks(o: Any, d: int) -> list[list[Piece]] | None:
+    """The blocks of a polyhedral atom (each a list of affine pieces), or None."""
+    if isinstance(o, atoms.MaxOf):
+        return _max_of(o, d)
+    if not isinstance(o, (atoms.AbsAffine, atoms.Hinge, atoms.Norm1, atoms.NormInf,
+                          atoms.MaxAffine)):
+        return None
+    rows = [(tuple(a), b) for a, b in zip(o.exact["A"], o.exact["b"], strict=True)]
+    zero = (tuple(Fraction(0) for _ in range(d)), Fraction(0))
+    if isinstance(o, atoms.MaxAffine):
+        return [rows]
+    if isinstance(o, atoms.Hinge):
+        return [[(rows[0][0], -rows[0][1]), zero]]
+    absolute = [[(a, -b), (tuple(-v for v in a), b)] for a, b in rows]
+    if isinstance(o, atoms.NormInf):
+        return [[p for blk in absolute for p in blk]]
+    return absolute  # AbsAffine, Norm1: one block per row
+
+
+def _max_of(o: Any, d: int) -> list[list[Piece]] | None:
+    """max_t F_t with every F_t polyhedral (H = 0): one block, the union over t of the
+    pieces g_t + Σ_k a_{k,j_k} (one per choice of a piece in each of F_t's blocks)."""
+    out: list[Piece] = []
+    for t in o.terms:
+        F = of_oracle(t, d)
+        if F is None or F.norms or any(v for row in F.H for v in row):
+            return None
+        count = 1
+        for blk in F.blocks:
+            count *= len(blk)
+        if len(out) + count > MAX_PIECES:
+            return None
+        for choice in itertools.product(*F.blocks):
+            a = tuple(sum(col, gi) for gi, col in zip(F.g, zip(*(p[0] for p in choice)),
+                                                      strict=True)) if choice else tuple(F.g)
+            out.append((a, sum((p[1] for p in choice), Fraction(0))))
+    return [out]
+
+
+# --------------------------------------------------------------------------- #
+# certificates from float solutions
+# --------------------------------------------------------------------------- #
+
+Mult = list[list[Fraction]]
+
+
+@dataclass
+class Optimal:
+    """A certified minimiser: x, block multipliers lam[k][j], norm multipliers mu[l],
+    and the set they describe (module docstring)."""
+
+    x: list[Fraction]
+    lam: Mult
+    mu: Mult
+    rref: list[list[Fraction]]  # canonical basis of the row space of M
+    affine: bool  # argmin F = {y : M (y − x) = 0}
+
+    def contains(self, y: list[Fraction]) -> bool:
+        """y ∈ the affine set {M(y − x) = 0} (meaningful when ``affine``)."""
+        diff = [a - b for a, b in zip(y, self.x, strict=True)]
+        return all(_dot(row, diff) == 0 for row in self.rref)
+
+
+def check_optimal(F: PQ, x: list[Fraction], lam: Mult, mu: Mult) -> str | None:
+    """None when (x, lam, mu) is an optimality certificate for F, else what fails."""
+    if len(lam) != len(F.blocks) or any(len(lk) != len(b) for lk, b in zip(lam, F.blocks)):
+        return "multipliers do not match the blocks"
+    if len(mu) != len(F.norms) or any(len(m) != len(c) for m, (_, c) in zip(mu, F.norms)):
+        return "multipliers do not match the norm terms"
+    stat = [_dot(row, x) + gi for row, gi in zip(F.H, F.g, strict=True)]
+    for lk, blk in zip(lam, F.blocks, strict=True):
+        if any(v < 0 for v in lk) or sum(lk) != 1:
+            return "multipliers are not a probability vector on every block"
+        vals = [_dot(a, x) + b for a, b in blk]
+        top = max(vals)
+        if any(v > 0 and val != top for v, val in zip(lk, vals, strict=True)):
+            return "complementary slackness fails"
+        stat = _axpy(stat, lk, [a for a, _ in blk])
+    for m, (A, c) in zip(mu, F.norms, strict=True):
+        if _dot(m, m) > 1 or any(_dot(a, x) != ci for a, ci in zip(A, c, strict=True)):
+            return "a norm term's residual is not 0 or its multiplier is longer than 1"
+        stat = _axpy(stat, m, A)
+    return None if not any(stat) else "stationarity fails"
+
+
+def _axpy(stat: list[Fraction], coefs: list[Fraction], rows: list) -> list[Fraction]:
+    """stat + Σ_i coefs_i rows_i."""
+    for v, a in zip(coefs, rows, strict=True):
+        if v:
+            stat = [s + v * ai for s, ai in zip(stat, a, strict=True)]
+    return stat
+
+
+def describe(F: PQ, x: list[Fraction], lam: Mult, mu: Mult) -> Optimal:
+    """The argmin set certified by (x, lam, mu) (module docstring)."""
+    M = [list(row) for row in F.H if any(row)]
+    ineq = []
+    for lk, blk in zip(lam, F.blocks, strict=True):
+        supp = [j for j, v in enumerate(lk) if v]
+        a0 = blk[supp[0]][0]
+        M += [[u - v for u, v in zip(blk[j][0], a0, strict=True)] for j in supp[1:]]
+        ineq += [[u - v for u, v in zip(blk[j][0], a0, strict=True)]
+                 for j in range(len(blk)) if j not in supp]
+    tight = False
+    for m, (A, _) in zip(mu, F.norms, strict=True):
+        if _dot(m, m) < 1:
+            M += [list(a) for a in A]
+        else:
+            tight = True
+    piv = _rref(M, F.d) if M else []
+    R = M[:len(piv)]
+    affine = len(piv) == F.d or (not tight and all(_in_rowspace(v, R, piv) for v in ineq))
+    return Optimal(x, lam, mu, R, affine)
+
+
+def _in_rowspace(v: list[Fraction], R: list[list[Fraction]], piv: list[int]) -> bool:
+    w = list(v)
+    for row, p in zip(R, piv, strict=True):
+        if w[p]:
+            f = w[p]
+            w = [a - f * b for a, b in zip(w, row, strict=True)]
+    return not any(w)
+
+
+def rational(v: float) -> Fraction:
+    """A short rational near the float v (a guess; every use is verified exactly)."""
+    return Fraction(float(v)).limit_denominator(_FREE_DEN)
+
+
+def certify(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], muf: list[np.ndarray]
+            ) -> Optimal | None:
+    """An exact optimality certificate near the float solution, or None.
+
+    The support S_k of each block's multipliers is guessed from the floats (large
+    multipliers, then all pieces active to 1e-6); norm terms must have a zero residual
+    there. The linear system in (x, λ_S, μ) — equal values of the pieces in S_k,
+    A_l x = c_l, stationarity, Σ_j λ_kj = 1 — is solved exactly with its free unknowns
+    set to short rationals near the floats, or else projected exactly (least squares)
+    from those rationals onto the solution set, which keeps the interior-point
+    multipliers positive; the result is kept only when :func:`check_optimal` accepts it."""
+    for guess in ("support", "active"):
+        S = _support(F, xf, lamf, guess)
+        for project in (False, True):
+            sol = _solve_system(F, S, xf, lamf, muf, project)
+            if sol is not None and check_optimal(F, *sol) is None:
+                return describe(F, *sol)
+    return None
+
+
+def _support(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], guess: str) -> list[list[int]]:
+    out = []
+    for blk, lk in zip(F.blocks, lamf, strict=True):
+        if guess == "support":
+            s = [j for j, v in enumerate(lk) if v > 1e-6 * max(lk.max(), 1e-300)]
+        else:
+            vals = np.array([sum(float(u) * xi for u, xi in zip(a, xf)) + float(b)
+                             for a, b in blk])
+            s = [int(j) for j in np.flatnonzero(vals >= vals.max() - 1e-6 * (1 + abs(vals).max()))]
+        out.append(s or [int(np.argmax(lk))])
+    return out
+
+
+def _solve_system(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray],
+                  muf: list[np.ndarray], project: bool
+                  ) -> tuple[list[Fraction], Mult, Mult] | None:
+    """Solve for (x, λ on the multi-piece supports, μ) exactly, free unknowns near the
+    floats (module docstring of :func:`certify`)."""
+    d = F.d
+    multi = [(k, j) for k, s in enumerate(S) if len(s) > 1 for j in s]
+    nmu = [len(c) for _, c in F.norms]
+    n = d + len(multi) + sum(nmu)
+    zeros = [Fraction(0)] * (n - d)
+    rows: list[list[Fraction]] = []
+    rhs = list(F.g)
+    for k, s in enumerate(S):
+        if len(s) == 1:
+            rhs = [u + v for u, v in zip(rhs, F.blocks[k][s[0]][0], strict=True)]
+            continue
+        a0, b0 = F.blocks[k][s[0]]
+        for j in s[1:]:
+            a, b = F.blocks[k][j]
+            rows.append([u - v for u, v in zip(a, a0, strict=True)] + zeros + [b0 - b])
+        rows.append([Fraction(0)] * d + [Fraction(int(kj[0] == k)) for kj in multi]
+                    + [Fraction(0)] * sum(nmu) + [Fraction(1)])
+    rows += [list(a) + zeros + [ci] for A, c in F.norms for a, ci in zip(A, c, strict=True)]
+    for i in range(d):
+        rows.append(list(F.H[i]) + [F.blocks[k][j][0][i] for k, j in multi]
+                    + [a[i] for A, _ in F.norms for a in A] + [-rhs[i]])
+    guess = ([rational(v) for v in xf] + [rational(lamf[k][j]) for k, j in multi]
+             + [rational(v) for m in muf for v in m])
+    piv = _rref(rows, n)
+    if any(row[n] for row in rows[len(piv):]):
+        return None
+    z = _project(rows[:len(piv)], guess) if project else _free_near(rows, piv, guess)
+    lam = [[Fraction(0)] * len(blk) for blk in F.blocks]
+    for k, s in enumerate(S):
+        if len(s) == 1:
+            lam[k][s[0]] = Fraction(1)
+    for i, (k, j) in enumerate(multi):
+        lam[k][j] = z[d + i]
+    it = iter(z[d + len(multi):])
+    return z[:d], lam, [[next(it) for _ in range(m)] for m in nmu]
+
+
+def _free_near(rows: list[list[Fraction]], piv: list[int], guess: list[Fraction]
+               ) -> list[Fraction]:
+    """The solution of the reduced system ``rows`` (rref, right-hand side last) whose free
+    unknowns are the guesses."""
+    n = len(guess)
+    z = [Fraction(0)] * n
+    for c in set(range(n)) - set(piv):
+        z[c] = guess[c]
+    for row, p in zip(rows, piv):
+        z[p] = row[n] - sum((row[c] * z[c] for c in range(n) if c not in piv), Fraction(0))
+    return z
+
+
+def _project(R: list[list[Fraction]], guess: list[Fraction]) -> list[Fraction]:
+    """guess − Rᵀ(RRᵀ)⁻¹(R guess − rhs): the exact solution of R z = rhs (independent
+    rows, right-hand side last) nearest to ``guess``."""
+    n = len(guess)
+    res = [_dot(row[:n], guess) - row[n] for row in R]
+    if not any(res):
+        return list(guess)
+    G = [[_dot(a[:n], b[:n]) for b in R] for a in R]
+    y = solve_exact(G, res)
+    return [gc - sum((yi * row[c] for yi, row in zip(y, R)), Fraction(0))
+            for c, gc in enumerate(guess)]
+
+
+def recession(F: PQ, vf: np.ndarray) -> list[Fraction] | None:
+    """An exact unboundedness certificate near the float direction vf, or None."""
+    s = float(np.abs(vf).max(initial=0.0))
+    if not s > 0:
+        return None
+    cands = [[rational(v / s) for v in vf]]
+    if any(v for row in F.H for v in row):  # the component of v in null(H), exactly
+        null = nullspace_exact(F.H)
+        if null:
+            coef = np.linalg.lstsq(np.array(null, dtype=float).T, vf / s, rcond=None)[0]
+            cands.append([sum((rational(c) * b[i] for c, b in zip(coef, null)), Fraction(0))
+                          for i in range(F.d)])
+    return next((v for v in cands if is_recession(F, v)), None)
+
+
+def is_recession(F: PQ, v: list[Fraction]) -> bool:
+    """Hv = 0, A_l v = 0 and gᵀv + Σ_k max_j a_kjᵀv < 0: F is unbounded below along v."""
+    if any(_dot(row, v) for row in F.H) or any(_dot(a, v) for A, _ in F.norms for a in A):
+        return False
+    slope = _dot(F.g, v) + sum((max(_dot(a, v) for a, _ in blk) for blk in F.blocks),
+                               Fraction(0))
+    return slope < 0
+
+
+def quadratic_argmin(F: PQ) -> tuple[str, Any]:
+    """A PQ without blocks or norms, exactly: ("optimal", Optimal) or ("unbounded", v)."""
+    d = F.d
+    aug = [list(row) + [-gi] for row, gi in zip(F.H, F.g, strict=True)]
+    piv = _rref(aug, d)
+    if any(row[d] for row in aug[len(piv):]):
+        for b in nullspace_exact(F.H):
+            s = _dot(F.g, b)
+            if s:
+                return "unbounded", [-v if s > 0 else v for v in b]
+    x = [Fraction(0)] * d
+    for row, p in zip(aug, piv):
+        x[p] = row[d]
+    return "optimal", describe(F, x, [], [])

@@ -1,0 +1,576 @@
+"""r-redundancy of convex costs (SPEC §4): :func:`check_redundancy`.
+
+Definition: the costs f_1, …, f_N are r-redundant when every subset S of N − r agents
+has the same argmin set A_S = argmin Σ_{i∈S} f_i. If that common set is nonempty, the
+whole set's argmin A* equals it (Σ_all f_i is a positive multiple of Σ_S Σ_{i∈S} f_i, a
+sum of functions sharing the minimisers A), so
+
+    r-redundant  ⇔  every A_S is empty, or every A_S equals A* ≠ ∅,
+
+decided with C(N, r) comparisons against the one reference A*. A refutation needs an
+(N − r)-subset S1 with a minimiser x1 and a set S2 (another (N − r)-subset or all
+agents) with x1 ∉ A_S2 (x1 ∈ A_S1 ≠ ∅ would force A_S2 = A_S1 under redundancy).
+
+Exact verdicts (``exact=True``, with a certificate ``rescon check`` verifies) when the
+sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functions,
+|aᵀx − b|, hinge, ‖·‖₁, ‖·‖∞ of affine maps, max of affine functions, sums, scalings):
+
+* each A_S is computed by Clarabel and then *certified* in rationals (a minimiser and
+  multipliers, or a recession direction when the sum is unbounded below);
+* x ∉ A_S2 is proved by exact evaluation: F_S2(y) < F_S2(x) for a certified y ∈ A_S2,
+  or F_S2 unbounded below;
+* equality is proved when the certified argmins are affine sets (single points, or
+  affine subspaces as for quadratics): same reduced row echelon form and a common point.
+
+Everything else is numerical (``exact=False``): support functions h_A(u) = max_{x∈A} uᵀx
+in the fixed directions ±e_i and ±u_j (j < d, u_j seeded Gaussian unit vectors, seed 0),
+from Clarabel via CVXPY (min F_S, then max uᵀx on {F_S ≤ F_S* + 1e-8(1 + |F_S*|)}) or,
+for certified polyhedral argmins, from HiGHS on their exact description; sets agree
+when every support differs by at most ``tolerance`` = 1e-4 (1 + the largest |h|). The
+``gap`` is then max |h_S(u) − h*(u)| over those directions — a lower bound on the
+Hausdorff distance (exact for single points and affine sets).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Hashable, Mapping
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from .. import _validate
+from ..errors import InputError, SolverError
+from ..geometry.exact import fraction_str
+from . import _pq
+from .cost import cost
+
+__all__ = ["RedundancyReport", "check_redundancy"]
+
+REL_TOL = 1e-4  # numerical verdicts: supports agree to REL_TOL (1 + max |h|)
+LEVEL_TOL = 1e-8  # numerical supports: on {F ≤ F* + LEVEL_TOL (1 + |F*|)}
+MAX_PAIRS = 5_000  # pairs of certified subsets tried for an exact witness
+
+
+@dataclass(frozen=True)
+class RedundancyReport:
+    """The answer of :func:`check_redundancy`.
+
+    Attributes
+    ----------
+    holds : whether every (N − r)-subset has the same argmin set
+    exact : whether the verdict is proven in exact arithmetic (its certificate is then
+        verified by ``rescon check``); False: a numerical verdict within ``tolerance``
+    witness : for a violation, JSON-ready: ``subsets`` [S1, S2] (agent labels; S2 may be
+        all agents), ``direction`` u, ``support`` [value for S1, value for S2],
+        ``points`` [x1, x2] attaining them (x2 None when S2's sum is unbounded below),
+        ``exact``, ``reason``. For exact witnesses u = x1 − x2 and the values are uᵀx1,
+        uᵀx2 (the support values when both argmins are single points); for numerical
+        ones, the support values in the direction where they differ most. None if holds.
+    gap : the largest distance found between a subset's argmin and the whole set's
+        (inf when exactly one of them is empty): the ε of (r, ε)-redundancy
+    unbounded : the (N − r)-subsets whose sum has no minimiser (tuples of labels)
+    unbounded_agents : the agents whose cost alone has no minimiser
+    tolerance : of a numerical verdict (None when exact)
+    certificate : JSON-ready (kinds ``redundancy_violation``, ``redundancy_holds``,
+        ``redundancy_numerical``; see certificates/FORMAT.md)
+    """
+
+    holds: bool
+    exact: bool
+    witness: dict[str, Any] | None
+    gap: float
+    unbounded: tuple[tuple[Hashable, ...], ...]
+    unbounded_agents: tuple[Hashable, ...]
+    tolerance: float | None
+    certificate: dict[str, Any] = field(repr=False)
+
+
+def check_redundancy(costs: Any, r: int, *, d: int | None = None) -> RedundancyReport:
+    """Decide whether ``costs`` are r-redundant (every N − r of them share their argmin).
+
+    Parameters
+    ----------
+    costs : mapping agent label → cost (anything :func:`rescon.cost` accepts that is an
+        atom tree: an expression string, atoms, a lowered CVXPY expression), or a
+        sequence (labels 0, 1, …)
+    r : 0 ≤ r < N, the number of agents left out
+    d : the dimension (default: the costs')
+
+    Raises
+    ------
+    InputError
+        r ≥ N, a cost of another dimension (naming the agent), a cost that is neither
+        piecewise quadratic nor convertible to CVXPY (callables, CasADi).
+
+    Examples
+    --------
+    >>> rep = check_redundancy(["(x1 - 1)^2", "(x1 + 1)^2", "2*abs(x1)"], r=1)
+    >>> rep.holds, rep.exact, rep.gap
+    (True, True, 0.0)
+    """
+    labels, oracles, d = _costs(costs, d)
+    N = len(labels)
+    r = _validate.integer("r", r, low=0)
+    if r >= N:
+        raise InputError(f"r must be an integer < N = {N} (the number of costs); got {r}")
+    return _Check(labels, oracles, d, r).run()
+
+
+def _costs(costs: Any, d: int | None) -> tuple[list[Hashable], list[Any], int]:
+    if isinstance(costs, Mapping):
+        items = list(costs.items())
+    elif isinstance(costs, (list, tuple)):
+        items = list(enumerate(costs))
+    else:
+        raise InputError(f"costs must be a mapping agent → cost or a list; got "
+                         f"{type(costs).__name__}")
+    if not items:
+        raise InputError("costs must hold at least one cost; got none")
+    if d is not None:
+        d = _validate.integer("d", d, low=1)
+    out = []
+    for label, spec in items:
+        o = cost(spec, d=d, name=f"cost of agent {label}")
+        if o.d is None:
+            raise InputError(f"cost of agent {label}: its dimension is unknown (give d)")
+        if d is None:
+            d = o.d
+        elif o.d != d:
+            raise InputError(f"cost of agent {label}: dimension {o.d}, not d = {d}")
+        out.append(o)
+    return [k for k, _ in items], out, d
+
+
+# --------------------------------------------------------------------------- #
+# one argmin set
+# --------------------------------------------------------------------------- #
+
+
+@dataclass
+class _Set:
+    """A_S for the agents ``members`` (indices): ``status`` "optimal" / "unbounded" /
+    "unknown"; exact data when certified; float point; supports computed on demand."""
+
+    members: tuple[int, ...]
+    F: _pq.PQ | None
+    status: str = "unknown"
+    opt: _pq.Optimal | None = None
+    ray: list[Fraction] | None = None
+    point: np.ndarray | None = None
+    supports: dict[int, tuple[float, np.ndarray | None]] = field(default_factory=dict)
+
+    @property
+    def certified(self) -> bool:
+        return self.opt is not None or self.ray is not None
+
+
+class _Check:
+    def __init__(self, labels: list[Hashable], oracles: list[Any], d: int, r: int) -> None:
+        self.labels, self.oracles, self.d, self.r = labels, oracles, d, r
+        self.pq = [_pq.of_oracle(o, d) for o in oracles]
+        self.dirs = _directions(d)
+        self._cvx: _Cvx | None = None
+
+    # -- computing argmin sets ------------------------------------------------ #
+
+    def argmin(self, members: tuple[int, ...]) -> _Set:
+        F = self._sum(members)
+        s = _Set(members, F)
+        if F is not None:
+            self._exact(s)
+        if s.status == "unknown":
+            s.status, s.point = self.cvx.minimise(members)
+        return s
+
+    def _sum(self, members: tuple[int, ...]) -> _pq.PQ | None:
+        if any(self.pq[i] is None for i in members):
+            return None
+        F = _pq.PQ.zero(self.d)
+        for i in members:
+            F.add(self.pq[i])
+        return F
+
+    def _exact(self, s: _Set) -> None:
+        F = s.F
+        if not F.blocks and not F.norms:
+            s.status, data = _pq.quadratic_argmin(F)
+            s.opt, s.ray = (data, None) if s.status == "optimal" else (None, data)
+        else:
+            status, data = _clarabel(F)
+            if status == "optimal":
+                s.opt = _pq.certify(F, *data)
+                if s.opt is not None and F.norms and not s.opt.affine:
+                    s.opt = None  # a norm term with |μ| = 1: not described by linear data
+                s.status, s.point = "optimal", data[0]
+            elif status == "unbounded":
+                s.ray = _pq.recession(F, data)
+                s.status = "unbounded"
+        if s.opt is None and s.ray is None:
+            s.status = "unknown"
+        elif s.opt is not None:
+            s.point = np.array([float(v) for v in s.opt.x])
+
+    @property
+    def cvx(self) -> _Cvx:
+        if self._cvx is None:
+            self._cvx = _Cvx(self.oracles, self.d)
+        return self._cvx
+
+    def support(self, s: _Set, k: int) -> tuple[float, np.ndarray | None]:
+        """h_{A_S}(u_k) and a point attaining it (inf, None: unbounded in u_k)."""
+        if k not in s.supports:
+            if s.opt is not None:
+                s.supports[k] = _poly_support(s.F, s.opt, self.dirs[k])
+            else:
+                s.supports[k] = self.cvx.support(s.members, self.dirs[k])
+        return s.supports[k]
+
+    # -- the decision ---------------------------------------------------------- #
+
+    def run(self) -> RedundancyReport:
+        N = len(self.labels)
+        ref = self.argmin(tuple(range(N)))
+        subs = [self.argmin(m) for m in itertools.combinations(range(N), N - self.r)]
+        alone = [self.argmin((i,)) for i in range(N)]
+        unbounded = tuple(tuple(self.labels[i] for i in s.members) for s in subs
+                          if s.status == "unbounded")
+        nonempty = [s for s in subs if s.status != "unbounded"]
+        gaps = [0.0 if s.status == "unbounded" and ref.status == "unbounded"
+                else math.inf if "unbounded" in (s.status, ref.status)
+                else self.gap(s, ref) for s in subs]
+        gap = max(gaps, default=0.0) if nonempty else 0.0
+        wit = self.exact_witness(subs, ref)
+        if wit is not None:
+            return self.report(False, True, wit, gap, unbounded, alone)
+        all_exact = all(s.certified for s in subs) and (ref.certified or not nonempty)
+        if all_exact and (not nonempty or all(self.equal(s, ref) for s in subs)):
+            return self.report(True, True, None, gap, unbounded, alone, subs=subs)
+        tol = self.tolerance(subs + [ref])
+        holds = not nonempty or gap <= tol
+        wit = None if holds else self.numerical_witness(subs, ref, gaps)
+        return self.report(holds, False, wit, gap, unbounded, alone, tol=tol)
+
+    def equal(self, s: _Set, ref: _Set) -> bool:
+        """A_S = A*, exactly (both certified affine sets, or both empty)."""
+        if s.status == "unbounded" or ref.status == "unbounded":
+            return s.status == ref.status
+        a, b = s.opt, ref.opt
+        return a.affine and b.affine and a.rref == b.rref and b.contains(a.x)
+
+    def gap(self, s: _Set, ref: _Set) -> float:
+        """Hausdorff distance of two nonempty argmins: exact formula for affine sets,
+        else the largest support difference over the directions."""
+        a, b = s.opt, ref.opt
+        if a is not None and b is not None and a.affine and b.affine:
+            if a.rref != b.rref:
+                return math.inf
+            if not a.rref:
+                return 0.0
+            R = np.array(a.rref, dtype=float)  # distance of parallel affine sets
+            diff = np.array([float(u - v) for u, v in zip(a.x, b.x, strict=True)])
+            return float(np.linalg.norm(R.T @ np.linalg.lstsq(R.T, diff, rcond=None)[0]))
+        return max(abs(self.support(s, k)[0] - self.support(ref, k)[0])
+                   if math.isfinite(self.support(s, k)[0] + self.support(ref, k)[0])
+                   else (0.0 if self.support(s, k)[0] == self.support(ref, k)[0] else math.inf)
+                   for k in range(len(self.dirs)))
+
+    def tolerance(self, sets: list[_Set]) -> float:
+        vals = [abs(h) for s in sets for h, _ in s.supports.values() if math.isfinite(h)]
+        vals += [float(np.abs(s.point).max()) for s in sets if s.point is not None]
+        return REL_TOL * (1.0 + max(vals, default=0.0))
+
+    # -- witnesses --------------------------------------------------------------- #
+
+    def exact_witness(self, subs: list[_Set], ref: _Set) -> dict[str, Any] | None:
+        """A certified S1 (minimiser x1) and S2 (a subset or all) with x1 ∉ A_S2."""
+        opts = [s for s in subs if s.opt is not None]
+        others = [ref] + subs if ref.certified else subs
+        tried = 0
+        for s1 in opts:
+            for s2 in others:
+                if s2 is s1:
+                    continue
+                w = _separation(s1, s2)
+                if w is not None:
+                    return w
+                tried += 1
+                if tried >= MAX_PAIRS:
+                    return None
+        return None
+
+    def numerical_witness(self, subs: list[_Set], ref: _Set, gaps: list[float]
+                          ) -> dict[str, Any]:
+        s = subs[int(np.argmax(gaps))]
+        if "unbounded" in (s.status, ref.status):
+            return {"subsets": [s.members, ref.members], "direction": None,
+                    "support": None, "points": [_pt(s.point), _pt(ref.point)],
+                    "exact": False, "reason": "one of the two sums is unbounded below"}
+        diffs = [abs(self.support(s, k)[0] - self.support(ref, k)[0]) for k in range(len(self.dirs))]
+        k = int(np.nanargmax(np.nan_to_num(diffs, nan=math.inf)))
+        (h1, p1), (h2, p2) = self.support(s, k), self.support(ref, k)
+        return {"subsets": [s.members, ref.members], "direction": self.dirs[k].tolist(),
+                "support": [h1, h2], "points": [_pt(p1), _pt(p2)], "exact": False,
+                "reason": "support functions differ beyond the tolerance"}
+
+    # -- output ----------------------------------------------------------------- #
+
+    def report(self, holds: bool, exact: bool, wit: dict | None, gap: float,
+               unbounded: tuple, alone: list[_Set], *, subs: list[_Set] | None = None,
+               tol: float | None = None) -> RedundancyReport:
+        if exact and not holds:
+            cert = self.violation_certificate(wit)
+        elif exact:
+            cert = self.holds_certificate(subs)
+        else:
+            cert = self.numerical_certificate(holds, gap, tol)
+        if wit is not None:
+            wit = dict(wit, subsets=[[self.labels[i] for i in m] for m in wit["subsets"]])
+            wit.pop("_proof", None)
+        return RedundancyReport(
+            holds, exact, wit, gap, unbounded,
+            tuple(self.labels[s.members[0]] for s in alone if s.status == "unbounded"),
+            tol, cert)
+
+    def _head(self, kind: str) -> dict[str, Any]:
+        return {"rescon_certificate": 1, "kind": kind, "d": self.d, "r": self.r,
+                "agents": [_label(x) for x in self.labels]}
+
+    def _costs_json(self) -> list[dict[str, Any]]:
+        return [{"H": [[fraction_str(v) for v in row] for row in F.H],
+                 "g": [fraction_str(v) for v in F.g],
+                 "blocks": [[[fraction_str(v) for v in (*a, b)] for a, b in blk]
+                            for blk in F.blocks],
+                 "norms": [[[fraction_str(v) for v in (*a, ci)] for a, ci in zip(A, c)]
+                           for A, c in F.norms]} for F in self.pq]
+
+    def violation_certificate(self, wit: dict[str, Any]) -> dict[str, Any]:
+        s1, s2, proof = wit["_proof"]
+        c = self._head("redundancy_violation")
+        c["costs"] = self._costs_json()
+        w: dict[str, Any] = {"S1": list(s1.members), "S2": list(s2.members),
+                             "x1": _opt_json(s1.opt)}
+        if proof == "unbounded":
+            w["unbounded"] = [fraction_str(v) for v in s2.ray]
+        else:
+            w["better"] = [fraction_str(v) for v in proof]
+        c["witness"] = w
+        return c
+
+    def holds_certificate(self, subs: list[_Set]) -> dict[str, Any]:
+        c = self._head("redundancy_holds")
+        c["costs"] = self._costs_json()
+        c["subsets"] = [{"agents": list(s.members), **(
+            {"unbounded": [fraction_str(v) for v in s.ray]} if s.ray is not None
+            else {"x": _opt_json(s.opt)})} for s in subs]
+        return c
+
+    def numerical_certificate(self, holds: bool, gap: float, tol: float) -> dict[str, Any]:
+        c = self._head("redundancy_numerical")
+        c.update(holds=holds, gap=gap if math.isfinite(gap) else None, tolerance=tol,
+                 directions=[u.tolist() for u in self.dirs],
+                 trusted="numerical support functions (Clarabel/HiGHS floats): the verdict "
+                         "is not proven")
+        return c
+
+
+def _separation(s1: _Set, s2: _Set) -> dict[str, Any] | None:
+    """x1 = s1's certified minimiser ∉ A_S2: S2 certified unbounded, or a certified y
+    (s2's minimiser) with F_S2(y) < F_S2(x1), checked exactly."""
+    x1 = s1.opt.x
+    if s2.ray is not None and not s2.F.norms:
+        proof: Any = "unbounded"
+        u, vals, pts = s2.ray, [_dot_f(s2.ray, x1), None], [x1, None]
+    elif s2.opt is not None and not s2.F.norms and s2.F.value(s2.opt.x) < s2.F.value(x1):
+        proof = s2.opt.x
+        u = [a - b for a, b in zip(x1, proof, strict=True)]
+        vals, pts = [_dot_f(u, x1), _dot_f(u, proof)], [x1, proof]
+    else:
+        return None
+    return {"subsets": [s1.members, s2.members], "direction": [float(v) for v in u],
+            "support": vals, "points": [None if p is None else [float(v) for v in p] for p in pts],
+            "exact": True, "reason": ("the second sum is unbounded below" if proof == "unbounded"
+                                      else "x1 minimises the first sum but not the second"),
+            "_proof": (s1, s2, proof)}
+
+
+def _dot_f(u: list[Fraction], x: list[Fraction]) -> float:
+    return float(sum((a * b for a, b in zip(u, x, strict=True)), Fraction(0)))
+
+
+def _pt(p: np.ndarray | None) -> list[float] | None:
+    return None if p is None else [float(v) for v in p]
+
+
+def _label(x: Hashable) -> Any:
+    return x if isinstance(x, (int, str)) and not isinstance(x, bool) else str(x)
+
+
+def _opt_json(opt: _pq.Optimal) -> dict[str, Any]:
+    return {"x": [fraction_str(v) for v in opt.x],
+            "lambda": [[fraction_str(v) for v in lk] for lk in opt.lam],
+            "mu": [[fraction_str(v) for v in m] for m in opt.mu]}
+
+
+def _directions(d: int) -> list[np.ndarray]:
+    """±e_i and ±u_j (j < d; u_j Gaussian, seed 0, normalised): 4d directions."""
+    U = np.random.default_rng(0).standard_normal((d, d))
+    U /= np.linalg.norm(U, axis=1, keepdims=True)
+    base = list(np.eye(d)) + list(U)
+    return [s * u for u in base for s in (1.0, -1.0)]
+
+
+# --------------------------------------------------------------------------- #
+# numerical solvers
+# --------------------------------------------------------------------------- #
+
+
+def _clarabel(F: _pq.PQ) -> tuple[str, Any]:
+    """min ½xᵀHx + gᵀx + Σ t_k + Σ s_l s.t. a_kjᵀx + b_kj ≤ t_k, ‖A_l x − c_l‖ ≤ s_l, by
+    Clarabel: ("optimal", (x, λ per block, μ per norm term)), ("unbounded", direction)
+    or ("failed", status). Clarabel's duals z satisfy Px + q + Aᵀz = 0, so λ = z on the
+    pieces and μ = −(z on a norm cone's residual rows)."""
+    import clarabel
+    import scipy.sparse as sp
+
+    f = F.float_data()
+    d, K, L, m = F.d, len(F.blocks), len(F.norms), len(f["b"])
+    n = d + K + L
+    P = sp.triu(sp.block_diag([sp.csc_matrix(f["H"]), sp.csc_matrix((K + L, K + L))]),
+                format="csc")
+    q = np.concatenate([f["g"], np.ones(K + L)])
+    rows = [sp.hstack([sp.csc_matrix(f["A"]),
+                       sp.csc_matrix((-np.ones(m), (np.arange(m), f["block"])), shape=(m, K)),
+                       sp.csc_matrix((m, L))])]
+    rhs, cones = [-f["b"]], [clarabel.NonnegativeConeT(m)]
+    for l, (A, c) in enumerate(f["norms"]):  # (s_l, A_l x − c_l) in the second-order cone
+        top = sp.csc_matrix(([-1.0], ([0], [d + K + l])), shape=(1, n))
+        rows.append(sp.vstack([top, sp.hstack([sp.csc_matrix(-A),
+                                               sp.csc_matrix((len(c), K + L))])]))
+        rhs.append(np.concatenate([[0.0], -c]))
+        cones.append(clarabel.SecondOrderConeT(len(c) + 1))
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    res = clarabel.DefaultSolver(P, q, sp.vstack(rows, format="csc"), np.concatenate(rhs),
+                                 cones, settings).solve()
+    status = str(res.status)
+    x, z = np.array(res.x), np.array(res.z)
+    if status in ("Solved", "AlmostSolved"):
+        mus, at = [], m
+        for A, c in f["norms"]:
+            mus.append(-z[at + 1:at + 1 + len(c)])
+            at += len(c) + 1
+        return "optimal", (x[:d], [z[:m][f["block"] == k] for k in range(K)], mus)
+    if status in ("DualInfeasible", "AlmostDualInfeasible"):
+        return "unbounded", x[:d]
+    return "failed", status
+
+
+def _poly_support(F: _pq.PQ, opt: _pq.Optimal, u: np.ndarray) -> tuple[float, np.ndarray | None]:
+    """max uᵀy over the certified argmin {M(y − x̄) = 0, pieces of supp λ maximal}
+    (HiGHS, floats)."""
+    from scipy.optimize import linprog
+
+    x = np.array([float(v) for v in opt.x])
+    if opt.affine and len(opt.rref) == F.d:
+        return float(u @ x), x
+    Aub, bub = [], []
+    for lk, blk in zip(opt.lam, F.blocks, strict=True):
+        j0 = next(j for j, v in enumerate(lk) if v)
+        a0, b0 = blk[j0]
+        for j, (a, bj) in enumerate(blk):
+            if not lk[j]:
+                Aub.append([float(p - q) for p, q in zip(a, a0, strict=True)])
+                bub.append(float(b0 - bj))
+    R = np.array(opt.rref, dtype=float).reshape(-1, F.d)
+    res = linprog(-u, A_ub=np.array(Aub).reshape(-1, F.d) if Aub else None,
+                  b_ub=bub or None, A_eq=R if len(R) else None,
+                  b_eq=R @ x if len(R) else None, bounds=[(None, None)] * F.d,
+                  method="highs")
+    if res.status == 3:
+        return math.inf, None
+    if res.status != 0:
+        raise SolverError(f"HiGHS could not compute a support value: {res.message}")
+    return float(-res.fun), np.asarray(res.x)
+
+
+class _Cvx:
+    """The numerical path: Σ w_i f_i in CVXPY (w a nonnegative Parameter, so each
+    subset re-solves a compiled problem) with Clarabel."""
+
+    def __init__(self, oracles: list[Any], d: int) -> None:
+        from ..models.backends import require_backend
+
+        require_backend("cvxpy", "model")
+        import cvxpy as cp
+
+        self.cp = cp
+        self.x = cp.Variable(d)
+        self.w = cp.Parameter(len(oracles), nonneg=True)
+        F = sum(self.w[i] * _to_cvxpy(cp, o, self.x) for i, o in enumerate(oracles))
+        self.u, self.level = cp.Parameter(d), cp.Parameter()
+        self.pmin = cp.Problem(cp.Minimize(F))
+        self.psup = cp.Problem(cp.Maximize(self.u @ self.x), [F <= self.level])
+        self.fstar: dict[tuple[int, ...], float] = {}
+
+    def _weights(self, members: tuple[int, ...]) -> None:
+        w = np.zeros(self.w.size)
+        w[list(members)] = 1.0
+        self.w.value = w
+
+    def minimise(self, members: tuple[int, ...]) -> tuple[str, np.ndarray | None]:
+        self._weights(members)
+        self.pmin.solve(solver="CLARABEL")
+        if self.pmin.status in ("unbounded", "unbounded_inaccurate"):
+            return "unbounded", None
+        if self.pmin.status not in ("optimal", "optimal_inaccurate"):
+            raise SolverError(f"Clarabel could not minimise the sum of agents {members}: "
+                              f"{self.pmin.status}")
+        self.fstar[members] = float(self.pmin.value)
+        return "optimal", np.array(self.x.value, dtype=float)
+
+    def support(self, members: tuple[int, ...], u: np.ndarray) -> tuple[float, np.ndarray | None]:
+        self._weights(members)
+        f = self.fstar[members]
+        self.u.value, self.level.value = u, f + LEVEL_TOL * (1.0 + abs(f))
+        self.psup.solve(solver="CLARABEL")
+        if self.psup.status in ("unbounded", "unbounded_inaccurate"):
+            return math.inf, None
+        if self.psup.status not in ("optimal", "optimal_inaccurate"):
+            raise SolverError(f"Clarabel could not compute a support value of agents "
+                              f"{members}: {self.psup.status}")
+        return float(self.psup.value), np.array(self.x.value, dtype=float)
+
+
+def _to_cvxpy(cp: Any, o: Any, x: Any) -> Any:
+    """The CVXPY expression of an atom tree (InputError for other oracles)."""
+    from . import atoms
+
+    if isinstance(o, atoms.Sum):
+        return sum(_to_cvxpy(cp, t, x) for t in o.terms)
+    if isinstance(o, atoms.Scaled):
+        return o.coef * _to_cvxpy(cp, o.term, x)
+    if isinstance(o, atoms.MaxOf):
+        return cp.maximum(*[_to_cvxpy(cp, t, x) for t in o.terms])
+    if isinstance(o, atoms.Quadratic):
+        quad = 0.5 * cp.quad_form(x - o.c, cp.psd_wrap(o.Q)) if o.Q.any() else 0
+        return quad + o.q @ x + o.const
+    if isinstance(o, atoms.Affine):
+        return o.a @ x + o.b
+    maps = {atoms.AbsAffine: lambda r: cp.abs(r[0]), atoms.Norm1: cp.norm1,
+            atoms.Norm2: lambda r: cp.norm(r, 2), atoms.NormInf: cp.norm_inf,
+            atoms.Hinge: lambda r: cp.pos(r[0])}
+    if type(o) in maps:
+        return maps[type(o)](o.A @ x - o.b)
+    if isinstance(o, atoms.MaxAffine):
+        return cp.max(o.A @ x + o.b)
+    if isinstance(o, atoms.LogSumExp):
+        return cp.log_sum_exp(o.A @ x + o.b)
+    if isinstance(o, atoms.Huber):
+        return cp.sum(cp.huber(o.A @ x - o.b, o.M))
+    raise InputError(f"{o.name}: check_redundancy needs costs built of atoms (an expression "
+                     f"string, atoms, or a CVXPY expression lowered to atoms); got a "
+                     f"{o.kind} oracle")
