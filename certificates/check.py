@@ -1069,24 +1069,27 @@ KINDS: dict[str, Callable[[dict, _Ctx], str]] = {
 }
 
 
-def _kernel_kinds() -> dict[str, Callable[[dict, _Ctx], str]]:
-    """The safe-kernel kinds of the sibling module kernels.py (stdlib only), bound to the
-    helpers above: ``from .kernels`` inside the package, otherwise (script, or this file
-    loaded by path) kernels.py is loaded from this file's directory."""
+def _sibling(name: str) -> Any:
+    """The sibling module ``name``.py (stdlib only; its kinds are bound to the helpers
+    above by its ``install``): ``from . import name`` inside the package, otherwise
+    (script, or this file loaded by path) loaded from this file's directory."""
     if __package__:
-        from . import kernels
-    else:
-        import importlib.util
-        import os
-        path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "kernels.py")
-        spec = importlib.util.spec_from_file_location(f"{__name__}_kernels", path)
-        kernels = importlib.util.module_from_spec(spec)
-        sys.modules[spec.name] = kernels
-        spec.loader.exec_module(kernels)
-    return kernels.install(Invalid, _obj, _int, _array, _tname, unchecked=Unchecked)
+        import importlib
+        return importlib.import_module(f".{name}", __package__)
+    import importlib.util
+    import os
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), f"{name}.py")
+    spec = importlib.util.spec_from_file_location(f"{__name__}_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
-KINDS.update(_kernel_kinds())
+_kernels = _sibling("kernels")  # safe kernels
+KINDS.update(_kernels.install(Invalid, _obj, _int, _array, _tname, unchecked=Unchecked))
+KINDS.update(_sibling("redundancy").install(  # redundancy of costs
+    Invalid, _obj, _int, _array, _tname, unchecked=Unchecked, rat=_kernels._rat))
 
 
 def check(cert: Any) -> CheckResult:
