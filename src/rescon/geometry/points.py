@@ -155,54 +155,54 @@ def _vertex_guide(V: np.ndarray, m: np.ndarray) -> np.ndarray:
     return (V.T @ lam) / total if total > 0 else V.mean(axis=0)
 
 
-def _guides(K: SafeKernel, m: Vec, backend: str):
-    """Float points near the projection, best first. An explicit backend is the only
-    guide (its failure is the user's answer); "auto" tries the geometric guide (dim ≤
-    2) or Clarabel, then the vertex guide. All are solved in the unit frame."""
+def _guides(dim: int, framed, m: np.ndarray, backend: str):
+    """Float points near the projection of m, best first, all in the unit frame
+    (:func:`_frame`; ``framed``: Ψ there, :func:`_framed`). An explicit backend guides
+    first (its failure is the user's answer); "auto" tries the geometric guide (dim ≤ 2)
+    or Clarabel. The vertex guide follows either way, so a backend's inaccurate answer
+    (thin kernels, far targets) never leaves the exact search to enumerate every
+    active set (4–6 s for a thin 3-D kernel where "auto" took 0.06 s)."""
     from ..models.kernel_models import project
 
-    mf = np.array([float(v) for v in m])
-    o, e = _frame(K, mf)
-    A, b, origin, B, V = _framed(K, o, e)
-    mf = _to_frame(mf, o, e)
-    back = lambda y: _from_frame(y, o, e)
+    A, b, origin, B, V = framed
     if backend not in ("auto", "exact"):
-        yield back(project(A, b, origin, B, mf, backend=backend))
-        return
-    if backend == "auto" and K.dim <= 2 and len(V) <= GEOMETRIC_GUIDE_VERTICES:
-        yield back(_geometric_guide(A, b, origin, B, V, K.dim, mf))
+        yield project(A, b, origin, B, m, backend=backend)
+    elif backend == "auto" and dim <= 2 and len(V) <= GEOMETRIC_GUIDE_VERTICES:
+        yield _geometric_guide(A, b, origin, B, V, dim, m)
     else:
         try:
-            guess = project(A, b, origin, B, mf, backend="clarabel")
+            guess = project(A, b, origin, B, m, backend="clarabel")
         except SolverError:  # a hint only: the next guide and the exact search decide
             pass
         else:
-            yield back(guess)
+            yield guess
     try:
-        guess = _vertex_guide(V, mf)
+        guess = _vertex_guide(V, m)
     except (RuntimeError, ValueError):  # scipy's NNLS at its iteration limit: no hint
         return
-    yield back(guess)
+    yield guess
 
 
-def _near_active_sets(K: SafeKernel, guess: np.ndarray) -> list[tuple[int, ...]]:
+def _near_active_sets(A: np.ndarray, b: np.ndarray, V: np.ndarray, dim: int,
+                      guess: np.ndarray) -> list[tuple[int, ...]]:
     """Subsets of ≤ dim facets near the guide, most plausible first: the dim + 1 nearest
     and every facet about as near (at a degenerate vertex more than dim are tight up
-    to rounding, in any order)."""
-    slack = K.b - K.A @ guess  # unit rows: distances
-    reach = NEAR_SLACK * float(np.ptp(K.vertices, axis=0).max())
+    to rounding, in any order). Unit frame (:func:`_frame`): A, b the facet rows, V
+    the vertices."""
+    slack = b - A @ guess  # unit rows: distances
+    reach = NEAR_SLACK * float(np.ptp(V, axis=0).max())
     order = np.argsort(slack, kind="stable")
     ranked = slack[order]
-    close = int(np.searchsorted(ranked, ranked[min(K.dim, len(ranked) - 1)] + reach,
+    close = int(np.searchsorted(ranked, ranked[min(dim, len(ranked) - 1)] + reach,
                                 side="right"))
-    near = sorted(order[: min(max(K.dim + 1, close), MAX_NEAR)].tolist())
+    near = sorted(order[: min(max(dim + 1, close), MAX_NEAR)].tolist())
     tight = slack <= reach  # a hint only: the KKT check decides
 
     def plausibility(S: tuple[int, ...]) -> tuple[int, int]:
         return (sum(not tight[i] for i in S) + sum(tight[i] for i in near if i not in S),
                 len(S))
 
-    sets = [S for size in range(K.dim + 1) for S in itertools.combinations(near, size)]
+    sets = [S for size in range(dim + 1) for S in itertools.combinations(near, size)]
     return sorted(sets, key=plausibility)
 
 
@@ -212,11 +212,14 @@ def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:
     if K.dim == 0:
         return ex.vertices[0]
     facets = list(ex.facets)
+    mf = np.array([float(v) for v in m])
+    o, e = _frame(K, mf)
+    framed = _framed(K, o, e)
 
     def near_sets():
-        for guess in _guides(K, m, backend):
+        for guess in _guides(K.dim, framed, _to_frame(mf, o, e), backend):
             if len(facets) and np.isfinite(guess).all():
-                yield from _near_active_sets(K, guess)
+                yield from _near_active_sets(framed[0], framed[1], framed[4], K.dim, guess)
 
     tried = set()
     for S in itertools.chain(near_sets(), _active_sets(len(facets), K.dim)):
