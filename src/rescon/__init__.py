@@ -35,6 +35,7 @@ from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kerne
 from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.sarymsakov import is_sarymsakov
 from .optim import check_subgradient, cost
+from .optim.redundancy import RedundancyReport, check_redundancy
 from .optim.rmdo import rmdo
 
 __version__ = "0.1.0"
@@ -47,6 +48,7 @@ __all__ = [
     "InputError",
     "MissingDependency",
     "RESCONError",
+    "RedundancyReport",
     "RobustnessCheck",
     "RobustnessReport",
     "SafeKernel",
@@ -60,6 +62,7 @@ __all__ = [
     "check_assumption2",
     "check_attack_model",
     "check_certificate",
+    "check_redundancy",
     "check_subgradient",
     "cost",
     "is_r_robust",
