@@ -84,7 +84,7 @@ def read_rmdo(path: str | Path) -> RMDOFile:
     for k in RMDO_TABLES:
         data.pop(k, None)
     sc = _from_dict(data, p.parent, str(p))
-    costs = _costs(tables["costs"], p, sc.d)
+    costs = _costs(tables["costs"], p, sc.d, sc.graph)
     return RMDOFile(sc, costs, _step_size(tables["step_size"], f"{p} [step_size]"))
 
 
@@ -117,8 +117,10 @@ def _dimension(value: Any, p: Path) -> int:
         raise InputError(f"{p}: {exc}") from None
 
 
-def _costs(table: Mapping[str, Any], p: Path, d: int | None) -> dict[Hashable, Oracle]:
-    """[costs] as oracles over R^d, one per distinct source (same string or object)."""
+def _costs(table: Mapping[str, Any], p: Path, d: int | None, nodes: Any = None
+           ) -> dict[Hashable, Oracle]:
+    """[costs] as oracles over R^d, one per distinct source (same string or object);
+    with ``nodes`` (the scenario's graph), agents that are not nodes are refused first."""
     where = f"{p} [costs]"
     if "paper" in table or "f7" in table:
         return _paper(table, where)
@@ -129,6 +131,10 @@ def _costs(table: Mapping[str, Any], p: Path, d: int | None) -> dict[Hashable, O
                 raise InputError(f"{where}: agent {v!r} has a cost in the file and one from "
                                  f"module {table['module']!r}")
             specs[v] = spec
+    unknown = [v for v in specs if nodes is not None and v not in nodes]
+    if unknown:
+        raise InputError(f"{where}: {unknown[:5]} are not nodes of the graph (the keys "
+                         f"{sorted(_RESERVED)} are reserved, the others are node labels)")
     made: dict[Any, Oracle] = {}
     out = {}
     for v, spec in specs.items():
