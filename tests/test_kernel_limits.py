@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import rescon
-from rescon.errors import EmptyKernel, InputError
-from rescon.geometry import halfspaces
-from rescon.models.kernel_models import lp_backends
+from rescon.errors import EmptyKernel, InputError, SolverError
+from rescon.geometry import halfspaces, points
+from rescon.models.kernel_models import lp_backends, qp_backends
 
 FLAT = [[i, 0.1 * i] for i in range(6)]  # not exactly collinear in floats: a segment
 
@@ -209,3 +209,37 @@ def test_flat_kernel_certificate_keeps_its_equalities():
     rows = K.certificate["facets"]
     assert len(rows) == 4  # the segment's line (both sides) and its two ends
     assert rescon.check_certificate(K.certificate).valid
+
+
+# --------------------------------------------------------------------------- #
+# explicit QP backends on a thin 3-D kernel with a far target
+# --------------------------------------------------------------------------- #
+
+
+def _thin_kernel():
+    """Ψ of a cloud 1e-12 thick along a tilted direction, its mean pulled 3e6 away by
+    one far point: explicit backends' inaccurate answers used to leave the exact search
+    enumerating active sets for seconds (minutes on larger kernels)."""
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(30, 3))
+    X[:, 2] *= 1e-12
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    X = X @ Q.T + 10
+    X[0] = 1e8
+    return rescon.safe_kernel(X, 3)
+
+
+@pytest.mark.parametrize("backend", qp_backends())
+def test_thin_kernel_every_backend_exact_or_solver_error(monkeypatch, backend):
+    K = _thin_kernel()
+    ref = K.point("project")
+    calls = []
+    real = points._kkt
+    monkeypatch.setattr(points, "_kkt", lambda *a: calls.append(1) or real(*a))
+    try:
+        x, cert = K.point("project", backend=backend)
+    except SolverError as exc:
+        assert backend in str(exc)
+    else:
+        assert np.array_equal(x, ref[0]) and cert == ref[1]
+    assert len(calls) <= 2000  # the exact search was guided, not exhaustive

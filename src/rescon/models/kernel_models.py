@@ -194,12 +194,8 @@ def project(A, b, origin, basis, target, *, backend="clarabel", solver=None) -> 
     y = _vector(target, "target", hull.origin.size)
     if hull.k == 0:
         return hull.origin.copy()
-    # conditioning: in units of the polytope's size s (the largest facet distance from
-    # the origin), u = t / s; the minimiser of ½‖u − c/s‖² over G u ≤ h/s is t*/s
-    s = float(np.abs(hull.h).max()) if hull.h.size else 0.0
-    if not (s > 0 and np.isfinite(s)):
-        s = 1.0
-    scaled = _Hull(hull.origin, hull.basis, hull.G, hull.h / s)
+    # the minimiser of ½‖u − c/s‖² over G u ≤ h/s is t*/s
+    s, scaled = _unit_scale(hull)
     return hull.lift(s * _SOLVE_QP[name](scaled, _target_t(hull, y) / s, solver))
 
 
@@ -245,8 +241,9 @@ def chebyshev(A, b, origin, basis, *, backend="highs", solver=None) -> tuple[np.
     hull = _validate(A, b, origin, basis)
     if hull.k == 0:
         return hull.origin.copy(), 0.0
-    t, rho = _SOLVE_LP[name](hull, solver)
-    return hull.lift(t), float(rho)
+    s, scaled = _unit_scale(hull)  # max ρ over G u + ρ ≤ h/s is ρ*/s, at t*/s
+    t, rho = _SOLVE_LP[name](scaled, solver)
+    return hull.lift(s * t), float(s * rho)
 
 
 def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None,
@@ -359,6 +356,17 @@ def _reduce(A: np.ndarray, b: np.ndarray, o: np.ndarray, B: np.ndarray) -> _Hull
     G = At[keep] / norm[keep, None]
     h = (b - A @ o)[keep] / norm[keep]
     return _Hull(o, B, G, h)
+
+
+def _unit_scale(hull: _Hull) -> tuple[float, _Hull]:
+    """(s, the hull with h / s): every backend sees the polytope at unit size, s the
+    power of two with max |h| ∈ [s, 2s) (the largest facet distance from the origin,
+    a point of K); dividing by it is exact, so the scaled model is the same polytope."""
+    top = float(np.abs(hull.h).max()) if hull.h.size else 0.0
+    if not (top > 0 and np.isfinite(top)):
+        return 1.0, hull
+    s = float(np.ldexp(1.0, np.frexp(top)[1] - 1))
+    return s, _Hull(hull.origin, hull.basis, hull.G, hull.h / s)
 
 
 def _target_t(hull: _Hull, y: np.ndarray) -> np.ndarray:
