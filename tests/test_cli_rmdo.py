@@ -304,3 +304,52 @@ def test_subprocess_bad_expression(tmp_path):
                          capture_output=True, text=True, timeout=120, check=False)
     assert res.returncode == 2 and res.stdout == "" and "Traceback" not in res.stderr
     assert res.stderr.count("\n") == 1 and "position" in res.stderr
+
+
+# ---------------------------------------------------------------- rescon redundancy
+
+REDUNDANCY_KEYS = {"holds", "exact", "r", "N", "gap", "unbounded", "witness", "seconds",
+                   "unbounded_agents", "tolerance"}
+
+
+def test_redundancy_violation_with_certificate(capsys, tmp_path):
+    p = write(tmp_path, 'd = 2\n[costs]\n1 = "(x1 - 1)^2 + x2^2"\n2 = "x1^2 + x2^2"\n'
+              '3 = "(x1 + 1)^2 + x2^2"\n')
+    cert = tmp_path / "c" / "cert.json"
+    out = run_json(["redundancy", p, "--r", 1, "--certificate", cert], capsys)
+    assert set(out) == REDUNDANCY_KEYS
+    assert (out["holds"], out["exact"], out["r"], out["N"]) == (False, True, 1, 3)
+    assert out["gap"] > 0 and out["tolerance"] is None
+    assert len(out["witness"]["subsets"]) == 2
+    code, _, err = run(["check", cert], capsys)
+    assert code == 0, err
+
+
+def test_redundancy_examples(capsys, tmp_path):
+    out = run_json(["redundancy", EXAMPLES / "rmdo_quadratic.toml", "--r", 2], capsys)
+    assert (out["holds"], out["exact"], out["N"], out["gap"]) == (True, True, 19, 0.0)
+    code, out, err = run(["redundancy", EXAMPLES / "paper_rmdo.toml", "--r", 2], capsys)
+    assert code == 0, err
+    assert "N = 10 costs in d = 2" in out and "agents [6]" in out
+
+
+def test_redundancy_infinite_gap_is_null(capsys, tmp_path):
+    """A subset with no minimiser (max(x1, x2) alone) against a bounded whole set: the
+    gap is infinite, written as null (the output stays strict JSON)."""
+    p = write(tmp_path, '[costs]\n1 = "max(x1, x2)"\n2 = "x1^2 + x2^2"\n')
+    out = run_json(["redundancy", p, "--r", 1], capsys)
+    assert out["holds"] is False and out["gap"] is None
+    assert out["unbounded"] == [[1]] and out["unbounded_agents"] == [1]
+
+
+def test_redundancy_bad_input(capsys, tmp_path):
+    p = write(tmp_path, '[costs]\n1 = "x1^2"\n2 = "x1^2"\n')
+    assert_error(["redundancy", p, "--r", 2], capsys, "r must be", "N = 2")
+    assert_error(["redundancy", write(tmp_path, "d = 1\n", "e.toml"), "--r", 0], capsys,
+                 "needs a [costs] table")
+    assert_error(["redundancy", write(tmp_path, '[costs]\n1 = "x1^"\n', "x.toml"), "--r", 0],
+                 capsys, "agent 1", "position 3")
+    assert_error(["redundancy", p, "--r", 0, "--certificate", tmp_path], capsys,
+                 "--certificate", "is a directory")
+    code, out, err = run(["redundancy", p], capsys)  # --r is required
+    assert code == 2 and "--r" in err and out == ""

@@ -257,6 +257,49 @@ def _finite_or_none(x: Any) -> Any:
     return x if x is None or math.isfinite(x) else None
 
 
+def _json_safe(x: Any) -> Any:
+    """``x`` with every non-finite float (anywhere in lists, tuples, dicts) as null."""
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_json_safe(v) for v in x]
+    return _finite_or_none(x) if isinstance(x, float) else x
+
+
+def _cmd_redundancy(args: argparse.Namespace) -> int:
+    """JSON keys ``holds, exact, r, N, gap, unbounded, witness, seconds`` (+
+    ``unbounded_agents``, ``tolerance``); ``gap`` is null when infinite (one argmin
+    empty, the other not), non-finite support values in ``witness`` too."""
+    import time
+
+    from .optim.files import read_costs
+    from .optim.redundancy import check_redundancy
+
+    cert_path = _output(args.certificate, "--certificate")
+    t0 = time.perf_counter()
+    costs, d = read_costs(args.costs)
+    rep = check_redundancy(costs, args.r, d=d)
+    seconds = time.perf_counter() - t0
+    _write_certificate(rep.certificate, cert_path)
+    out = {"holds": rep.holds, "exact": rep.exact, "r": args.r, "N": len(costs),
+           "gap": _finite_or_none(rep.gap),
+           "unbounded": [_sorted(S) for S in rep.unbounded], "witness": _json_safe(rep.witness),
+           "seconds": round(seconds, 6), "unbounded_agents": _sorted(rep.unbounded_agents),
+           "tolerance": rep.tolerance}
+    how = "exact" if rep.exact else f"numerical, tolerance {rep.tolerance:.1e}"
+    lines = [(f"N = {len(costs)} costs in d = {d} {'ARE' if rep.holds else 'are NOT'} "
+              f"{args.r}-redundant ({how}); largest argmin gap {rep.gap:.3e}")]
+    if rep.witness is not None:
+        S1, S2 = rep.witness["subsets"]
+        lines.append(f"witness: argmin over {_sorted(S1)} differs from argmin over "
+                     f"{_sorted(S2)} ({rep.witness.get('reason', '')})")
+    if rep.unbounded_agents:
+        lines.append(f"unbounded below alone: agents {_sorted(rep.unbounded_agents)}")
+    lines.append(f"{seconds:.3f} s")
+    _emit(out, args.json, lines)
+    return 0
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     """Exit 0 valid, 1 invalid, 2 unreadable, 3 unchecked (the standalone checker's codes);
     ``--json``: one object with ``verdict``, ``valid``, ``readable``, ``reason``,
@@ -346,6 +389,13 @@ def _parser() -> argparse.ArgumentParser:
     opt.add_argument("--plot", action="store_true", help="with --out: draw the trajectory")
     opt.add_argument("--json", action="store_true", help="one JSON object on stdout")
     opt.set_defaults(func=_cmd_rmdo)
+
+    red = sub.add_parser("redundancy", help="are the costs r-redundant? (exact when possible)")
+    red.add_argument("costs", help="TOML with [costs] (and d), or an RMDO scenario file")
+    red.add_argument("--r", type=_nonneg_int, required=True, help="agents that may be left out")
+    red.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
+    red.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    red.set_defaults(func=_cmd_redundancy)
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")
