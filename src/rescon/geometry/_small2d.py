@@ -25,8 +25,18 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._rounding import MIN_NORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
-from ._expansions import PARALLEL, difference, exact_mean, in_range, orient, side_of_meet
+from ._expansions import (
+    PARALLEL,
+    approximate,
+    cross,
+    difference,
+    exact_mean,
+    in_range,
+    orient,
+    side_of_meet,
+)
 
 OK = 0
 #: a batch answer x is used only if its certified error bound is at most this times
@@ -492,22 +502,37 @@ def _radon4(Y, out):
     for j in (1, 2, 3):
         others = [q for q in (1, 2, 3) if q != j]
         if _orient(Y, 0, j, others[0]) * _orient(Y, 0, j, others[1]) < 0:
-            a0, a1 = -(Y[j, 1] - Y[0, 1]), Y[j, 0] - Y[0, 0]
-            c = a0 * Y[0, 0] + a1 * Y[0, 1]
-            b0, b1 = -(Y[others[1], 1] - Y[others[0], 1]), Y[others[1], 0] - Y[others[0], 0]
-            d = b0 * Y[others[0], 0] + b1 * Y[others[0], 1]
-            aerr = EPS * (abs(a0) + abs(a1))
-            berr = EPS * (abs(b0) + abs(b1))
-            cerr = 4.0 * EPS * (abs(a0 * Y[0, 0]) + abs(a1 * Y[0, 1])) + aerr * (
-                abs(Y[0, 0]) + abs(Y[0, 1]))
-            derr = 4.0 * EPS * (abs(b0 * Y[others[0], 0]) + abs(b1 * Y[others[0], 1])) + berr * (
-                abs(Y[others[0], 0]) + abs(Y[others[0], 1]))
-            A = np.array([[b0, b1]])
-            C = np.array([d])
-            Ae = np.array([berr])
-            Ce = np.array([derr])
-            return _meet(0, a0, a1, c, aerr, cerr, A, C, Ae, Ce, np.zeros(4), out)
+            return _crossing(Y, 0, j, others[0], others[1], out)
     return -1.0
+
+
+@njit(cache=True, nogil=True)
+def _crossing(Y, a, b, c, d, out):
+    """The crossing of the lines p_a p_b and p_c p_d (which cross: decided before),
+    x = p_a + t (p_b − p_a) with t = ((p_c − p_a) × (p_d − p_c)) / ((p_b − p_a) ×
+    (p_d − p_c)), both cross products exact (expansions) then rounded (3 ulps each),
+    so t is within 7u of itself however flat the four points are; into out. Returns
+    the error bound (max norm): 12u |t| |p_b − p_a| + 2u |x| — relative to the
+    diagonal and the answer, not to the coordinates' size or the lines' angle."""
+    u = np.empty((2, 2))
+    w = np.empty((2, 2))
+    v = np.empty((2, 2))
+    buf = np.empty(16)
+    for k in range(2):
+        difference(Y[b, k], Y[a, k], u[k])
+        difference(Y[d, k], Y[c, k], w[k])
+        difference(Y[c, k], Y[a, k], v[k])
+    den = approximate(buf, cross(u, w, buf))
+    num = approximate(buf, cross(v, w, buf))
+    if den == 0.0:
+        return -1.0
+    t = num / den
+    e = 0.0
+    for k in range(2):
+        uk = u[k, 0] + u[k, 1]
+        out[k] = Y[a, k] + t * uk
+        e = max(e, 12.0 * EPS * abs(t * uk) + 2.0 * EPS * abs(out[k]))
+    return e + MIN_NORMAL
 
 
 @njit(cache=True, nogil=True)
