@@ -132,16 +132,17 @@ def _costs(costs: Any, d: int | None) -> tuple[list[Hashable], list[Any], int]:
         raise InputError("costs must hold at least one cost; got none")
     if d is not None:
         d = _validate.integer("d", d, low=1)
-    out = []
-    for label, spec in items:
-        o = cost(spec, d=d, name=f"cost of agent {label}")
+    out = [cost(spec, d=d, name=f"cost of agent {label}") for label, spec in items]
+    for (label, _), o in zip(items, out):
         if o.d is None:
             raise InputError(f"cost of agent {label}: its dimension is unknown (give d)")
-        if d is None:
-            d = o.d
-        elif o.d != d:
+    if d is None:  # expressions may use fewer variables than the others: widen them
+        d = max(o.d for o in out)
+        out = [cost(spec, d=d, name=o.name) if isinstance(spec, str) else o
+               for (_, spec), o in zip(items, out)]
+    for (label, _), o in zip(items, out):
+        if o.d != d:
             raise InputError(f"cost of agent {label}: dimension {o.d}, not d = {d}")
-        out.append(o)
     return [k for k, _ in items], out, d
 
 
