@@ -243,3 +243,15 @@ def test_thin_kernel_every_backend_exact_or_solver_error(monkeypatch, backend):
     else:
         assert np.array_equal(x, ref[0]) and cert == ref[1]
     assert len(calls) <= 2000  # the exact search was guided, not exhaustive
+
+
+def test_planar_estimate_follows_the_method(monkeypatch):
+    # integer points spread too wide for the sweep's exact separation are scanned
+    # directly (O(n³)): the estimate must be that scan's, and refuse
+    X = np.random.default_rng(6).integers(0, 10**7, size=(2100, 2)).astype(float)
+    plans = []
+    real = halfspaces._scan_plan
+    monkeypatch.setattr(halfspaces, "_scan_plan", lambda *a: plans.append(a) or real(*a))
+    with pytest.raises(InputError, match="2100 distinct points"):
+        rescon.safe_kernel(X, 100)
+    assert plans == [(2100, 2, False)]

@@ -213,27 +213,28 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     m, k = Y.shape
     count = comb(m, k)
+    bits = max(abs(v) for row in Yi for v in row).bit_length()
+    # k = 1: the sign of a float difference is exact — of exact floats
+    exact_floats = exact_view and (k == 1 or bits <= _exact_float_bits(k))
+    # small integers in the plane: two distinct directions between data points differ
+    # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
+    # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
+    # window is exactly on the line
     sweep = k == 2 and m >= SWEEP_MIN_POINTS and exact_view
+    separated = sweep and exact_floats and 16 * ANGLE_ERR * 2 * max(
+        max(col) - min(col) for col in zip(*Yi)) ** 2 < 1
+    sweep = sweep and (separated or not exact_floats)  # else the direct scan decides
     exact_only, work, nbytes = _scan_plan(m, k, sweep)
     require(f"the safe kernel of {m} distinct points in dimension {k}", work, nbytes,
             "reduce n or d")
     perms, signs = _permutations(0 if exact_only else k - 1)
-    bits = max(abs(v) for row in Yi for v in row).bit_length()
-    # k = 1: the sign of a float difference is exact — of exact floats
-    exact_floats = exact_view and (k == 1 or bits <= _exact_float_bits(k))
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
     # exact floats: Y holds small integers over a unit ≤ 2^(bits + 32), so no product of
     # k + 1 of them underflows either
     floor = 0.0 if exact_floats else underflow_floor(k, float(np.abs(Y).max()))
     expansions = exact_view and in_range(Y)
     subsets = k_subsets(m, k, count)
-    # small integers in the plane: two distinct directions between data points differ
-    # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
-    # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
-    # window is exactly on the line
-    separated = sweep and exact_floats and 16 * ANGLE_ERR * 2 * max(
-        max(col) - min(col) for col in zip(*Yi)) ** 2 < 1
-    if sweep and (separated or not exact_floats):
+    if sweep:
         plus, minus, unc, degenerate, cof, cof_abs = sweep_pairs_2d(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
         if separated:
