@@ -46,6 +46,7 @@ __all__ = [
 FORMAT_VERSION = 1
 MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
 MAX_N = 1_000_000  # resource limit on graph / matrix size
+MAX_SEARCH_WORK = 10_000_000  # mask operations (1024-bit units) replaying a search tree
 
 
 VERDICTS = ("valid", "invalid", "unchecked")
@@ -228,12 +229,23 @@ def _bits(mask: int) -> list[int]:
 class Graph:
     """Nodes 0..n-1; ``inmask[i]`` = bitmask of the in-neighbours N(i) of i."""
 
-    __slots__ = ("inmask", "m", "n")
+    __slots__ = ("_outmask", "inmask", "m", "n")
 
     def __init__(self, n: int, inmask: list[int], m: int) -> None:
         self.n = n
         self.inmask = inmask
         self.m = m  # number of edges
+        self._outmask: list[int] | None = None
+
+    def outmask(self) -> list[int]:
+        """``outmask()[u]`` = bitmask of the out-neighbours of u (computed once)."""
+        if self._outmask is None:
+            out = [0] * self.n
+            for v, mk in enumerate(self.inmask):
+                for u in _bits(mk):
+                    out[u] |= 1 << v
+            self._outmask = out
+        return self._outmask
 
     @property
     def full(self) -> int:
@@ -305,24 +317,46 @@ def reach(g: Graph, S: int, r: int) -> int:
     return out
 
 
-def core(g: Graph, U: int, r: int) -> int:
+def core(g: Graph, U: int, r: int, meter: list[int] | None = None) -> int:
     """core_r(U): peel every i in U with |N(i) \\ U| >= r until none is left.
 
     The result is the largest closed subset of U (closed sets are union-closed and
-    removability is monotone, so the peeling order does not matter).
-    """
+    removability is monotone, so the peeling order does not matter). Monotonicity also
+    means that after one scan of U only the out-neighbours of removed nodes need a
+    recount: O(|U| + sum of their out-degrees) mask operations (a pass-by-pass peel
+    costs |U| per pass and up to |U| passes). ``meter[0]``, when given, is increased by
+    the number of mask operations, each weighted by the words of an n-bit mask
+    (:func:`_mask_cost`)."""
     inmask = g.inmask
-    while True:
-        removed = False
-        m = U
+    outmask = g.outmask()
+    todo = []
+    m = U
+    while m:
+        low = m & -m
+        m ^= low
+        if (inmask[low.bit_length() - 1] & ~U).bit_count() >= r:
+            todo.append(low.bit_length() - 1)
+    ops = U.bit_count()
+    for i in todo:
+        U ^= 1 << i
+    while todo:
+        m = outmask[todo.pop()] & U
         while m:
             low = m & -m
             m ^= low
-            if (inmask[low.bit_length() - 1] & ~U).bit_count() >= r:
+            ops += 1
+            j = low.bit_length() - 1
+            if (inmask[j] & ~U).bit_count() >= r:
                 U ^= low
-                removed = True
-        if not removed:
-            return U
+                todo.append(j)
+    if meter is not None:
+        meter[0] += _mask_cost(g, ops)
+    return U
+
+
+def _mask_cost(g: Graph, ops: int) -> int:
+    """``ops`` operations on n-bit masks, counted in operations on 1024-bit ones."""
+    return ops * max(1, -(-g.n // 1024))
 
 
 def _pair_failure(g: Graph, r: int, s: int, S1: int, S2: int) -> str | None:
@@ -519,10 +553,16 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
     full = g.full
     pos = 0
     ntok = len(tree)
+    meter = [0]  # mask operations spent replaying the tree (_mask_cost units)
     B = 0
     for k in range(n):
         stack = [(1 << order[k], B)]  # (S, X) with X = B at the root
         while stack:
+            if meter[0] > MAX_SEARCH_WORK:
+                return _enumerate_or_trust(
+                    "search", where, g, r, s, ctx,
+                    f"replaying its tree needs more than {MAX_SEARCH_WORK} mask operations "
+                    f"(the checker's work limit; stopped at token {pos} of {ntok})")
             S, X = stack.pop()
             if pos >= ntok:
                 raise Invalid(f"{where}: search tree ends early (in the subtree of root {k})")
@@ -536,19 +576,19 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
                 stack.append((S, X | bit))  # second: u forced out of S1
                 stack.append((S | bit, X))  # first: u in S1
             elif t == -1:
-                c = core(g, full & ~S & ~B, r)
+                c = core(g, full & ~S & ~B, r, meter)
                 if c:
                     raise Invalid(f"{where}: search tree leaf -1 at token {pos} is not justified: "
                                   f"core(V \\ S \\ B) = {_fmt(c)} is nonempty "
                                   f"(S = {_fmt(S)}, B = {_fmt(B)})")
             elif t == -2:
-                c = core(g, full & ~X, r)
+                c = core(g, full & ~X, r, meter)
                 if not S & ~c:
                     raise Invalid(f"{where}: search tree leaf -2 at token {pos} is not justified: "
                                   f"S = {_fmt(S)} is inside core(V \\ X) = {_fmt(c)} "
                                   f"(X = {_fmt(X)})")
             else:  # t == -3
-                fits = _sizes_fit(g, S, X, B, r)
+                fits = _sizes_fit(g, S, X, B, r, meter)
                 if fits:
                     raise Invalid(f"{where}: search tree leaf -3 at token {pos} is not justified: "
                                   f"{fits}")
@@ -559,7 +599,7 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
     return "search"
 
 
-def _sizes_fit(g: Graph, S: int, X: int, B: int, r: int) -> str:
+def _sizes_fit(g: Graph, S: int, X: int, B: int, r: int, meter: list[int]) -> str:
     """'' when a closed S1 ⊇ S avoiding X and a closed nonempty S2 ⊆ core(V \\ S \\ B)
     provably cannot fit together; otherwise the reason they might.
 
@@ -567,8 +607,9 @@ def _sizes_fit(g: Graph, S: int, X: int, B: int, r: int) -> str:
     while S1 ⊆ P = core(V \\ X), S2 ⊆ Q = core(V \\ S \\ B) are disjoint: |S1| + |S2| ≤ |P ∪ Q|.
     """
     full = g.full
-    Q = core(g, full & ~S & ~B, r)
-    P = core(g, full & ~X, r)
+    Q = core(g, full & ~S & ~B, r, meter)
+    P = core(g, full & ~X, r, meter)
+    meter[0] += _mask_cost(g, S.bit_count() + Q.bit_count())
     need1 = S.bit_count() + max([0] + [(g.inmask[i] & ~S).bit_count() - r + 1 for i in _bits(S)])
     need2 = min([g.n + 1] + [max(1, g.inmask[j].bit_count() - r + 2) for j in _bits(Q)])
     room = (P | Q).bit_count()
@@ -650,13 +691,14 @@ def _info(p: dict, where: str) -> None:
         raise Invalid(f"{where}.info must be a JSON object, got {_tname(p['info'])}")
 
 
-def _enumerate_or_trust(method: str, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
-    """A proof the checker cannot replay: re-verified by enumeration when n ≤ 20,
-    otherwise accepted on trust (and reported)."""
+def _enumerate_or_trust(method: str, where: str, g: Graph, r: int, s: int, ctx: _Ctx,
+                        why: str = "") -> str:
+    """A proof the checker cannot replay (``why``, if given, says why not): re-verified
+    by enumeration when n ≤ 20, otherwise accepted on trust (and reported)."""
     if g.n > MAX_ENUM_N:
         return _unreplayed(method, where, g, r, s, ctx,
-                           f"accepted on trust (n = {g.n} > {MAX_ENUM_N}, beyond the "
-                           "checker's own enumeration)")
+                           (f"{why}; " if why else "") + f"accepted on trust (n = {g.n} > "
+                           f"{MAX_ENUM_N}, beyond the checker's own enumeration)")
     _enumerate_or_fail(where, g, r, s)
     return f"{method} (re-verified by enumeration)"
 
@@ -668,24 +710,38 @@ def _proof_dp(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
 
 
 MAX_SPECTRAL_N = 200
+MAX_SPECTRAL_WORK = 12_000_000  # n^3/6 eliminations weighted by (bits / 1024)^2
 
 
-def _positive_definite(M: list[list[Fraction]]) -> int:
-    """-1 when the symmetric rational matrix M is positive definite, else the index of
-    the first non-positive pivot of its exact LDLᵀ elimination."""
+def _positive_definite(M: list[list[int]]) -> int:
+    """-1 when the symmetric integer matrix M is positive definite, else the index k of
+    the first leading principal minor det M[:k+1, :k+1] that is <= 0 (Sylvester).
+
+    Fraction-free (Bareiss) elimination: after step k − 1 the pivot A[k][k] is that
+    minor, and every division is exact. The matrix stays symmetric, so only the upper
+    triangle is updated (A[i][k] = A[k][i])."""
     A = [row[:] for row in M]
     n = len(A)
+    prev = 1
     for k in range(n):
-        piv = A[k][k]
-        if piv <= 0:
+        Ak = A[k]
+        akk = Ak[k]
+        if akk <= 0:
             return k
         for i in range(k + 1, n):
-            f = A[i][k] / piv
-            if f:
-                Ai, Ak = A[i], A[k]
-                for j in range(k + 1, n):
-                    Ai[j] -= f * Ak[j]
+            Ai = A[i]
+            aik = Ak[i]
+            for j in range(i, n):
+                Ai[j] = (akk * Ai[j] - aik * Ak[j]) // prev
+        prev = akk
     return -1
+
+
+def _spectral_work(n: int, entry_bits: int) -> int:
+    """About n^3/6 products of minors of up to n (entry_bits + log2 n) bits (Hadamard),
+    counted in 1024-bit products."""
+    bits = n * (entry_bits + n.bit_length())
+    return n ** 3 // 6 * max(1, -(-bits // 1024)) ** 2
 
 
 def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
@@ -716,10 +772,18 @@ def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) ->
         return _unreplayed("spectral", where, g, r, s, ctx,
                            f"too large for the exact spectral check (n = {n} > "
                            f"{MAX_SPECTRAL_N})")
-    off = c / n + 1
-    M = [[off - (1 if g.inmask[i] >> j & 1 else 0) for j in range(n)] for i in range(n)]
+    # M = q n (L - c I + (c/n + 1) J) for c = a/q: integer, positive definite iff the
+    # matrix above is
+    a, q = c.numerator, c.denominator
+    off = a + q * n  # q n (c/n + 1)
+    M = [[off - (q * n if g.inmask[i] >> j & 1 else 0) for j in range(n)] for i in range(n)]
     for i in range(n):
-        M[i][i] = g.inmask[i].bit_count() - c + off
+        M[i][i] = q * n * g.inmask[i].bit_count() - a * n + off
+    work = _spectral_work(n, max(abs(t).bit_length() for row in M for t in row))
+    if work > MAX_SPECTRAL_WORK:
+        return _unreplayed("spectral", where, g, r, s, ctx,
+                           f"the exact spectral check needs work {work} > {MAX_SPECTRAL_WORK} "
+                           f"(n = {n}, c = {c})")
     k = _positive_definite(M)
     if k >= 0:
         raise Invalid(f"{where}: lambda2 > c = {c} fails (L - cI + (c/n+1)J has a "

@@ -1123,3 +1123,49 @@ def test_package_init_exports():
     spec.loader.exec_module(pkg)
     assert pkg.check(_base()).valid
     assert pkg.CheckResult is sys.modules[spec.name + ".check"].CheckResult
+
+
+def _timed_check(cert):
+    t0 = time.perf_counter()
+    res = check(json.loads(json.dumps(cert)))
+    return res, time.perf_counter() - t0
+
+
+def test_search_tree_replay_is_bounded_on_a_long_peeling_chain():
+    """A 5 KB certificate: a directed cycle where node i hears only node i + 1, so
+    peeling V \\ S removes one node per pass, with one leaf per root. Replaying it took
+    O(n^3) mask operations (11 s at n = 400, minutes at n = 1000)."""
+    n = 1000
+    edges = [[(i + 1) % n, i] for i in range(n)]
+    cert = rs_cert(n, edges, 1, 1, {"method": "search", "order": list(range(n)),
+                                    "tree": [-1] * n})
+    res, seconds = _timed_check(cert)
+    assert res.verdict in ("valid", "unchecked"), res
+    assert seconds < 10, seconds
+    # a smaller chain is replayed in full, and a wrong leaf there is still refuted
+    n = 300
+    edges = [[(i + 1) % n, i] for i in range(n)]
+    good = rs_cert(n, edges, 1, 1, {"method": "search", "order": list(range(n)),
+                                    "tree": [-1] * n})
+    res, seconds = _timed_check(good)
+    assert res.verdict == "valid" and seconds < 5, (res, seconds)
+    bad = rs_cert(n, edges, 1, 1, {"method": "search", "order": list(range(n)),
+                                   "tree": [-2] * n})
+    assert check(bad).verdict == "invalid"
+
+
+def test_spectral_check_at_its_size_limit_is_bounded():
+    """An undirected ring lattice on MAX_SPECTRAL_N nodes: the exact LDL^T in Fractions
+    took 26 s; integer (Bareiss) elimination on the upper triangle answers in seconds.
+    A c beyond lambda2 is still refuted."""
+    def ring(n, k):
+        edges = [[i, (i + j) % n] for i in range(n) for j in range(1, k + 1)]
+        return edges + [[v, u] for u, v in edges]
+
+    n = C.MAX_SPECTRAL_N
+    proof = {"method": "spectral", "c": "7/3"}
+    res, seconds = _timed_check(rs_cert(n, ring(n, 30), 1, 1, proof))
+    assert res.verdict in ("valid", "unchecked") and seconds < 10, (res, seconds)
+    # lambda2 of the ring lattice (60, 3) is 2 sum_j (1 - cos(2 pi j / 60)) < 1: c = 5 fails
+    res = check(rs_cert(60, ring(60, 3), 2, 1, {"method": "spectral", "c": "5"}))
+    assert res.verdict == "invalid" and "lambda2" in res.reason, res
