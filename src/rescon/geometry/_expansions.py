@@ -187,18 +187,33 @@ def _normal3(Y, i, j, k, C, nC):
 
 
 @njit(cache=True, nogil=True)
-def orient3(Y, i, j, k, q):
-    """Exact sign of ((p_j − p_i) × (p_k − p_i)) · (p_q − p_i) for rows of Y."""
+def _orient3(Y, i, j, k, q, S):
+    """((p_j − p_i) × (p_k − p_i)) · (p_q − p_i) exactly, as an expansion in S (192
+    slots); returns its length."""
     C = np.empty((3, 16))
     nC = np.empty(3, dtype=np.int64)
     _normal3(Y, i, j, k, C, nC)
     d = np.empty(2)
-    S = np.empty(3 * 2 * 2 * 16)
     n = 0
     for c in range(3):
         difference(Y[q, c], Y[i, c], d)
         n += product(C[c], nC[c], d, 2, S[n:])
-    return sign(S, compress(S, n))
+    return compress(S, n)
+
+
+@njit(cache=True, nogil=True)
+def orient3(Y, i, j, k, q):
+    """Exact sign of ((p_j − p_i) × (p_k − p_i)) · (p_q − p_i) for rows of Y."""
+    S = np.empty(3 * 2 * 2 * 16)
+    return sign(S, _orient3(Y, i, j, k, q, S))
+
+
+@njit(cache=True, nogil=True)
+def det3(Y, i, j, k, q):
+    """((p_j − p_i) × (p_k − p_i)) · (p_q − p_i), its exact value rounded (within 3
+    ulps; 0 only when it is 0)."""
+    S = np.empty(3 * 2 * 2 * 16)
+    return approximate(S, _orient3(Y, i, j, k, q, S))
 
 
 @njit(cache=True, nogil=True)

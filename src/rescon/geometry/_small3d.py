@@ -48,7 +48,7 @@ from numba import njit
 
 from .._rounding import MIN_NORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
-from ._expansions import TINY, exact_mean, normal3, orient3
+from ._expansions import TINY, det3, exact_mean, normal3, orient3
 from ._small2d import ACCEPT_REL, cluster_box
 
 #: rounding-error factor of the 3 × 3 orientation (as in _candidates for k = 3)
@@ -299,10 +299,94 @@ def project_small_3d(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np
     if Ys.shape[1] >= 4 * F + 1:  # (Ψ ≠ ∅) converged clusters: any of their points
         cluster_boxes(Ys, F, out, err)
     found = err <= ACCEPT_REL * np.abs(out).max(axis=1)
+    if Ys.shape[1] == 5 and F == 1 and not found.all():  # one Radon point, directly
+        rest = np.flatnonzero(~found)
+        Zs, exps = _scaled(Ys[rest])
+        pts, bounds = np.zeros((len(rest), 3)), np.full(len(rest), np.inf)
+        radon5_all(Zs, pts, bounds)
+        out[rest], err[rest] = np.ldexp(pts, exps[:, None]), np.ldexp(bounds, exps)
+        found = err <= ACCEPT_REL * np.abs(out).max(axis=1)
     rest = np.flatnonzero(~found)
     if len(rest):
         out[rest], err[rest], found[rest] = _project(Ys[rest], F)
     return out, err, found
+
+
+def _scaled(Ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each set times 2^−e (exact), e its largest |coordinate|'s exponent (0 for a set
+    with a non-finite one, which the numba passes then decline): (scaled sets, e)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        big = np.abs(Ys).max(axis=(1, 2)) if Ys.shape[1] else np.zeros(len(Ys))
+    exps = np.where(np.isfinite(big), np.frexp(np.where(np.isfinite(big), big, 1.0))[1], 0)
+    return np.ldexp(Ys, -exps[:, None, None]), exps
+
+
+@njit(cache=True, nogil=True)
+def radon5_all(Zs, out, err):
+    """_radon5 for every (scaled) set of five points; err stays inf where declined."""
+    for b in range(Zs.shape[0]):
+        if _in_scaled_range(Zs[b]):
+            e = _radon5(Zs[b], out[b])
+            if e >= 0.0:
+                err[b] = e
+
+
+@njit(cache=True, nogil=True)
+def _radon5(Y, x):
+    """Ψ(Y, 1) for five points in general position (every orientation below nonzero):
+    the data point strictly inside the tetrahedron of the others, or the crossing of
+    the segment p_i p_j with the triangle p_k p_l p_r it pierces (the plane klr and
+    the planes ijk, ijl are valid on both sides, and meet only there; the crossing
+    lies in every hull of four). x = p_i + t (p_j − p_i), t = D_i / (D_i − D_j) with
+    D_q = det3(k, l, r, q) exactly rounded and of opposite signs (no cancellation): t
+    within 8 ulps, so ‖x − x*‖₂ ≤ √3 (14u |t| ‖p_j − p_i‖_∞ + 2u ‖x‖_∞). Writes x,
+    returns that bound; −1 if an orientation is zero."""
+    for i in range(5):
+        o = _others(i, -1)
+        inside = True
+        for f in range(4):  # face without o[f], against the vertex o[f]
+            a, b, c = o[(f + 1) % 4], o[(f + 2) % 4], o[(f + 3) % 4]
+            s_i = orient3(Y, a, b, c, i)
+            s_v = orient3(Y, a, b, c, o[f])
+            if s_i == 0 or s_v == 0:
+                return -1.0
+            inside = inside and s_i == s_v
+        if inside:
+            x[:] = Y[i]
+            return 0.0
+    for i in range(5):
+        for j in range(i + 1, 5):
+            k, l, r = _others(i, j)[:3]
+            s1 = orient3(Y, i, j, k, l)
+            s2 = orient3(Y, i, j, l, r)
+            s3 = orient3(Y, i, j, r, k)
+            if s1 == 0 or s2 == 0 or s3 == 0:
+                return -1.0
+            if not (s1 == s2 == s3):
+                continue
+            di, dj = det3(Y, k, l, r, i), det3(Y, k, l, r, j)
+            if not di * dj < 0.0:
+                continue
+            t = di / (di - dj)
+            e = 0.0
+            for c in range(3):
+                u = Y[j, c] - Y[i, c]
+                x[c] = Y[i, c] + t * u
+                e = max(e, 14.0 * EPS * abs(t * u) + 2.0 * EPS * abs(x[c]))
+            return (e + MIN_NORMAL) * math.sqrt(3.0) * (1.0 + 4.0 * EPS)
+    return -1.0
+
+
+@njit(cache=True, nogil=True)
+def _others(i, j):
+    """The indices of range(5) other than i and j (j = −1: other than i)."""
+    o = np.empty(4, dtype=np.int64)
+    n = 0
+    for q in range(5):
+        if q != i and q != j:
+            o[n] = q
+            n += 1
+    return o
 
 
 @njit(cache=True, nogil=True)
@@ -315,10 +399,7 @@ def cluster_boxes(Ys, F, out, err):
 def _project(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """project_small_3d by the certified KKT route (module docstring)."""
     B, m, _ = Ys.shape
-    with np.errstate(invalid="ignore", over="ignore"):
-        big = np.abs(Ys).max(axis=(1, 2)) if m else np.zeros(B)
-    exps = np.where(np.isfinite(big), np.frexp(np.where(np.isfinite(big), big, 1.0))[1], 0)
-    Zs = np.ldexp(Ys, -exps[:, None, None])  # exact; max |coordinate| in [1/2, 1)
+    Zs, exps = _scaled(Ys)  # exact; max |coordinate| in [1/2, 1)
     H = m * (m - 1) * (m - 2) // 3
     normals = np.empty((B, H, 3))
     offsets = np.empty((B, H))
