@@ -116,3 +116,20 @@ def test_converging_states_are_certified_or_declined_never_raise():
     out, err, found = project_small_3d(Y[None], 1)
     exact = rescon.kernel_point(Y, 1)[0]
     assert not found[0] or np.linalg.norm(out[0] - exact) <= err[0]
+
+
+@pytest.mark.parametrize("flat", [1.0, 1e-4, 1e-8, 1e-12])
+def test_five_points_flat_or_not_give_the_radon_point(flat):
+    """Five points with F = 1 (each agent's sets for d = 3, F = 1): Ψ is one Radon point,
+    certified to a few ulps of itself however nearly coplanar the points are (converging
+    states flatten to ~1e-12 before they meet) — and equal to the exact point."""
+    rng = np.random.default_rng(int(-np.log10(flat)))
+    B = rng.normal(size=(40, 5, 3))
+    B[..., 2] *= flat
+    B += rng.uniform(-10, 10, size=3)
+    B[:10, 0] = B[:10, 1:].mean(axis=1) + 1e-3 * rng.normal(size=(10, 3)) * flat
+    out, err, found = project_small_3d(B, 1)
+    assert found.all()
+    for b in range(len(B)):
+        exact = rescon.safe_kernel(B[b], 1).point("project")[0]
+        assert np.linalg.norm(exact - out[b]) <= err[b] <= 1e-14 * np.abs(out[b]).max()
