@@ -34,6 +34,13 @@ def kernel_point_cvxpy(Y: np.ndarray, F: int) -> np.ndarray:
 def simulate_naive(sc) -> np.ndarray:
     """States (K+1, N, d) of Algorithm 1 for a Scenario ``sc`` (policy "hold",
     centre as in ``sc``), one agent and one CVXPY problem at a time."""
+    return run_naive(sc, lambda i, k, t, z: z + sc.residual(t))
+
+
+def run_naive(sc, update) -> np.ndarray:
+    """The naive loop with its update rule: agent i (a node label) at step k, time t
+    moves to ``update(i, k, t, z)``, z = α x_i + (1 − α) x̃_i (Algorithm 1: z + ε(t);
+    Algorithm 2: z − β_k d_i, d_i ∈ ∂f_i(z))."""
     from rescon.consensus.dos import blocked_links
 
     nodes = sc.nodes
@@ -75,7 +82,7 @@ def simulate_naive(sc) -> np.ndarray:
             L = np.array(pts)
             aux = (L.min(axis=0) + L.max(axis=0)) / 2 if sc.centre == "box" else L.mean(axis=0)
             a = sc.alpha[pos[i]]
-            new[pos[i]] = a * xi + (1 - a) * aux + sc.residual(t)
+            new[pos[i]] = update(i, k, t, a * xi + (1 - a) * aux)
         for a_node, beh in sc.adversaries.items():
             new[pos[a_node]] = np.asarray(beh.f((k + 1) * sc.T), dtype=float)
         x = new
