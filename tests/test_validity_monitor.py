@@ -45,3 +45,28 @@ def test_filter_declines_on_a_flat_hull():
     mon = ValidityMonitor(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]))
     assert not mon.surely_inside(np.array([[1.0, 1.0]])).any()
     assert mon.distances(np.array([[1.0, 1.0], [0.0, 1.0]]))[0] == 0.0
+
+
+def _diameter_n2(X: np.ndarray) -> float:
+    diff = X[:, None, :] - X[None, :, :]
+    return float(np.sqrt((diff**2).sum(axis=2)).max())
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_diameter_same_float_as_all_pairs(seed):
+    """The pruned diameter (only rows that can end one are compared) is the same float
+    as the n² formula: random clouds at scales 1e-300..1e300, repeated rows (converged
+    clusters), collinear rows, one row, NaN."""
+    from rescon.consensus.metrics import diameter
+
+    rng = np.random.default_rng(seed)
+    for t in range(150):
+        n, d = int(rng.integers(1, 80)), int(rng.integers(1, 4))
+        X = rng.normal(size=(n, d)) * 10.0 ** float(rng.integers(-300, 300))
+        if t % 4 == 1:
+            X = np.repeat(X[:2], 7, axis=0)
+        elif t % 4 == 2:
+            X = np.outer(rng.normal(size=n), rng.normal(size=d))
+        with np.errstate(all="ignore"):
+            assert diameter(X) == _diameter_n2(X)
+    assert np.isnan(diameter(np.array([[np.nan, 1.0], [0.0, 0.0], [1.0, 1.0]])))
