@@ -359,3 +359,24 @@ def test_step_view_validation():
 def test_doctests():
     res = doctest.testmod(adv_mod, optionflags=doctest.ELLIPSIS)
     assert res.failed == 0 and res.attempted > 5
+
+
+@pytest.mark.parametrize("value", [1e308, -1.7e308, 5e-324])
+def test_recorded_adversary_state_is_what_it_sent_at_any_magnitude(value):
+    """The trajectory records each adversary's message (the mean of what it sent on its
+    links): averaging six copies of 1e308 overflowed to inf (and warned)."""
+    import warnings
+
+    import networkx as nx
+
+    import rescon
+
+    G = nx.complete_graph(7).to_directed()
+    x0 = {i: [float(i % 3), float(i % 2)] for i in range(7)}
+    sc = rescon.Scenario(graph=G, x0=x0, F=1, steps=2,
+                         adversaries={6: Constant([value, value])})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        tr = rescon.simulate(sc)
+    rec = tr.states[:, 6]
+    assert np.isfinite(rec).all() and np.allclose(rec, value, rtol=4e-16, atol=0), rec

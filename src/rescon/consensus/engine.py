@@ -27,6 +27,7 @@ are computed together (:func:`_kernel_points`).
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
@@ -220,7 +221,7 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
                 raise InputError(f"adversary {sc.nodes[a]!r}: {exc}") from None
             values[rows] = msgs
             finite = msgs[np.isfinite(msgs).all(axis=1)]
-            sent[a] = finite.mean(axis=0) if len(finite) else np.full(d, np.nan)
+            sent[a] = _scaled_mean(finite) if len(finite) else np.full(d, np.nan)
     finite = np.isfinite(values).all(axis=1)
     blocked = blocked_mask(sc.dos, links.index, t) if sc.dos else np.zeros(len(values), bool)
     metrics["blocked_links"][k] = int(blocked.sum())
@@ -236,6 +237,16 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
     has_last |= delivered
     values[~usable] = np.nan
     return values, usable, sent
+
+
+def _scaled_mean(rows: np.ndarray) -> np.ndarray:
+    """Mean of the rows of a finite (m, d) array without overflow: the rows are divided
+    by 2^e ≥ max |entry| (exact, a power of two), averaged (|mean| ≤ 1), and scaled back."""
+    top = float(np.abs(rows).max())
+    if top == 0.0:
+        return rows.mean(axis=0)
+    e = math.frexp(top)[1]
+    return np.ldexp((np.ldexp(rows, -e)).mean(axis=0), e)
 
 
 def _auxiliary(sc, links, x, values, usable, benign, d, cache):
