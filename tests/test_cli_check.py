@@ -61,8 +61,10 @@ def test_exit_codes_and_json(tmp_path, capsys):
         path.write_text(text)
         got, out, err = _run(capsys, path)
         assert got == 2 and err.startswith("unreadable: "), (name, err)
-        got, out, _ = _run(capsys, path, "--json")
+        got, out, err = _run(capsys, path, "--json")
         assert got == 2 and json.loads(out)["verdict"] == "unreadable"
+        # bad input: one line on stderr under --json too (DESIGN.md, command line)
+        assert err.startswith("unreadable: ") and err.count("\n") == 1, (name, err)
 
 
 def test_correct_kernel_too_large_to_enumerate_is_not_invalid(tmp_path, capsys):

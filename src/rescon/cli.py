@@ -312,6 +312,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     try:
         cert = load(args.certificate)
     except (ValueError, OSError, RecursionError) as exc:  # what the checker calls unreadable
+        print(f"unreadable: {args.certificate}: {exc}", file=sys.stderr)
         print(json.dumps({"verdict": "unreadable", "valid": False, "readable": False,
                           "reason": str(exc), "trusted": [], "unchecked": []}))
         return 2
