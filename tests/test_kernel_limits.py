@@ -115,7 +115,7 @@ def test_quick_emptiness_directions_skipped_in_high_dimension():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("n,d,F", [(13, 12, 0), (25, 20, 0)])
+@pytest.mark.parametrize("n,d,F", [(13, 12, 0), (25, 20, 0), (21, 20, 0)])
 def test_high_dimension_refused_by_the_budget(n, d, F):
     # (d−1)! permutations took 5.5 GB (13 in R^12) and 18 GB (25 in R^20)
     out = _run_limited(f"""

@@ -87,8 +87,10 @@ class ExactPolytope:
         """The box lo ≤ y ≤ hi (lo_j < hi_j), constraints 2j: −y_j ≤ −lo_j and
         2j+1: y_j ≤ hi_j."""
         k = len(lo)
-        require(f"the bounding box in dimension {k}", PYTHON_STEP * k * 2**k,
-                40 * (k + 1) * 2**k, "reduce d")
+        # 2^k vertices of k + 1 Python ints, each met with its k tight facets by the
+        # first clip (whose float pass alone reads all k coordinates)
+        require(f"the bounding box in dimension {k}", PYTHON_STEP * k * k * 2**k,
+                (48 * (k + 1) + 64) * 2**k, "reduce d")
         P = cls(k, unit=unit)
         for j in range(k):
             e = [0] * k
