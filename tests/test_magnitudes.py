@@ -129,6 +129,26 @@ def test_float_guides_are_solved_at_unit_size(j):
         assert np.array_equal(x2, np.ldexp(rescon.kernel_point(X, 3)[0], j))
 
 
+@pytest.mark.parametrize("X,F,j", [
+    ([[6e12, -2e12, 11e12], [-11, -4, -13], [11, 0, 20], [3, 4, -9], [-9, -4, 7],
+      [-8, -19, 6], [7, -8, 3], [8, 9, -13], [0, -7, 7], [0, -10, 0]], 2, -73),
+    ([[-2, 2, 8, 7], [1, 2, 10, 5], [4, -8, 1, 3], [1, -7, -13, 5], [5, 1, -6, -3],
+      [0, 6, 1, -6], [-3, -8, 14, -5], [11, 3, 14, -7], [6, -6, -6, -5], [-9, -6, -1, 13],
+      [-3, -11, 5, 11], [-19, 4, -10, -13], [5, 11, 14, 1], [-2, 2, 5, 7]], 2, 602),
+])
+def test_float_outputs_do_not_depend_on_the_path(X, F, j):
+    """Integer data take exact-float paths, 2^j X the normalised ones; the vertices
+    (lexicographic) and facet rows (by direction) come out in one order either way, so
+    the float outputs and the Chebyshev point (not unique: the LP's choice) scale by
+    2^j exactly too."""
+    X = np.array(X, dtype=np.float64)
+    K0, K1 = rescon.safe_kernel(X, F), rescon.safe_kernel(np.ldexp(X, j), F)
+    assert np.array_equal(np.ldexp(K0.vertices, j), K1.vertices)
+    assert np.array_equal(K0.A, K1.A) and np.array_equal(np.ldexp(K0.b, j), K1.b)
+    x0, x1 = K0.point("chebyshev")[0], K1.point("chebyshev")[0]
+    assert np.array_equal(np.ldexp(x0, j), x1)
+
+
 def _parse(s: str) -> Fraction:
     """Fraction(s) without Python's default limit on str → int."""
     old = sys.get_int_max_str_digits()

@@ -350,11 +350,15 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
 def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
                      ) -> tuple[tuple[Fraction, ...], ...]:
     """The vertices of Ψ in the original coordinates, exactly (from the homogeneous
-    scaled-integer vertices (w, y) of the clipped polytope: x = y / (w · scale))."""
+    scaled-integer vertices (w, y) of the clipped polytope: x = y / (w · scale)), in
+    lexicographic order — independent of how the polytope was built and of a scaling
+    of X by 2^j, as is then everything computed from them in floats (origin, basis,
+    the guides' frame)."""
     if hull.dim == len(P.ints[0]):  # the pivot coordinates are all of x
-        return tuple(tuple(Fraction(y, w * P.scale) for y in ys) for w, *ys in poly.verts)
-    return tuple(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
-                 for y in poly.fraction_vertices())
+        return tuple(sorted(tuple(Fraction(y, w * P.scale) for y in ys)
+                            for w, *ys in poly.verts))
+    return tuple(sorted(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
+                        for y in poly.fraction_vertices()))
 
 
 def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
@@ -438,7 +442,10 @@ def _affine_of(verts, d: int, full: bool):
 def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
     """Constraints whose tight vertices span a (dim − 1)-face: the facets of Ψ relative
     to its affine hull (implicit equalities, tight everywhere, are left out), as
-    ``ambient[h]`` (the constraint h in the original coordinates)."""
+    ``ambient[h]`` (the constraint h in the original coordinates), ordered by their
+    directions a / max|a_j| — an order that does not depend on how the polytope was
+    built, nor on a scaling of X by 2^j (so neither do the rows A, b, nor the float
+    guides that read them)."""
     if dim == 0:
         return []
     nv = len(poly.verts)
@@ -449,7 +456,7 @@ def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
         if len(members) >= dim and len(members) < nv and (
                 poly.clear_rank(members) >= dim - 1 or poly.face_dim(members) == dim - 1):
             out.append(ambient[h])
-    return out
+    return sorted(out, key=lambda row: tuple(v / max(map(abs, row[0])) for v in row[0]))
 
 
 def _needed_rows(poly: ExactPolytope, ambient: dict, facets: list) -> tuple:
