@@ -135,7 +135,7 @@ def _rounded_normals(Yi, through: np.ndarray, sign: np.ndarray
     |af − a| ≤ ε|a| + 2^-1075 componentwise (a the scaled exact normal); returns
     (af, af_abs, c_err) with af_abs = |af|(1 + 4ε) + 2^-1022 and c_err = 8ε, the
     convention of :class:`Halfspaces`."""
-    af = np.zeros((len(sign), through.shape[1] if len(sign) else 0))
+    af = np.zeros(through.shape)
     for r, (sub, s) in enumerate(zip(through.tolist(), sign.tolist(), strict=True)):
         normal = exact_normal(Yi, sub)
         unit = 1 << max(map(abs, normal)).bit_length()
