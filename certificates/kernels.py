@@ -362,6 +362,18 @@ def _normal(vecs: list[list[int]], k: int) -> list[int]:
     return [(-1) ** j * _det([row[:j] + row[j + 1:] for row in vecs]) for j in range(k)]
 
 
+def _normal_steps(k: int) -> int:
+    """Products :func:`_normal` spends: k Bareiss determinants of order k − 1, about
+    (k − 1)³/3 products each, beyond the closed forms of k ≤ 3."""
+    return k if k <= 3 else k * (k - 1) ** 3 // 3
+
+
+def _solve_steps(m: int) -> int:
+    """Products :func:`_solve` spends on an m x m system, counted as 2 m³: Gauss–Jordan
+    takes m²(m + 1) Fraction operations, each a few integer products and a gcd."""
+    return 2 * m ** 3
+
+
 def _solve(rows: list[list[int]], rhs: list[int]) -> Vec | None:
     """The unique solution of rows · x = rhs (square, exact), or None if singular."""
     m = len(rows)
@@ -569,7 +581,7 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
             W[s] += 1
     Q = [list(q) for q in first]
     u = len(Q)
-    steps = math.comb(u, k) * (u + len(T)) if k > 1 else u + len(T)
+    steps = math.comb(u, k) * (u + len(T) + _normal_steps(k)) if k > 1 else u + len(T)
     work = _cost(steps, bits)
     if work > MAX_HALFSPACE_WORK:
         ctx.trust("halfspaces", f"{part}: enumerating the hyperplanes through {k} of the "
@@ -768,9 +780,12 @@ def _poly_enumeration(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], 
     rE = len(BE)
     m = len(Fc)
     r1, r0 = d - 1 - rE, d - rE
-    subsets = (math.comb(m, r1) if r1 >= 0 else 0) + math.comb(m, r0)
+    rays = math.comb(m, r1) if r1 >= 0 else 0
+    subsets = rays + math.comb(m, r0)
     bits = _bit_size([a + [b] for a, b in E + Fc])
-    work = _cost(subsets * (m + len(E) + d * d), d * bits)
+    steps = (rays * (_normal_steps(d) + m + len(E))
+             + math.comb(m, r0) * (_solve_steps(d) + m + len(E)))
+    work = _cost(steps, d * bits)
     if work > MAX_POLY_WORK:
         ctx.trust("vertex enumeration", f"facets: P bounded with every vertex listed: "
                   f"enumerating {subsets} subsets of the {m} facets ({bits}-bit rows) needs "

@@ -1114,3 +1114,20 @@ def test_cli_on_kernel_certificates(tmp_path):
     nan = tmp_path / "nan.json"
     nan.write_text('{"rescon_certificate": 1, "kind": "kernel_point", "points": [[NaN]]}')
     assert _run(nan).returncode == 2
+
+
+def test_halfspace_enumeration_counts_the_cost_of_each_normal():
+    """20 integer points in R^8 and their mean (F = 0): C(20, 8) = 125 970 hyperplanes,
+    each normal 8 determinants of order 7. The work estimate counted only the point
+    classifications (2.6·10^6 < 3·10^6) and the check took 27 s for a 1 KB certificate;
+    now it is over the limit (unchecked) and answers at once. Just inside the limit
+    (14 points) the enumeration still runs and is valid."""
+    rng = random.Random(1)
+    for u, expect in ((20, "unchecked"), (14, "valid")):
+        pts = [[rng.randint(-1000, 1000) for _ in range(8)] for _ in range(u)]
+        x = [f"{sum(p[j] for p in pts)}/{u}" for j in range(8)]
+        cert = {"rescon_certificate": 1, "kind": "kernel_point", "points": pts, "F": 0,
+                "x": x, "proof": {"method": "halfspaces"}}
+        t0 = time.perf_counter()
+        res = check(cert)
+        assert res.verdict == expect and time.perf_counter() - t0 < 5, (u, res)
