@@ -37,6 +37,7 @@ from .graphs.sarymsakov import is_sarymsakov
 from .optim import check_subgradient, cost
 from .optim.redundancy import RedundancyReport, check_redundancy
 from .optim.rmdo import rmdo
+from .paper import PaperReport, reproduce_paper
 
 __version__ = "0.1.0"
 
@@ -47,6 +48,7 @@ __all__ = [
     "GraphFormatError",
     "InputError",
     "MissingDependency",
+    "PaperReport",
     "RESCONError",
     "RedundancyReport",
     "RobustnessCheck",
@@ -71,6 +73,7 @@ __all__ = [
     "kernel_point",
     "kernel_points",
     "max_s",
+    "reproduce_paper",
     "rmdo",
     "robustness",
     "safe_kernel",

@@ -300,6 +300,22 @@ def _cmd_redundancy(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_paper(args: argparse.Namespace) -> int:
+    """Exit 0 when the reproduction ran: claims that do not hold are findings, not
+    failures. ``--json``: the object of ``DIR/summary.json``."""
+    from .paper import reproduce_paper
+
+    rep = reproduce_paper(args.out)
+    lines = [f"{c.verdict:>13}  {c.claim}" for c in rep.claims]
+    verdicts = [c["verdict"] for c in rep.certificates]
+    lines.append(f"certificates: {len(verdicts)} written, "
+                 + ", ".join(f"{verdicts.count(v)} {v}" for v in sorted(set(verdicts))))
+    lines.append(f"written to {rep.out}: report.md, summary.json, {len(rep.figures)} figures "
+                 f"({rep.seconds:.1f} s)")
+    _emit(rep.summary, args.json, lines)
+    return 0
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     """Exit 0 valid, 1 invalid, 2 unreadable, 3 unchecked (the standalone checker's codes);
     ``--json``: one object with ``verdict``, ``valid``, ``readable``, ``reason``,
@@ -397,6 +413,12 @@ def _parser() -> argparse.ArgumentParser:
     red.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
     red.add_argument("--json", action="store_true", help="one JSON object on stdout")
     red.set_defaults(func=_cmd_redundancy)
+
+    pap = sub.add_parser("paper", help="reproduce the paper's example and check its claims")
+    pap.add_argument("--out", metavar="DIR", default="out/paper",
+                     help="figures, certificates, summary.json, report.md (default out/paper)")
+    pap.add_argument("--json", action="store_true", help="one JSON object on stdout (summary)")
+    pap.set_defaults(func=_cmd_paper)
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")

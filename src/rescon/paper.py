@@ -35,7 +35,7 @@ from .consensus.engine import simulate
 from .consensus.scenario import Scenario, ScenarioWarning
 from .graphs.attacks import check_assumption2, check_attack_model
 from .graphs.robustness import is_r_robust, robustness
-from .io import output_path, write_json
+from .io import output_path, to_jsonable, write_json
 from .optim.paper import paper_costs
 from .optim.redundancy import check_redundancy
 from .optim.rmdo import rmdo
@@ -76,7 +76,7 @@ class PaperReport:
         ``verdict`` ("valid", "invalid" or "unchecked", from the standalone checker on
         the file as written), ``reason``, ``unchecked``.
     figures : the PNG files written (names in ``out``).
-    summary : the JSON-ready content of ``summary.json``.
+    summary : the content of ``summary.json`` (JSON types; non-finite floats as null).
     seconds : wall time.
     """
 
@@ -328,7 +328,7 @@ class _Reproduction:
             entries[name] = (r, rep, cert)
             self.summary.setdefault("redundancy", {})[f"r{r}"] = {
                 "r": r, "holds": rep.holds, "exact": rep.exact, "gap": _finite(rep.gap),
-                "witness": _json(rep.witness), "unbounded": [list(s) for s in rep.unbounded],
+                "witness": to_jsonable(rep.witness), "unbounded": [list(s) for s in rep.unbounded],
                 "unbounded_agents": list(rep.unbounded_agents), "certificate": cert["file"]}
         r, rep, cert = entries["F"]
         N = len(costs)
@@ -431,11 +431,11 @@ class _Reproduction:
     def finish(self, seconds: float) -> PaperReport:
         from . import __version__
 
-        self.summary = {
+        self.summary = to_jsonable({
             "paper": PAPER, "rescon_version": __version__, "seconds": round(seconds, 3),
             "out": str(self.out), "reached_factor": REACHED,
             "claims": [vars(c) for c in self.claims], "certificates": self.certs,
-            "figures": self.figures, **self.summary}
+            "figures": self.figures, **self.summary})
         write_json(self.summary, self.out / "summary.json")
         (self.out / "report.md").write_text(_markdown(self), encoding="utf-8")
         return PaperReport(self.out, tuple(self.claims), tuple(self.certs),
@@ -487,13 +487,6 @@ def _finite(x: Any) -> float | None:
     return float(x) if x is not None and math.isfinite(x) else None
 
 
-def _json(x: Any) -> Any:
-    """JSON-ready, non-finite floats as null."""
-    from .io import to_jsonable
-
-    return to_jsonable(x)
-
-
 def _num(x: Any) -> str:
     return "unknown" if x is None else f"{x:.6g}"
 
@@ -528,14 +521,15 @@ def _witness_text(rep: Any, cert: dict[str, Any]) -> str:
 
 def _plot_centres(trajs: dict[str, Any], path: Path) -> Any:
     """Benign diameter and distance to the initial benign hull over time, one line per
-    Cen(Λ) choice (hold-last)."""
+    Cen(Λ) choice (hold-last). The diameter's log axis stops at the rounding floor
+    ε · (initial diameter): an exact 0 is drawn there."""
     from .plot import pyplot
 
     plt = pyplot(path)
     fig, (ax_d, ax_v) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
-    tiny = np.finfo(float).tiny
+    floor = np.finfo(float).eps * max(t.metrics["diameter"][0] for t in trajs.values())
     for (centre, t), style in zip(trajs.items(), ("-", "--", ":"), strict=False):
-        ax_d.plot(t.times, np.maximum(t.metrics["diameter"], tiny), ls=style, label=centre)
+        ax_d.plot(t.times, np.maximum(t.metrics["diameter"], floor), ls=style, label=centre)
         ax_v.plot(t.times, t.metrics["validity"], ls=style, label=centre)
     ax_d.set_yscale("log")
     ax_d.set_ylabel("diameter (benign)")
