@@ -70,3 +70,64 @@ def test_diameter_same_float_as_all_pairs(seed):
         with np.errstate(all="ignore"):
             assert diameter(X) == _diameter_n2(X)
     assert np.isnan(diameter(np.array([[np.nan, 1.0], [0.0, 0.0], [1.0, 1.0]])))
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_edge_distances_within_their_bound(seed):
+    """In the plane, states a facet proves outside get the edge distance: within
+    edge_error of the exact projection's distance, at scales 1e-40..1e40; zero exactly
+    for the states in the hull."""
+    rng = np.random.default_rng(seed)
+    for _ in range(8):
+        scale = 10.0 ** float(rng.integers(-40, 40))
+        mon = ValidityMonitor(rng.normal(size=(int(rng.integers(3, 30)), 2)) * scale)
+        X = rng.normal(size=(40, 2)) * scale * rng.choice([0.3, 1.0, 3.0, 1e3], size=(40, 1))
+        fast = mon.distances(X)
+        exact = np.array([mon.distance(x) for x in X])
+        assert np.all(np.abs(fast - exact) <= mon.edge_error(X))
+        assert np.array_equal(fast == 0, exact == 0)
+
+
+def test_far_states_need_no_exact_projection(monkeypatch):
+    """States that left the hull (RMDO's agents heading to X*): no exact projection
+    (it took ~1.5 ms per state, 1.5 s per step at N = 1000)."""
+    rng = np.random.default_rng(0)
+    mon = ValidityMonitor(rng.uniform(0, 10, size=(200, 2)))
+    X = rng.uniform(20, 30, size=(500, 2))
+    exact = np.array([mon.distance(x) for x in X])
+    monkeypatch.setattr(mon, "distance", lambda x: pytest.fail("exact path taken"))
+    assert np.all(np.abs(mon.distances(X) - exact) <= mon.edge_error(X))
+
+
+def test_boundary_and_extreme_states_take_the_exact_path():
+    """On an edge, one ulp outside it, or at magnitudes beyond 1e±100 the filter cannot
+    place the state or the bound does not apply: the exact distance is used."""
+    mon = ValidityMonitor(np.array([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]]))
+    on_edge = np.array([[1.5, 1.5], [1.0, 0.0]])
+    assert mon.distances(on_edge).tolist() == [0.0, 0.0]
+    out = np.array([[np.nextafter(1.5, 2), 1.5], [1.0, -2.0**-1074], [1e120, 0.0]])
+    assert mon.distances(out).tolist() == [mon.distance(x) for x in out]
+    assert mon.distances(out)[[0, 2]].min() > 0
+    tiny = ValidityMonitor(np.array([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]]) * 1e-200)
+    x = np.array([[4e-200, 4e-200]])
+    assert tiny.distances(x).tolist() == [tiny.distance(x[0])] and np.isinf(tiny.edge_error(x))
+
+
+def test_run_leaving_the_hull_same_states_validity_within_bound(monkeypatch):
+    """The paper's example with zero-fill under the mean filter leaves the benign hull:
+    the states are those of the exact-validity run, the validity within edge_error."""
+    from rescon.consensus.engine import simulate
+    from rescon.consensus.scenario import Scenario
+
+    sc = Scenario.paper_example(check_robustness=False, steps=30, algorithm="mean",
+                                policy="zero")
+    fast = simulate(sc)
+    mon = ValidityMonitor(fast.states[0, fast.benign])
+    monkeypatch.setattr("rescon.consensus.metrics._polygon_edges", lambda hull: None)
+    exact = simulate(sc)
+    assert np.array_equal(fast.states, exact.states)
+    assert exact.metrics["validity"].max() > 1  # the case does leave the hull
+    xb = fast.states[:, fast.benign].reshape(-1, 2)
+    err = mon.edge_error(xb).reshape(len(fast.times), -1)
+    diff = np.abs(fast.metrics["validity_per_agent"] - exact.metrics["validity_per_agent"])
+    assert np.all(diff <= err) and np.any(diff > 0)
