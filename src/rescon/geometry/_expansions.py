@@ -221,13 +221,28 @@ def exact_mean(Y, mean, err):
     """The mean of the rows of Y per coordinate: the exact sum (an expansion) rounded,
     then divided by the row count, into mean; err bounds |mean − exact mean| (2 ulps
     from the two roundings, plus the smallest normal for an underflowing quotient)."""
+    lo = np.empty(Y.shape[1])
+    mean_two(Y, mean, lo, np.empty(Y.shape[1]))
+    for c in range(Y.shape[1]):
+        err[c] = 4.0 * EPS * abs(mean[c]) + MIN_NORMAL
+
+
+@njit(cache=True, nogil=True)
+def mean_two(Y, hi, lo, err):
+    """The mean of the rows of Y as two doubles per coordinate: hi = fl(fl(Σ)/m) as in
+    exact_mean, lo = the rest (Σ − m·hi, exact as an expansion, rounded, over m);
+    err bounds |hi + lo − exact mean| (4 ulps of lo, plus the smallest normal)."""
     m = Y.shape[0]
-    e = np.empty(m)
+    e = np.empty(m + 2)
     for c in range(Y.shape[1]):
         for q in range(m):
             e[q] = Y[q, c]
-        mean[c] = approximate(e, compress(e, m)) / m
-        err[c] = 4.0 * EPS * abs(mean[c]) + MIN_NORMAL
+        n = compress(e, m)
+        hi[c] = approximate(e, n) / m
+        p, r = two_prod(float(m), hi[c])
+        e[n], e[n + 1] = -p, -r
+        lo[c] = approximate(e, compress(e, n + 2)) / m
+        err[c] = 4.0 * EPS * abs(lo[c]) + MIN_NORMAL
 
 
 @njit(cache=True, nogil=True)

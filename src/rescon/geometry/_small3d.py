@@ -48,7 +48,7 @@ from numba import njit
 
 from .._rounding import MIN_NORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
-from ._expansions import TINY, det3, exact_mean, normal3, orient3
+from ._expansions import TINY, det3, mean_two, normal3, orient3
 from ._small2d import ACCEPT_REL, cluster_box
 
 #: rounding-error factor of the 3 × 3 orientation (as in _candidates for k = 3)
@@ -508,17 +508,20 @@ def _cross(u, ue, v, ve, w, we):
 
 
 @njit(cache=True, nogil=True)
-def _residual(row, rowe, x, a, ae):
-    """fl(row · fl(x − a)) and a bound on its distance to row* · (x − a*), given
-    |row* − row| ≤ rowe and |a* − a| ≤ ae: (row* − row)·(x − a*) + row·((x − a*) − d)
-    + the dot product's rounding (γ₃ < 4u), d = fl(x − a) within u|d| of x − a."""
+def _residual(row, rowe, x, a, alo, ae):
+    """fl(row · fl(fl(x − a) − alo)) and a bound on its distance to row* · (x − a*),
+    given |row* − row| ≤ rowe and |a* − (a + alo)| ≤ ae (alo: the low part of a
+    two-double anchor, else 0): (row* − row)·(x − a*) + row·((x − a*) − d) + the dot
+    product's rounding (γ₃ < 4u), d within u(|d₁| + |d|) of x − a − alo."""
     val = 0.0
     bnd = 0.0
     for k in range(3):
-        d = x[k] - a[k]
+        d1 = x[k] - a[k]
+        d = d1 - alo[k]
         val += row[k] * d
-        bnd += (rowe[k] * (abs(d) * (1.0 + EPS) + ae[k])
-                + abs(row[k]) * (EPS * abs(d) + ae[k]) + 4.0 * EPS * abs(row[k] * d))
+        rnd = EPS * (abs(d1) + abs(d))
+        bnd += (rowe[k] * (abs(d) + rnd + ae[k]) + abs(row[k]) * (rnd + ae[k])
+                + 4.0 * EPS * abs(row[k] * d))
     return val, bnd * (1.0 + 8.0 * EPS) + 4.0 * MIN_NORMAL
 
 
@@ -628,16 +631,18 @@ def _nearest_of(Y, idx, x):
 
 
 @njit(cache=True, nogil=True)
-def _system(Y, cn, cne, tri, sel, ns, hint, mean, merr, M, Me, A, Ae):
+def _system(Y, cn, cne, tri, sel, ns, hint, mean, mlo, merr, M, Me, A, Alo, Ae):
     """The rows of M* x = r* (module docstring) as unit rows M (errors Me) with their
-    anchors A (errors Ae): the planes of S anchored at their data point nearest the
-    hint, then tangents n₁ × n₂ (|S| = 2) or n × e_a for the two axes a other than n's
-    largest component (|S| = 1), anchored at the mean. False if a row is unsafe."""
+    anchors A + Alo (errors Ae): the planes of S anchored at their data point nearest
+    the hint, then tangents n₁ × n₂ (|S| = 2) or n × e_a for the two axes a other than
+    n's largest component (|S| = 1), anchored at the two-double mean (mean + mlo).
+    False if a row is unsafe."""
     for r in range(ns):
         h = sel[r]
         if not _unit_row(cn[h], cne[h], M[r], Me[r]):
             return False
         A[r] = Y[_nearest_of(Y, tri[h], hint)]
+        Alo[r] = 0.0
         Ae[r] = 0.0
     t = np.empty(3)
     te = np.empty(3)
@@ -658,6 +663,7 @@ def _system(Y, cn, cne, tri, sel, ns, hint, mean, merr, M, Me, A, Ae):
                 r += 1
     for r in range(ns, 3):
         A[r] = mean
+        Alo[r] = mlo
         Ae[r] = merr
     return True
 
@@ -682,7 +688,7 @@ def _solution(M, A, x):
 
 
 @njit(cache=True, nogil=True)
-def _error_bound(M, Me, A, Ae, x, kappa):
+def _error_bound(M, Me, A, Alo, Ae, x, kappa):
     """β ≥ ‖x − x*‖₂, x* = the exact solution of M* x = r*: with ρ the anchored float
     residuals (each within e_i of ρ*_i = M*_i x − r*_i) and δ = fl(M⁻¹ρ),
     x − x* − δ = M*⁻¹(ρ* − M*δ), so β = ‖δ‖₂ + κ ‖ρ* − M*δ‖₂: κ multiplies only
@@ -690,7 +696,7 @@ def _error_bound(M, Me, A, Ae, x, kappa):
     rho = np.empty(3)
     e = np.empty(3)
     for r in range(3):
-        rho[r], e[r] = _residual(M[r], Me[r], x, A[r], Ae[r])
+        rho[r], e[r] = _residual(M[r], Me[r], x, A[r], Alo[r], Ae[r])
     delta = rho.copy()
     if not _solve(M, delta):
         return np.inf
@@ -707,18 +713,19 @@ def _error_bound(M, Me, A, Ae, x, kappa):
 
 
 @njit(cache=True, nogil=True)
-def _multipliers_positive(M, Me, ns, two_sided, x, beta, kappa, mean, merr):
+def _multipliers_positive(M, Me, ns, two_sided, x, beta, kappa, mean, mlo, merr):
     """m* − x* = Σ_r λ_r M*_r (tangent rows: λ = 0): λ from Mᵀ μ = fl(m − x), with
     ‖λ − μ‖₂ ≤ κ ‖M*ᵀμ − (m* − x*)‖₂ bounded by the float residual, the row errors,
     the mean's error and β. True if μ_r exceeds that on every one-sided row."""
-    g = mean - x
+    g1 = mean - x
+    g = g1 + mlo  # m* − x within u(|g₁| + |g|) + merr
     mu = g.copy()
     if not _solve(M.T.copy(), mu):
         return False
     w2 = 0.0
     for k in range(3):
         res = -g[k]
-        bnd = EPS * abs(g[k]) + merr[k]
+        bnd = EPS * (abs(g1[k]) + abs(g[k])) + merr[k]
         for i in range(3):
             res += M[i, k] * mu[i]
             bnd += Me[i, k] * abs(mu[i]) + 4.0 * EPS * abs(M[i, k] * mu[i])
@@ -753,7 +760,7 @@ def _others_satisfied(Y, cn, cne, tri, sgn, sel, ns, x, beta, point):
                 return False
             continue
         a = Y[_nearest_of(Y, tri[h], x)]
-        val, bnd = _residual(cn[h], cne[h], x, a, np.zeros(3))
+        val, bnd = _residual(cn[h], cne[h], x, a, np.zeros(3), np.zeros(3))
         norm = math.sqrt(cn[h] @ cn[h]) + math.sqrt(cne[h] @ cne[h])
         if not val + bnd + norm * beta * (1.0 + 4.0 * EPS) < 0.0:
             return False
@@ -768,8 +775,9 @@ def _certify(Y, F, planes, hint, have_hint, s, x):
     (declined)."""
     cn, cne, tri, eq, sgn = planes
     mean = np.empty(3)
+    mlo = np.empty(3)
     merr = np.empty(3)
-    exact_mean(Y, mean, merr)
+    mean_two(Y, mean, mlo, merr)
     sel = np.empty(3, dtype=np.int64)
     ns = _pinning_planes(cn, eq, sel) if len(Y) >= 4 * F + 1 else 0
     if ns < 3:
@@ -781,13 +789,15 @@ def _certify(Y, F, planes, hint, have_hint, s, x):
         two_sided[r] = eq[sel[r]]
     if ns == 0:
         x[:] = mean
-        beta = math.sqrt(merr @ merr) * (1.0 + 4.0 * EPS)
+        gap = np.abs(mlo) + merr  # (x = the high part)
+        beta = math.sqrt(gap @ gap) * (1.0 + 4.0 * EPS)
         return beta if _others_satisfied(Y, cn, cne, tri, sgn, sel, 0, x, beta, -1) else -1.0
     M = np.empty((3, 3))
     Me = np.empty((3, 3))
     A = np.empty((3, 3))
     Ae = np.empty((3, 3))
-    if not _system(Y, cn, cne, tri, sel, ns, hint, mean, merr, M, Me, A, Ae):
+    Alo = np.empty((3, 3))
+    if not _system(Y, cn, cne, tri, sel, ns, hint, mean, mlo, merr, M, Me, A, Alo, Ae):
         return -1.0
     kappa = _inverse_bound(M, Me)
     if not kappa < np.inf:
@@ -799,19 +809,19 @@ def _certify(Y, F, planes, hint, have_hint, s, x):
     else:
         if not _solution(M, A, x):
             return -1.0
-        beta = _error_bound(M, Me, A, Ae, x, kappa)
+        beta = _error_bound(M, Me, A, Alo, Ae, x, kappa)
     if not np.isfinite(beta):
         return -1.0
     if ns == 3 and two_sided.all() and len(Y) >= 4 * F + 1:
         return beta  # Ψ ≠ ∅ lies on three independent planes: Ψ = {x*}
-    if not (_multipliers_positive(M, Me, ns, two_sided, x, beta, kappa, mean, merr)
-            or _other_choice(Y, planes, sel, ns, point, x, beta, mean, merr)):
+    if not (_multipliers_positive(M, Me, ns, two_sided, x, beta, kappa, mean, mlo, merr)
+            or _other_choice(Y, planes, sel, ns, point, x, beta, mean, mlo, merr)):
         return -1.0
     return beta if _others_satisfied(Y, cn, cne, tri, sgn, sel, ns, x, beta, point) else -1.0
 
 
 @njit(cache=True, nogil=True)
-def _other_choice(Y, planes, sel, ns, point, x, beta, mean, merr):
+def _other_choice(Y, planes, sel, ns, point, x, beta, mean, mlo, merr):
     """At a degenerate x* — the data point Y[point], or on the line pq of two data
     points two planes of S share — every plane through that point (line) contains x*,
     and the normal cone is spanned by some choice of them: try the choices (at most
@@ -834,6 +844,7 @@ def _other_choice(Y, planes, sel, ns, point, x, beta, mean, merr):
     M = np.empty((3, 3))
     Me = np.empty((3, 3))
     A = np.empty((3, 3))
+    Alo = np.empty((3, 3))
     Ae = np.empty((3, 3))
     trial = keep.copy()
     two_sided = np.zeros(3, dtype=np.bool_)
@@ -846,11 +857,11 @@ def _other_choice(Y, planes, sel, ns, point, x, beta, mean, merr):
             trial[nk + r] = members[combo[r]]
         for r in range(ns):
             two_sided[r] = eq[trial[r]]
-        if not _system(Y, cn, cne, tri, trial, ns, x, mean, merr, M, Me, A, Ae):
+        if not _system(Y, cn, cne, tri, trial, ns, x, mean, mlo, merr, M, Me, A, Alo, Ae):
             continue
         kappa = _inverse_bound(M, Me)
         if kappa < np.inf and _multipliers_positive(M, Me, ns, two_sided, x, beta, kappa,
-                                                     mean, merr):
+                                                     mean, mlo, merr):
             sel[:ns] = trial[:ns]
             return True
     return False
