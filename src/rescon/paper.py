@@ -76,7 +76,13 @@ class PaperReport:
         ``verdict`` ("valid", "invalid" or "unchecked", from the standalone checker on
         the file as written), ``reason``, ``unchecked``.
     figures : the PNG files written (names in ``out``).
-    summary : the content of ``summary.json`` (JSON types; non-finite floats as null).
+    summary : the content of ``summary.json`` (JSON types; non-finite floats as null):
+        ``paper``, ``rescon_version``, ``seconds``, ``out``, ``reached_factor``
+        (:data:`REACHED`), ``claims`` (``id``, ``claim``, ``verdict``, ``evidence``),
+        ``certificates``, ``figures``, and the measurements: ``graph``, ``algorithm1``
+        (one entry per policy_centre run, and ``residual_total``), ``redundancy``
+        (``r2``, ``r4``), ``optimum`` (X*: ``exact``, ``point``, ``value``, ``method``)
+        and ``algorithm2`` (with ``long_run``).
     seconds : wall time.
     """
 
@@ -145,11 +151,15 @@ class _Phases:
                             desc="rescon paper")
 
     def run(self, name: str, part: Callable[[], None]) -> None:
-        if self.bar is not None:
-            self.bar.set_postfix_str(name)
+        self.note(name)
         part()
         if self.bar is not None:
             self.bar.update(1)
+
+    def note(self, text: str) -> None:
+        """Say what runs now (the bar's postfix)."""
+        if self.bar is not None:
+            self.bar.set_postfix_str(text)
 
     def close(self) -> None:
         if self.bar is not None:
@@ -279,6 +289,7 @@ class _Reproduction:
         runs = {f"{p}_{c}": (p, c) for p, c in [("hold", c) for c in CENTRES] + [("zero", "centroid")]}
         trajs = {}
         for key, (policy, centre) in runs.items():
+            self.phases.note(f"Algorithm 1, {policy}, {centre} centre")
             trajs[key] = simulate(Scenario.paper_example(policy=policy, centre=centre),
                                   progress=self.bars)
         self.summary["algorithm1"] = {k: _run_summary(t) for k, t in trajs.items()}
