@@ -62,6 +62,9 @@ INDEPENDENT_TOL = 1e-12
 OK, DECLINED = 0, 1
 #: at a degenerate answer, at most this many other choices of S are tried
 MAX_CHOICES = 500
+#: when the hint's proposal fails, every S of at most three among this many
+#: halfspaces nearest the hint is tried
+NEAR_CANDIDATES = 8
 #: the dual active-set method: its step limit and its feasibility tolerance (local units)
 GI_MAX_STEPS = 200
 GI_TOL = 1e-13
@@ -585,10 +588,8 @@ def _pinning_planes(cn, eq, sel):
 
 
 @njit(cache=True, nogil=True)
-def _propose(Y, cn, tri, eq, hint, s, sel):
-    """The active set S proposed by the hint: halfspaces within ACTIVE_TOL·s of tight,
-    two-sided planes first, then by slack, each kept if its normal is independent of
-    those kept (INDEPENDENT_TOL); into sel, returns |S| ≤ 3. A proposal only."""
+def _slacks(Y, cn, tri, hint):
+    """|distance| of the hint to each halfspace's plane (floats; a hint only)."""
     nh = len(cn)
     dist = np.empty(nh)
     for h in range(nh):
@@ -597,6 +598,15 @@ def _propose(Y, cn, tri, eq, hint, s, sel):
         for k in range(3):
             v += cn[h, k] * (hint[k] - Y[i, k])
         dist[h] = abs(v) / math.sqrt(cn[h, 0] ** 2 + cn[h, 1] ** 2 + cn[h, 2] ** 2)
+    return dist
+
+
+@njit(cache=True, nogil=True)
+def _propose(cn, eq, dist, s, sel):
+    """The active set S proposed by the hint (its slacks dist): halfspaces within
+    ACTIVE_TOL·s of tight, two-sided planes first, then by slack, each kept if its
+    normal is independent of those kept (INDEPENDENT_TOL); into sel, returns
+    |S| ≤ 3. A proposal only."""
     order = np.argsort(dist)
     basis = np.zeros((3, 3))
     ns = 0
@@ -773,17 +783,41 @@ def _certify(Y, F, planes, hint, have_hint, s, x):
     independent two-sided planes when they pin Ψ to a point (no hint needed), else from
     the active set the hint proposes. Writes x, returns β ≥ ‖x − x*‖₂, or −1
     (declined)."""
-    cn, cne, tri, eq, sgn = planes
+    cn, _, tri, eq, _ = planes
     mean = np.empty(3)
     mlo = np.empty(3)
     merr = np.empty(3)
     mean_two(Y, mean, mlo, merr)
     sel = np.empty(3, dtype=np.int64)
     ns = _pinning_planes(cn, eq, sel) if len(Y) >= 4 * F + 1 else 0
-    if ns < 3:
-        if not have_hint:
-            return -1.0
-        ns = _propose(Y, cn, tri, eq, hint, s, sel)
+    if ns == 3:
+        beta = _certify_choice(Y, F, planes, sel, ns, hint, mean, mlo, merr, x)
+        if beta >= 0.0:
+            return beta
+    if not have_hint:
+        return -1.0
+    dist = _slacks(Y, cn, tri, hint)
+    ns = _propose(cn, eq, dist, s, sel)
+    beta = _certify_choice(Y, F, planes, sel, ns, hint, mean, mlo, merr, x)
+    if beta >= 0.0:
+        return beta
+    # the hint's proposal failed (an inaccurate hint on an ill-conditioned set): every
+    # choice of at most three among the NEAR_CANDIDATES halfspaces nearest it
+    near = np.argsort(dist)[:NEAR_CANDIDATES]
+    for size in range(1, 4):
+        for combo in _combinations(len(near), size):
+            for r in range(size):
+                sel[r] = near[combo[r]]
+            beta = _certify_choice(Y, F, planes, sel, size, hint, mean, mlo, merr, x)
+            if beta >= 0.0:
+                return beta
+    return -1.0
+
+
+@njit(cache=True, nogil=True)
+def _certify_choice(Y, F, planes, sel, ns, hint, mean, mlo, merr, x):
+    """_certify for the active set S = sel[:ns]: writes x, returns β or −1."""
+    cn, cne, tri, eq, sgn = planes
     two_sided = np.zeros(3, dtype=np.bool_)
     for r in range(ns):
         two_sided[r] = eq[sel[r]]
