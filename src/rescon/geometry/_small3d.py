@@ -15,8 +15,9 @@ through it). The set is first scaled by a power of two (exact) so that its large
 The point of Ψ nearest mean(Y) is then found in floats — a hint: a dual active-set
 method in numba (Goldfarb–Idnani), and for the sets where it stalls or its hint fails
 the certificate, the QP solver (clarabel, one batch call). The hint only proposes the
-active set S (halfspaces tight at it, at most three independent ones); the answer is
-certified by :func:`_certify`, with rigorous rounding bounds throughout:
+active set S (halfspaces tight at it, at most three independent ones; if that fails,
+every S of at most three among the NEAR_CANDIDATES halfspaces nearest it); the answer
+is certified by :func:`_certify`, with rigorous rounding bounds throughout:
 
 * x* is the exact solution of the 3 × 3 system M* x = r*: the planes of S,
   n_s · (x − p_s) = 0, anchored at a data point p_s of each, and, for |S| < 3, the
@@ -36,7 +37,9 @@ certified by :func:`_certify`, with rigorous rounding bounds throughout:
   undecided, singular or non-finite is declined (the exact path computes it).
 
 Before all this, a converged cluster — m − F points in a box a few ulps wide — is
-answered by one of its points (:func:`._small2d.cluster_box`: Ψ lies in that box).
+answered by one of its points (:func:`._small2d.cluster_box`: Ψ lies in that box), and
+five points with F = 1 by their Radon point from exactly rounded determinants
+(:func:`_radon5`), however flat they are.
 """
 
 from __future__ import annotations
