@@ -23,7 +23,6 @@ __all__ = [
     "exact_points",
     "float_view",
     "fraction_str",
-    "int_vector",
     "nullspace_exact",
     "solve_exact",
 ]
@@ -255,15 +254,3 @@ def nullspace_exact(M: list[list[Fraction]]) -> list[list[Fraction]]:
             v[pc] = -A[i][fc]
         basis.append(v)
     return basis
-
-
-def int_vector(v: list[Fraction]) -> tuple[int, ...]:
-    """The primitive integer vector with the direction of the rational vector v."""
-    den = 1
-    for x in v:
-        den = den * x.denominator // gcd(den, x.denominator)
-    ints = [int(x * den) for x in v]
-    g = 0
-    for x in ints:
-        g = gcd(g, x)
-    return tuple(x // g for x in ints) if g else tuple(ints)
