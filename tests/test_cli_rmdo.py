@@ -353,3 +353,17 @@ def test_redundancy_bad_input(capsys, tmp_path):
                  "--certificate", "is a directory")
     code, out, err = run(["redundancy", p], capsys)  # --r is required
     assert code == 2 and "--r" in err and out == ""
+
+
+@pytest.mark.parametrize("argv", [
+    ["rmdo", EXAMPLES / "paper_rmdo.toml", "--json"],
+    ["redundancy", EXAMPLES / "paper_rmdo.toml", "--r", "2", "--json"],
+])
+def test_subprocess_stdout_is_one_json_object(argv):
+    """In a fresh process (solver banners are written at the C level, past capsys):
+    stdout is exactly one JSON object."""
+    res = subprocess.run([sys.executable, "-m", "rescon.cli", *map(str, argv)],
+                         capture_output=True, text=True, timeout=300, check=False)
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    assert len(lines) == 1 and isinstance(json.loads(lines[0]), dict), res.stdout
