@@ -174,7 +174,7 @@ def test_module_costs(capsys, tmp_path):
 def test_costs_file_for_redundancy(tmp_path):
     costs, d = read_costs(write(tmp_path, '[costs]\n1 = "x1^2"\n2 = "abs(x3)"\n'))
     assert d == 3 and sorted(costs) == [1, 2] and costs[1].d == 3
-    costs, d = read_costs(write(tmp_path, 'd = 4\n[costs]\na = "x1^2"\n'))
+    costs, d = read_costs(write(tmp_path, 'd = 4\n[costs]\nalgorithm = "rmdo"\na = "x1^2"\n'))
     assert (d, list(costs), costs["a"].d) == (4, ["a"], 4)
     costs, d = read_costs(EXAMPLES / "paper_rmdo.toml")
     assert d == 2 and sorted(costs) == [1, 3, 4, 5, 6, 7, 8, 9, 10, 11]
@@ -183,7 +183,9 @@ def test_costs_file_for_redundancy(tmp_path):
     for text, needle in (('d = 0\n[costs]\n1 = "x1^2"\n', "d must be"),
                          ('d = 2\n', "needs a [costs] table"),
                          ('d = 1\n[costs]\n1 = "x2^2"\n', "x2 is used but d = 1"),
-                         ('[costs]\n1 = "x1^2 +"\n', "position 6")):
+                         ('[costs]\n1 = "x1^2 +"\n', "position 6"),
+                         ('D = 2\n[costs]\n1 = "x1^2"\n', "unknown keys ['D']"),
+                         ('[costs]\nalgorithm = "alg1"\n1 = "x1^2"\n', "algorithm must be")):
         with pytest.raises(InputError, match=r".*" + needle.replace("[", r"\[")):
             read_costs(write(tmp_path, text))
 

@@ -17,8 +17,10 @@ parser itself) with two more tables::
                                   # "harmonic" (a, b): 1/(a t_k + b); "sqrt_decay" (c):
                                   # c/sqrt(k + 1); "constant" (value)
 
-``module``, ``paper`` and ``f7`` are reserved: they are not node labels. Agents given
-the same expression string share one oracle (one call per step for all of them).
+``module``, ``paper``, ``f7`` and ``algorithm`` are reserved: they are not node labels.
+``algorithm = "rmdo"`` (its only value) may mark the table, as sweep grids do
+(``[base.costs]``, DESIGN.md). Agents given the same expression string share one
+oracle (one call per step for all of them).
 
 A costs file (``rescon redundancy``) is ``[costs]`` and an optional top-level ``d``
 (default: the largest variable index its expressions use), or a whole RMDO file (its
@@ -44,7 +46,7 @@ from .steps import StepSize, constant, harmonic, sqrt_decay
 
 __all__ = ["RMDOFile", "read_costs", "read_rmdo"]
 
-_RESERVED = {"module", "paper", "f7"}
+_RESERVED = {"module", "paper", "f7", "algorithm"}
 #: [step_size] kinds → (their parameters, the preset built from them)
 _STEP_KINDS: dict[str, tuple[tuple[str, ...], Any]] = {
     "paper": ((), lambda: harmonic(5.0, 1.0)),
@@ -92,10 +94,11 @@ def read_costs(path: str | Path) -> tuple[dict[Hashable, Oracle], int]:
     """The costs of a costs file and their dimension d (format: module docstring)."""
     p = Path(path)
     data = read_toml(p)
-    if set(data) - {"d", "costs"}:  # a whole RMDO file: its benign agents' costs
+    if set(data) & {"scenario", "graph", "initial"}:  # an RMDO file: its benign agents'
         f = read_rmdo(p)
         benign = set(f.scenario.benign)
         return {v: o for v, o in f.costs.items() if v in benign}, f.scenario.d
+    _keys(data, {"d", "costs"}, str(p))
     if "costs" not in data:
         raise InputError(f"{p}: a costs file needs a [costs] table")
     table = _table(data, "costs", str(p))
@@ -122,6 +125,10 @@ def _costs(table: Mapping[str, Any], p: Path, d: int | None, nodes: Any = None
     """[costs] as oracles over R^d, one per distinct source (same string or object);
     with ``nodes`` (the scenario's graph), agents that are not nodes are refused first."""
     where = f"{p} [costs]"
+    if table.get("algorithm", "rmdo") != "rmdo":
+        raise InputError(f"{where}: algorithm must be \"rmdo\" (or left out); got "
+                         f"{table['algorithm']!r}")
+    table = {k: v for k, v in table.items() if k != "algorithm"}
     if "paper" in table or "f7" in table:
         return _paper(table, where)
     specs: dict[Hashable, Any] = {_label(k): v for k, v in table.items() if k not in _RESERVED}
