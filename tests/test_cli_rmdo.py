@@ -369,3 +369,18 @@ def test_subprocess_stdout_is_one_json_object(argv):
     assert res.returncode == 0, res.stderr
     lines = res.stdout.splitlines()
     assert len(lines) == 1 and isinstance(json.loads(lines[0]), dict), res.stdout
+
+
+def test_unbounded_costs_null_optimum(capsys, tmp_path):
+    """Σ f_i unbounded below (affine costs): X* empty, reported as nulls (F* = -inf is
+    not JSON), the run still goes ahead; the text output says why."""
+    costs = "".join(f'{i} = "x1 + {i}*x2"\n' for i in range(5))
+    p = write(tmp_path, BASE + "[costs]\n" + costs + '[step_size]\nkind = "constant"\n'
+              "value = 0.01\n")
+    out = run_json(["rmdo", p], capsys)
+    opt = out["optimum"]
+    assert opt["exact"] is True and opt["point"] is None and opt["value"] is None
+    assert "unbounded" in opt["reason"]
+    assert out["final_distance_to_optimum"] is None and out["final_gap"] is None
+    code, text, _ = run(["rmdo", p], capsys)
+    assert code == 0 and "X* not known" in text and "unbounded" in text
