@@ -22,6 +22,11 @@ parser itself) with two more tables::
 (``[base.costs]``, DESIGN.md). Agents given the same expression string share one
 oracle (one call per step for all of them).
 
+[costs] is what makes a file an RMDO file: ``rescon rmdo`` requires it, and
+``Scenario.from_toml`` / ``rescon simulate`` refuse a file that has it (Algorithm 1
+would silently ignore the costs). Examples: ``examples/scenarios/paper_rmdo.toml``,
+``rmdo_quadratic.toml``.
+
 A costs file (``rescon redundancy``) is ``[costs]`` and an optional top-level ``d``
 (default: the largest variable index its expressions use), or a whole RMDO file (its
 benign agents' costs, d of its states).
