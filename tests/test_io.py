@@ -232,6 +232,10 @@ def test_read_points_npy(tmp_path):
         ("1,2\n-inf,0\n", r"p\.csv:2: column 1: coordinates must be finite"),
         ("", r"p\.csv: no points"),
         ("x,y\n", r"p\.csv: no points after the header row"),
+        # a first row mixing numbers and other cells is a bad point, not a header
+        # (it was dropped silently: "1+2j,2" gave n = 2)
+        ("1+2j,2\n3,4\n5,6\n", r"p\.csv:1: column 1: '1\+2j' is not a number"),
+        ("x,2\n3,4\n", r"p\.csv:1: column 1: 'x' is not a number"),
     ],
 )
 def test_read_points_csv_errors(tmp_path, text, pattern):

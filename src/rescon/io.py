@@ -276,8 +276,9 @@ def read_points(path: str | os.PathLike[str]) -> np.ndarray:
     ----------
     path : str or os.PathLike
         ``.npy``: a 2-D numeric array (no pickles). Anything else: CSV with n rows
-        of d comma-separated numbers, an optional header row (recognised by a
-        non-number cell, ignored), ``#`` comment lines and blank lines ignored.
+        of d comma-separated numbers, an optional header row (recognised by
+        having no number cell, ignored; a first row mixing numbers and other cells
+        is an error), ``#`` comment lines and blank lines ignored.
 
     Returns
     -------
@@ -298,7 +299,7 @@ def read_points(path: str | os.PathLike[str]) -> np.ndarray:
     if not rows:
         raise InputError(f"{p}: no points (expected n >= 1 rows of d numbers)")
     first_line, width = rows[0][0], len(rows[0][1])
-    if any(_number(c) is None for c in rows[0][1]):
+    if all(_number(c) is None for c in rows[0][1]):  # a header; a mixed row is a bad point
         rows = rows[1:]
         if not rows:
             raise InputError(f"{p}: no points after the header row")
