@@ -59,6 +59,7 @@ def run(quick: bool) -> list[dict]:
         warnings.simplefilter("ignore")
         simulate(case(20, 2, 1, 2))  # compile numba kernels outside the timings
         simulate(case(20, 3, 1, 2))
+        simulate(case(20, 3, 2, 2))  # (F = 2 in R³ takes the general certificate)
         sc = Scenario.paper_example(steps=200)
         sec, _ = timed(lambda: simulate(sc))
         rows.append({"case": "paper example (N=12, d=2, F=2)", "steps": 200,
