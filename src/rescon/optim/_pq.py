@@ -39,6 +39,7 @@ F(x + tv) decreases without bound in t.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
@@ -284,11 +285,59 @@ def certify(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], muf: list[np.ndarray]
     multipliers positive; the result is kept only when :func:`check_optimal` accepts it."""
     for guess in ("support", "active"):
         S = _support(F, xf, lamf, guess)
-        for project in (False, True):
-            sol = _solve_system(F, S, xf, lamf, muf, project)
+        for sol in _candidates(F, S, xf, lamf, muf):
             if sol is not None and check_optimal(F, *sol) is None:
                 return describe(F, *sol)
     return None
+
+
+def _candidates(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray],
+                muf: list[np.ndarray]) -> Iterator[tuple[list[Fraction], Mult, Mult] | None]:
+    """Solutions to try, lazily (the joint systems are large): two-stage, then joint
+    with free unknowns at the floats, then joint projected."""
+    yield _two_stage(F, S, xf, lamf, muf)
+    for project in (False, True):
+        yield _solve_system(F, S, xf, lamf, muf, project)
+
+
+def _two_stage(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray],
+               muf: list[np.ndarray]) -> tuple[list[Fraction], Mult, Mult] | None:
+    """The fast path when the active pieces and zero norm residuals pin x down: x from
+    those equalities alone (d unknowns), then the multipliers from the d stationarity
+    equations with λ_kj₀ = 1 − Σ_{j≠j₀} λ_kj substituted, projected exactly from the
+    floats (a d-row system however many blocks there are). None when x is not pinned."""
+    d = F.d
+    eq = [[u - v for u, v in zip(F.blocks[k][j][0], F.blocks[k][s[0]][0], strict=True)]
+          + [F.blocks[k][s[0]][1] - F.blocks[k][j][1]] for k, s in enumerate(S) for j in s[1:]]
+    eq += [list(a) + [ci] for A, c in F.norms for a, ci in zip(A, c, strict=True)]
+    piv = _rref(eq, d) if eq else []
+    if len(piv) < d or any(row[d] for row in eq[d:]):
+        return None
+    x = [row[d] for row in eq[:d]]
+    rhs = [-(_dot(row, x) + gi) for row, gi in zip(F.H, F.g, strict=True)]
+    cols, guess = [], []
+    for k, s in enumerate(S):
+        a0 = F.blocks[k][s[0]][0]
+        rhs = [u - v for u, v in zip(rhs, a0, strict=True)]
+        for j in s[1:]:
+            cols.append([u - v for u, v in zip(F.blocks[k][j][0], a0, strict=True)])
+            guess.append(rational(lamf[k][j]))
+    for (A, _), m in zip(F.norms, muf, strict=True):
+        cols += [list(a) for a in A]
+        guess += [rational(v) for v in m]
+    C = [[col[i] for col in cols] + [rhs[i]] for i in range(d)]
+    cpiv = _rref(C, len(cols)) if cols else []
+    if any(row[len(cols)] for row in C[len(cpiv):]):
+        return None
+    u = _project(C[:len(cpiv)], guess) if cpiv else guess
+    lam = [[Fraction(0)] * len(blk) for blk in F.blocks]
+    it = iter(u)
+    for k, s in enumerate(S):
+        rest = [next(it) for _ in s[1:]]
+        lam[k][s[0]] = 1 - sum(rest, Fraction(0))
+        for j, v in zip(s[1:], rest, strict=True):
+            lam[k][j] = v
+    return x, lam, [[next(it) for _ in c] for _, c in F.norms]
 
 
 def _support(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], guess: str) -> list[list[int]]:

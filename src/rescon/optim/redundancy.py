@@ -244,23 +244,24 @@ class _Check:
                 else math.inf if "unbounded" in (s.status, ref.status)
                 else self.gap(s, ref) for s in subs]
         gap = max(gaps, default=0.0) if nonempty else 0.0
-        wit = self.exact_witness(subs, ref)
+        odd = [s for s in subs if not self.equal(s, subs[0])]
+        if not odd:  # every subset certified and equal to the first: the definition
+            return self.report(True, True, None, gap, unbounded, alone, subs=subs)
+        wit = self.exact_witness(odd, subs, ref)
         if wit is not None:
             return self.report(False, True, wit, gap, unbounded, alone)
-        all_exact = all(s.certified for s in subs) and (ref.certified or not nonempty)
-        if all_exact and (not nonempty or all(self.equal(s, ref) for s in subs)):
-            return self.report(True, True, None, gap, unbounded, alone, subs=subs)
         tol = self.tolerance(subs + [ref])
         holds = not nonempty or gap <= tol
         wit = None if holds else self.numerical_witness(subs, ref, gaps)
         return self.report(holds, False, wit, gap, unbounded, alone, tol=tol)
 
-    def equal(self, s: _Set, ref: _Set) -> bool:
-        """A_S = A*, exactly (both certified affine sets, or both empty)."""
-        if s.status == "unbounded" or ref.status == "unbounded":
-            return s.status == ref.status
-        a, b = s.opt, ref.opt
-        return a.affine and b.affine and a.rref == b.rref and b.contains(a.x)
+    def equal(self, s: _Set, t: _Set) -> bool:
+        """A_S = A_T proven exactly (both certified affine sets, or both certified empty)."""
+        if s.ray is not None or t.ray is not None:
+            return s.ray is not None and t.ray is not None
+        a, b = s.opt, t.opt
+        return (a is not None and b is not None and a.affine and b.affine and a.rref == b.rref
+                and b.contains(a.x))
 
     def gap(self, s: _Set, ref: _Set) -> float:
         """Hausdorff distance of two nonempty argmins: exact formula for affine sets,
@@ -286,21 +287,19 @@ class _Check:
 
     # -- witnesses --------------------------------------------------------------- #
 
-    def exact_witness(self, subs: list[_Set], ref: _Set) -> dict[str, Any] | None:
-        """A certified S1 (minimiser x1) and S2 (a subset or all) with x1 ∉ A_S2."""
-        opts = [s for s in subs if s.opt is not None]
-        others = [ref] + subs if ref.certified else subs
-        tried = 0
-        for s1 in opts:
-            for s2 in others:
-                if s2 is s1:
-                    continue
+    def exact_witness(self, odd: list[_Set], subs: list[_Set], ref: _Set
+                      ) -> dict[str, Any] | None:
+        """A certified S1 (minimiser x1) and S2 (a subset or all) with x1 ∉ A_S2, among
+        the pairs involving a subset not proven equal to the first (``odd``): against
+        the whole set and the first subset, then against every subset (at most
+        MAX_PAIRS exact comparisons)."""
+        first = [(s, t) for s in odd for t in (ref, subs[0])] + [(subs[0], s) for s in odd]
+        rest = ((s, t) for s in odd for t in subs)
+        for s1, s2 in itertools.islice(itertools.chain(first, rest), MAX_PAIRS):
+            if s1.opt is not None and s2 is not s1 and s2.certified:
                 w = _separation(s1, s2)
                 if w is not None:
                     return w
-                tried += 1
-                if tried >= MAX_PAIRS:
-                    return None
         return None
 
     def numerical_witness(self, subs: list[_Set], ref: _Set, gaps: list[float]
