@@ -128,3 +128,27 @@ def test_out_that_is_a_file_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("rescon: error: out:") and "not a directory" in err
     assert len(err.splitlines()) == 1
+
+
+def test_redundancy_without_a_solver_is_not_decided(tmp_path, monkeypatch):
+    """Without cvxpy (core install + [plot]) the r = 2F check needs a solver it lacks:
+    the claim is "not decided" with the install hint, the other parts still run."""
+    from rescon import paper
+    from rescon.errors import SolverNotFound
+
+    real = paper.check_redundancy
+
+    def no_cvxpy(costs, r, **kw):
+        if r == 4:
+            raise SolverNotFound("backend 'cvxpy' is not installed (pip install cvxpy)")
+        return real(costs, r, **kw)
+
+    monkeypatch.setattr(paper, "check_redundancy", no_cvxpy)
+    run = _Reproduction(tmp_path, progress=False)
+    run.redundancy()
+    verdicts = {c.id: (c.verdict, c.evidence) for c in run.claims}
+    assert verdicts["costs_F_redundant"][0] == "holds"
+    assert verdicts["costs_2F_redundant"][0] == "not decided"
+    assert "rescon[solvers]" in verdicts["costs_2F_redundant"][1]
+    assert run.summary["redundancy"]["r4"]["holds"] is None
+    assert run.summary["optimum"]["exact"] and not (tmp_path / "redundancy_r4.cert.json").exists()

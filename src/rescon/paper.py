@@ -33,6 +33,7 @@ from .certify import check_certificate
 from .consensus.dos import PAPER_MU_D, PAPER_T_D, check_assumption3
 from .consensus.engine import simulate
 from .consensus.scenario import Scenario, ScenarioWarning
+from .errors import SolverNotFound
 from .graphs.attacks import check_assumption2, check_attack_model
 from .graphs.robustness import is_r_robust, robustness
 from .io import output_path, to_jsonable, write_json
@@ -332,66 +333,76 @@ class _Reproduction:
     # ----------------------------------------------------------------- redundancy, X*
 
     def redundancy(self) -> None:
+        """r-redundancy of the paper's costs for r = F (Theorem 2's hypothesis) and
+        r = 2F, then X*."""
         costs = paper_costs()
         F = Scenario.paper_example(check_robustness=False).F
-        entries = {}
-        for r, name in ((F, "F"), (2 * F, "2F")):
-            rep = check_redundancy(costs, r)
-            cert = self.certificate(f"redundancy_r{r}", rep.certificate,
-                                    f"the paper's costs are {'' if rep.holds else 'not '}"
-                                    f"{r}-redundant")
-            entries[name] = (r, rep, cert)
-            self.summary.setdefault("redundancy", {})[f"r{r}"] = {
-                "r": r, "holds": rep.holds, "exact": rep.exact, "gap": _finite(rep.gap),
-                "witness": to_jsonable(rep.witness), "unbounded": [list(s) for s in rep.unbounded],
-                "unbounded_agents": list(rep.unbounded_agents), "certificate": cert["file"]}
-        r, rep, cert = entries["F"]
         N = len(costs)
+        self.summary["redundancy"] = {}
+        rep, cert = self.redundant(costs, F)
         self.claim(
-            "costs_F_redundant", f"The paper's costs are F-redundant (r = F = {r}), the "
+            "costs_F_redundant", f"The paper's costs are F-redundant (r = F = {F}), the "
             "hypothesis of Theorem 2's exact convergence (SPEC §5 expects not: f_6 is "
             "unbounded below and f_1, f_5 have different minimisers)",
-            _verdict(rep.holds),
-            f"every {N - r} of the {N} costs have the same argmin set "
-            f"({'exact' if rep.exact else 'numerical'}, {_cert(cert)}); f_6 alone is "
-            f"unbounded below (agents {list(rep.unbounded_agents)}) and individual minimisers "
-            "differ, which does not refute redundancy: the norms' kinks at 0 outweigh them"
-            if rep.holds else _witness_text(rep, cert))
-        r, rep, cert = entries["2F"]
+            *_redundancy_verdict(rep, cert, N, F,
+                                 "; f_6 alone is unbounded below and individual minimisers "
+                                 "differ, which does not refute redundancy"))
+        rep, cert = self.redundant(costs, 2 * F)
         self.claim(
-            "costs_2F_redundant", f"The paper's costs are 2F-redundant (r = {r}; what exact "
-            "resilient optimisation needs when the adversaries are not known in advance, "
-            "Gupta & Vaidya) — a check, not a claim of the paper",
-            _verdict(rep.holds),
-            _witness_text(rep, cert) if not rep.holds else
-            f"every {N - r} of the {N} costs have the same argmin set ({_cert(cert)})")
+            "costs_2F_redundant", f"The paper's costs are 2F-redundant (r = {2 * F}; what "
+            "exact resilient optimisation needs when the adversaries are not known in "
+            "advance, Gupta & Vaidya) — a check, not a claim of the paper",
+            *_redundancy_verdict(rep, cert, N, 2 * F, ""))
         self.optimum(costs)
+
+    def redundant(self, costs: dict[Hashable, Any], r: int) -> tuple[Any, dict[str, Any]]:
+        """check_redundancy(costs, r), its certificate written and checked, its summary
+        entry; (None, entry with ``error``) when a solver it needs is not installed."""
+        try:
+            rep = check_redundancy(costs, r)
+        except SolverNotFound as exc:
+            entry = {"r": r, "holds": None, "error": f"{exc} (install rescon[solvers])"}
+            self.summary["redundancy"][f"r{r}"] = entry
+            return None, entry
+        cert = self.certificate(f"redundancy_r{r}", rep.certificate,
+                                f"the paper's costs are {'' if rep.holds else 'not '}"
+                                f"{r}-redundant")
+        self.summary["redundancy"][f"r{r}"] = {
+            "r": r, "holds": rep.holds, "exact": rep.exact, "gap": _finite(rep.gap),
+            "witness": to_jsonable(rep.witness), "unbounded": [list(s) for s in rep.unbounded],
+            "unbounded_agents": list(rep.unbounded_agents), "certificate": cert["file"]}
+        return rep, cert
 
     def optimum(self, costs: dict[Hashable, Any]) -> None:
         """X* = argmin Σ_{i∈B} f_i from the certified argmin of the one sum of all costs
         (``check_redundancy(costs, 0)``: kind redundancy_holds with r = 0). X* is that
-        single point when Σ H_i (the quadratic parts) is nonsingular (F strictly convex)."""
+        single point when Σ H_i (the quadratic parts) is nonsingular (F strictly convex);
+        otherwise rmdo's numerical estimate is used, and labelled so."""
         from .geometry.exact import nullspace_exact
 
-        rep = check_redundancy(costs, 0)
+        info: dict[str, Any] = {"exact": False, "method": "numerical (rmdo's own estimate)"}
+        self.summary["optimum"] = info
+        try:
+            rep = check_redundancy(costs, 0)
+        except SolverNotFound as exc:
+            info["error"] = f"{exc} (install rescon[solvers])"
+            return
         cert = self.certificate("optimum", rep.certificate,
                                 "a minimiser of the benign agents' total cost (r = 0)")
+        info["certificate"] = cert["file"]
         entry = rep.certificate.get("subsets", [{}])[0]
         point = entry.get("x", {}).get("x") if isinstance(entry, dict) else None
-        d = rep.certificate.get("d", 0)
+        if point is None or not rep.exact or cert["verdict"] != "valid":
+            return
+        d = rep.certificate["d"]
         H = [[sum((Fraction(c["H"][i][j]) for c in rep.certificate["costs"]), Fraction(0))
-              for j in range(d)] for i in range(d)] if point is not None else None
-        unique = H is not None and not nullspace_exact(H)
-        info: dict[str, Any] = {"exact": bool(rep.exact and unique and cert["verdict"] == "valid"),
-                                "certificate": cert["file"]}
-        if info["exact"]:
-            self.xstar = np.array([float(Fraction(v)) for v in point])
-            info.update(point=[str(Fraction(v)) for v in point], unique=True,
-                        method="certified minimiser of the total cost (optimum.cert.json); "
-                               "unique: the sum of the quadratic parts is nonsingular")
-        else:
-            info.update(method="numerical (rmdo's own estimate)")
-        self.summary["optimum"] = info
+              for j in range(d)] for i in range(d)]
+        if nullspace_exact(H):
+            return
+        self.xstar = np.array([float(Fraction(v)) for v in point])
+        info.update(exact=True, point=[str(Fraction(v)) for v in point], unique=True,
+                    method="certified minimiser of the total cost (optimum.cert.json); "
+                           "unique: the sum of the quadratic parts is nonsingular")
 
     # ----------------------------------------------------------------- Algorithm 2
 
@@ -527,6 +538,17 @@ def _pair_text(pair: Any) -> str:
 
 def _cert(entry: dict[str, Any]) -> str:
     return f"certificate {entry['file']}: {entry['verdict']}"
+
+
+def _redundancy_verdict(rep: Any, cert: dict[str, Any], N: int, r: int,
+                        note: str) -> tuple[str, str]:
+    """(verdict, evidence) of an r-redundancy claim."""
+    if rep is None:
+        return UNDECIDED, f"not checked: {cert['error']}"
+    if not rep.holds:
+        return FAILS, _witness_text(rep, cert)
+    return HOLDS, (f"every {N - r} of the {N} costs have the same argmin set "
+                   f"({'exact' if rep.exact else 'numerical'}, {_cert(cert)}){note}")
 
 
 def _witness_text(rep: Any, cert: dict[str, Any]) -> str:
