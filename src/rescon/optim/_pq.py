@@ -310,6 +310,7 @@ def _two_stage(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray]
     eq = [[u - v for u, v in zip(F.blocks[k][j][0], F.blocks[k][s[0]][0], strict=True)]
           + [F.blocks[k][s[0]][1] - F.blocks[k][j][1]] for k, s in enumerate(S) for j in s[1:]]
     eq += [list(a) + [ci] for A, c in F.norms for a, ci in zip(A, c, strict=True)]
+    eq = [list(row) for row in dict.fromkeys(tuple(row) for row in eq)]  # agents repeat them
     piv = _rref(eq, d) if eq else []
     if len(piv) < d or any(row[d] for row in eq[d:]):
         return None
