@@ -97,9 +97,9 @@ def main(argv: list[str] | None = None) -> int:
         w.writerows(rows)
     machine = f"{platform.processor() or platform.machine()}, Python {platform.python_version()}"
     lines = ["# r-redundancy verification (rescon.check_redundancy, d = 3, r = 2)", "",
-             f"{machine}; median of {args.repeat} warm runs; C(N, 2) subsets + the whole set "
-             "+ each agent alone. exact: certificate verified valid by certificates/check.py; "
-             "numerical: unchecked.", "",
+             (f"{machine}; median of {args.repeat} warm runs; C(N, 2) subsets + the whole set "
+              "+ each agent alone. exact: certificate verified valid by certificates/check.py; "
+              "numerical: unchecked."), "",
              "| family | N | holds | exact | gap | seconds | target |", "|---|---|---|---|---|---|---|"]
     lines += [f"| {r['family']} | {r['N']} | {r['holds']} | {r['exact']} | {r['gap']:.3g} | "
               f"{r['seconds']:.3f} | ≤ {r['target']:g} s |" for r in rows]
