@@ -36,6 +36,8 @@ import networkx as nx
 import numpy as np
 from numba import njit
 
+from rescon.models.backends import silent_highs
+
 __all__ = [
     "MilpResult",
     "in_neighbour_sets",
@@ -328,8 +330,7 @@ def _solve(
     lp.integrality_ = [
         highspy.HighsVarType.kInteger if z else highspy.HighsVarType.kContinuous for z in integer
     ]
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
+    h = silent_highs()
     h.setOptionValue("time_limit", float(time_limit))
     h.passModel(lp)
     h.run()

@@ -421,8 +421,9 @@ def _versions() -> str:
             m = __import__(mod)
             v = getattr(m, "__version__", None)
             if v is None and mod == "highspy":
-                import highspy
-                v = highspy.Highs().version()
+                from rescon.models.backends import silent_highs
+
+                v = silent_highs().version()
             out.append(f"{mod} {v}")
         except Exception:  # noqa: BLE001
             out.append(f"{mod} ?")
