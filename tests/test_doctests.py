@@ -17,6 +17,7 @@ MODULES = [
     "rescon.geometry.tverberg",
     "rescon.consensus.dos",
     "rescon.consensus.adversaries",
+    "rescon.optim.redundancy",
 ]
 
 
