@@ -70,10 +70,15 @@ def _random_specs(rng, kind, N):
         if kind == "common":  # share the minimiser c; some costs are flat in a direction
             a, b = rng.integers(-2, 3, size=2)
             out.append(f"({a}*(x1 - {c[0]}) + {b}*(x2 - {c[1]}))^2 + (x1 - {c[0]})^2"
-                       if rng.random() < 0.5 else f"({a}*(x1 - {c[0]}) + {b}*(x2 - {c[1]}))^2")
+                       if rng.random() < 0.2 else f"({a}*(x1 - {c[0]}) + {b}*(x2 - {c[1]}))^2")
         elif kind == "shifted":
             s = rng.integers(-1, 2, size=2) * (rng.random() < 0.4)
             out.append(f"(x1 - {c[0] + s[0]})^2 + (x2 - {c[1] + s[1]})^2")
+        elif kind == "mixed":  # a quadratic in x1 and a kink, through c or shifted
+            a = rng.integers(-2, 3, size=2)
+            s = int(rng.integers(-1, 2)) if rng.random() < 0.3 else 0
+            out.append(f"{int(rng.integers(0, 3))}*(x1 - {c[0] + s})^2 + "
+                       f"abs({a[0]}*x1 + {a[1]}*x2 - {int(a @ c)}) + abs(x2 - {c[1]})")
         else:  # polyhedral: |a·x − b| with kinks through c, or shifted ones
             a = rng.integers(-2, 3, size=2)
             shift = int(rng.integers(0, 2)) if rng.random() < 0.3 else 0
@@ -82,9 +87,9 @@ def _random_specs(rng, kind, N):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", ["common", "shifted", "polyhedral"])
+@pytest.mark.parametrize("kind", ["common", "shifted", "polyhedral", "mixed"])
 def test_brute_force_over_all_pairs_agrees(kind):
-    rng = np.random.default_rng({"common": 1, "shifted": 2, "polyhedral": 3}[kind])
+    rng = np.random.default_rng({"common": 1, "shifted": 2, "polyhedral": 3, "mixed": 4}[kind])
     verdicts = []
     for _ in range(6):
         N = int(rng.integers(3, 5))
@@ -250,6 +255,17 @@ def test_tampered_holds_certificates_are_rejected():
     flipped = _tampered(unb, lambda c: c["subsets"][0].__setitem__(
         "unbounded", [str(-int(v)) for v in c["subsets"][0]["unbounded"]]))
     assert flipped.verdict == "invalid"
+
+
+def test_forged_holds_certificate_with_valid_proofs_is_rejected():
+    """Every subset's optimality proof is valid, but the argmins differ."""
+    from rescon.optim.redundancy import _Check
+
+    specs = ["(x1-1)^2 + x2^2", "(x1+1)^2 + x2^2", "abs(x1) + abs(x2)", "x1^2"]
+    chk = _Check(list(range(4)), [rescon.cost(f, d=2) for f in specs], 2, 1)
+    subs = [chk.argmin(m) for m in itertools.combinations(range(4), 3)]
+    res = check_certificate(chk.holds_certificate(subs))
+    assert res.verdict == "invalid" and "differs" in res.reason
 
 
 def test_numerical_certificate_cannot_pass_as_valid():
