@@ -46,6 +46,7 @@ __all__ = [
 FORMAT_VERSION = 1
 MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
 MAX_N = 1_000_000  # resource limit on graph / matrix size
+MAX_GRAPH_WORK = 20_000_000  # (n + #edges) * ceil(n / 1024): reading a graph or support
 MAX_SEARCH_WORK = 10_000_000  # mask operations (1024-bit units) replaying a search tree
 
 
@@ -276,9 +277,22 @@ def _size(x: Any, where: str) -> int:
     return n
 
 
+def _mask_work(n: int, entries: int, where: str) -> None:
+    """Refuse (unchecked) a graph / support whose n + entries mask operations on n-bit
+    masks (:func:`_mask_cost`, each reading one entry or one node) exceed
+    MAX_GRAPH_WORK: node sets are n-bit masks, so a large sparse graph costs n (n + m)."""
+    work = (n + entries) * max(1, -(-n // 1024))
+    if work > MAX_GRAPH_WORK:
+        raise Unchecked("size limit", f"{where}: n = {n} with {entries} entries needs work "
+                        f"{work} > {MAX_GRAPH_WORK} on n-bit node sets: the certificate "
+                        "was not read further")
+
+
 def _graph(x: Any, where: str = "graph") -> Graph:
     _obj(x, where, ("n", "edges"), ("nodes",))
     n = _size(x["n"], f"{where}.n")
+    if isinstance(x["edges"], _ARRAY):
+        _mask_work(n, len(x["edges"]), where)
     if "nodes" in x:
         labels = _array(x["nodes"], f"{where}.nodes")
         if len(labels) != n:
@@ -969,6 +983,7 @@ def _support_rows(c: dict) -> tuple[int, list[int]]:
     """(n, row) with row[i] = mask of the j with a_ij > 0, validated."""
     n = _size(c["n"], "n")
     sup = _array(c["support"], "support")
+    _mask_work(n, len(sup), "support")
     row = [0] * n  # row[i] = mask of the j with a_ij > 0
     for k, e in enumerate(sup):
         w = f"support[{k}]"
