@@ -183,6 +183,18 @@ def test_paper_certificate_through_rescon_check(tmp_path):
     assert out.returncode == 0 and out.stdout.strip() == "valid"
 
 
+def test_interval_argmins():
+    """|x−1| + |x+1| has argmin [−1, 1]: the minimisers found (0) lie in every set, the
+    witness is a support point (1) proven a minimiser by the same multipliers."""
+    box = "abs(x1 - 1) + abs(x1 + 1)"
+    rep = check_redundancy([box, box, "abs(x1)"], r=1)
+    assert not rep.holds and rep.exact and rep.gap == pytest.approx(1.0)
+    assert rep.witness["points"] == [[1.0], [0.0]]
+    assert check_certificate(rep.certificate).valid
+    same = check_redundancy([box, box, box], r=1)  # equal intervals: no exact proof (yet)
+    assert same.holds and not same.exact and same.gap <= same.tolerance
+
+
 def test_nonpolyhedral_costs_get_a_numerical_verdict_unchecked():
     costs = ["huber(x1 - 1, 1) + x2^2", "huber(x1 - 1, 1) + abs(x2)",
              "logsumexp(x1 - 1, 1 - x1) + x2^2"]

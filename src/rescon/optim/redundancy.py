@@ -33,8 +33,10 @@ Hausdorff distance (exact for single points and affine sets).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
+import warnings
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -300,6 +302,28 @@ class _Check:
                 w = _separation(s1, s2)
                 if w is not None:
                     return w
+        for s1, s2 in first[:MAX_PAIRS // 100]:  # the minimisers found lie in both sets
+            w = self.support_separation(s1, s2)
+            if w is not None:
+                return w
+        return None
+
+    def support_separation(self, s1: _Set, s2: _Set) -> dict[str, Any] | None:
+        """:func:`_separation` from a support point of A_S1 instead of its minimiser: the
+        float support point in each direction, as short rationals, kept when s1's
+        multipliers still prove it a minimiser (check_optimal) — for polyhedral argmins
+        that are not affine, where both minimisers found may lie in both sets."""
+        if s1.opt is None or s1.F.norms or s2 is s1 or not s2.certified:
+            return None
+        for k in range(len(self.dirs)):
+            p = self.support(s1, k)[1]
+            if p is None:
+                continue
+            x = [_pq.rational(v) for v in p]
+            if _pq.check_optimal(s1.F, x, s1.opt.lam, s1.opt.mu) is None:
+                w = _separation(dataclasses.replace(s1, opt=dataclasses.replace(s1.opt, x=x)), s2)
+                if w is not None:
+                    return w
         return None
 
     def numerical_witness(self, subs: list[_Set], ref: _Set, gaps: list[float]
@@ -523,7 +547,9 @@ class _Cvx:
 
     def minimise(self, members: tuple[int, ...]) -> tuple[str, np.ndarray | None]:
         self._weights(members)
-        self.pmin.solve(solver="CLARABEL")
+        with warnings.catch_warnings():  # "inaccurate": the verdict is numerical anyway
+            warnings.simplefilter("ignore", UserWarning)
+            self.pmin.solve(solver="CLARABEL")
         if self.pmin.status in ("unbounded", "unbounded_inaccurate"):
             return "unbounded", None
         if self.pmin.status not in ("optimal", "optimal_inaccurate"):
@@ -536,7 +562,9 @@ class _Cvx:
         self._weights(members)
         f = self.fstar[members]
         self.u.value, self.level.value = u, f + LEVEL_TOL * (1.0 + abs(f))
-        self.psup.solve(solver="CLARABEL")
+        with warnings.catch_warnings():  # "inaccurate": the verdict is numerical anyway
+            warnings.simplefilter("ignore", UserWarning)
+            self.psup.solve(solver="CLARABEL")
         if self.psup.status in ("unbounded", "unbounded_inaccurate"):
             return math.inf, None
         if self.psup.status not in ("optimal", "optimal_inaccurate"):
