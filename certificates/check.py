@@ -47,7 +47,7 @@ FORMAT_VERSION = 1
 MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
 MAX_N = 1_000_000  # resource limit on graph / matrix size
 MAX_GRAPH_WORK = 20_000_000  # (n + #edges) * ceil(n / 1024): reading a graph or support
-MAX_SEARCH_WORK = 10_000_000  # mask operations (1024-bit units) replaying a search tree
+MAX_SEARCH_WORK = 12_000_000  # mask operations (1024-bit units) replaying a search tree
 
 
 VERDICTS = ("valid", "invalid", "unchecked")
@@ -350,7 +350,7 @@ def core(g: Graph, U: int, r: int, meter: list[int] | None = None) -> int:
         m ^= low
         if (inmask[low.bit_length() - 1] & ~U).bit_count() >= r:
             todo.append(low.bit_length() - 1)
-    ops = U.bit_count()
+    ops = U.bit_count() + 2  # the scan, and the call itself
     for i in todo:
         U ^= 1 << i
     while todo:
