@@ -73,7 +73,8 @@ def test_auto_race_agrees_with_dp_beyond_the_dp_threshold(seed):
     assert rescon.check_certificate(auto.certificate).valid
 
 
-@pytest.mark.parametrize("n, p, seed", [(30, 0.5, 30000), (25, 0.5, 25000), (22, 0.3, 7)])
+@pytest.mark.parametrize("n, p, seed", [pytest.param(30, 0.5, 30000, marks=pytest.mark.slow),
+                                         (25, 0.5, 25000), (22, 0.3, 7)])
 def test_produced_certificates_match_the_schema(n, p, seed):
     G = nx.gnp_random_graph(n, p, directed=True, seed=seed)
     rep = rescon.robustness(G)
@@ -97,6 +98,7 @@ def test_search_tree_certificate_is_replayed_not_trusted():
     assert not rescon.check_certificate(tampered).valid
 
 
+@pytest.mark.slow
 def test_race_uses_the_milp_on_dense_graphs_and_says_so():
     """ER(40, 0.8): the MILP proves 17-robustness long before the search; the proof is
     labelled milp and the checker reports it as accepted on trust."""
