@@ -20,7 +20,8 @@ the same argmin set. Facts used (proofs in FORMAT.md):
     A_l with μ_lᵀμ_l < 1.
 (b) unboundedness: Hv = 0, A_l v = 0 and gᵀv + Σ_k max_j a_kjᵀv < 0.
 (c) a violation: |S1| = N − r, x1 ∈ argmin F_S1 by (a), and x1 ∉ argmin F_S2 (S2 of
-    size N − r or all agents) by F_S2(y) < F_S2(x1) or by (b) for F_S2. Under
+    size N − r or all agents): by (b) for F_S2, or by x2 ∈ argmin F_S2 (a) with
+    F_S2(x2) < F_S2(x1) (no norm terms) or x1 outside the affine set (a) gives. Under
     r-redundancy argmin F_S1 ≠ ∅ would be the common argmin, which is also the whole
     set's (the whole sum is a positive multiple of the sum of all F_S).
 """
@@ -304,21 +305,25 @@ def _recession(F: _Cost, x: Any, where: str, d: int) -> None:
 def kind_violation(c: dict, ctx: Any) -> str:
     """Fact (c)."""
     d, r, N, costs = _head(c, (), ("witness",))
-    w = _obj(c["witness"], "witness", ("S1", "S2", "x1"), ("better", "unbounded"))
+    w = _obj(c["witness"], "witness", ("S1", "S2", "x1"), ("x2", "unbounded"))
     S1 = _subset(w["S1"], "witness.S1", N, (N - r,))
     S2 = _subset(w["S2"], "witness.S2", N, (N - r, N))
     if S1 == S2:
         raise Invalid("witness: S1 and S2 are the same set")
     x1, _, _ = _optimal(_sum(costs, S1, d), w["x1"], "witness.x1", d)
     F2 = _sum(costs, S2, d)
-    if ("better" in w) == ("unbounded" in w):
-        raise Invalid("witness must have exactly one of 'better' and 'unbounded'")
+    if ("x2" in w) == ("unbounded" in w):
+        raise Invalid("witness must have exactly one of 'x2' and 'unbounded'")
     if "unbounded" in w:
         _recession(F2, w["unbounded"], "witness.unbounded", d)
     else:
-        y = _vec(w["better"], "witness.better", d)
-        if not _value(F2, y, "witness.better") < _value(F2, x1, "witness.better"):
-            raise Invalid("witness.better does not lower the sum over S2 below its value at x1")
+        p2, lam2, mu2 = _optimal(F2, w["x2"], "witness.x2", d)
+        if F2.norms:
+            R, _ = _affine(F2, p2, lam2, mu2, "witness.x2", d)
+            if not any(_dot(row, [a - b for a, b in zip(x1, p2)]) for row in R):
+                raise Invalid("witness: x1 lies in the argmin over S2 that x2 describes")
+        elif not _value(F2, p2, "witness.x2") < _value(F2, x1, "witness.x2"):
+            raise Invalid("witness: x2 does not lower the sum over S2 below its value at x1")
     return (f"not {r}-redundant: agents {list(S1)} are minimised at x1, which does not "
             f"minimise the sum over agents {list(S2)}")
 

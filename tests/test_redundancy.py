@@ -207,6 +207,19 @@ def test_nonpolyhedral_costs_get_a_numerical_verdict_unchecked():
     assert shifted.witness["exact"] is False and shifted.witness["direction"] is not None
 
 
+def test_norm2_at_its_kink_is_exact():
+    """3‖x‖₂ + (x1 − 1)² has argmin {0} (|∇| = 2 < 3): μ = (2/3, 0) certifies it, and
+    (1, 1), the minimiser of the other pair, lies outside — no exact value of a norm
+    is needed; tampering with μ is refuted."""
+    rep = check_redundancy(["3*sqrt(x1^2+x2^2)", "(x1-1)^2", "(x1-1)^2 + (x2-1)^2"], r=1)
+    assert not rep.holds and rep.exact
+    assert rep.witness["points"] == [[1.0, 1.0], [0.0, 0.0]]
+    cert = rep.certificate
+    assert check_certificate(cert).valid and "x2" in cert["witness"]
+    assert _tampered(cert, lambda c: c["witness"]["x2"].__setitem__(
+        "mu", [["1", "0"]])).verdict == "invalid"
+
+
 def test_norm2_term_with_tight_multiplier_is_not_claimed_exact():
     """‖x‖₂ + (x1 − 1)²: the minimiser (0.5, 0)... is off the norm's kink: numerical."""
     rep = check_redundancy(["sqrt(x1^2 + x2^2)", "(x1 - 2)^2 + x2^2"], r=0)
@@ -236,7 +249,8 @@ def test_tampered_violation_certificates_are_rejected():
     assert check_certificate(cert).valid
     edits = {
         "x1 moved": lambda c: c["witness"]["x1"]["x"].__setitem__(0, "1/7"),
-        "better = x1": lambda c: c["witness"].__setitem__("better", c["witness"]["x1"]["x"]),
+        "x2 = x1": lambda c: c["witness"].__setitem__("x2", c["witness"]["x1"]),
+        "x2 moved": lambda c: c["witness"]["x2"].__setitem__("x", ["1", "0"]),
         "cost changed": lambda c: c["costs"][0]["g"].__setitem__(0, "5"),
         "non-convex cost": lambda c: c["costs"][3]["H"][0].__setitem__(0, "-2"),
         "S1 too large": lambda c: c["witness"].__setitem__("S1", [0, 1, 2, 3]),

@@ -380,7 +380,7 @@ class _Check:
         if proof == "unbounded":
             w["unbounded"] = [fraction_str(v) for v in s2.ray]
         else:
-            w["better"] = [fraction_str(v) for v in proof]
+            w["x2"] = _opt_json(s2.opt)
         c["witness"] = w
         return c
 
@@ -402,13 +402,14 @@ class _Check:
 
 
 def _separation(s1: _Set, s2: _Set) -> dict[str, Any] | None:
-    """x1 = s1's certified minimiser ∉ A_S2: S2 certified unbounded, or a certified y
-    (s2's minimiser) with F_S2(y) < F_S2(x1), checked exactly."""
+    """x1 = s1's certified minimiser ∉ A_S2: S2 certified unbounded, or x2 = s2's certified
+    minimiser with F_S2(x2) < F_S2(x1) (exact values; without norm terms) or x1 outside
+    the affine set that x2's certificate proves to be A_S2."""
     x1 = s1.opt.x
-    if s2.ray is not None and not s2.F.norms:
+    if s2.ray is not None:
         proof: Any = "unbounded"
         u, vals, pts = s2.ray, [_dot_f(s2.ray, x1), None], [x1, None]
-    elif s2.opt is not None and not s2.F.norms and s2.F.value(s2.opt.x) < s2.F.value(x1):
+    elif s2.opt is not None and _outside(s2, x1):
         proof = s2.opt.x
         u = [a - b for a, b in zip(x1, proof, strict=True)]
         vals, pts = [_dot_f(u, x1), _dot_f(u, proof)], [x1, proof]
@@ -419,6 +420,13 @@ def _separation(s1: _Set, s2: _Set) -> dict[str, Any] | None:
             "exact": True, "reason": ("the second sum is unbounded below" if proof == "unbounded"
                                       else "x1 minimises the first sum but not the second"),
             "_proof": (s1, s2, proof)}
+
+
+def _outside(s: _Set, x: list[Fraction]) -> bool:
+    """x ∉ A_S, exactly, from s's certified minimiser."""
+    if not s.F.norms:
+        return s.F.value(s.opt.x) < s.F.value(x)
+    return s.opt.affine and not s.opt.contains(x)
 
 
 def _dot_f(u: list[Fraction], x: list[Fraction]) -> float:
