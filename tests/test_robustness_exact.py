@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 import rescon
 from benchmarks.baselines import leblanc_max_s, leblanc_rho
+from tests.test_robustness import check_valid
 from rescon.graphs import bounds as bd
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import decide_r_robust, min_cost_pair
@@ -70,7 +71,7 @@ def test_auto_race_agrees_with_dp_beyond_the_dp_threshold(seed):
     auto = rescon.robustness(G)
     dp = rescon.robustness(G, method="dp")
     assert (auto.r_max, auto.s_max) == (dp.r_max, dp.s_max)
-    assert rescon.check_certificate(auto.certificate).valid
+    check_valid(auto.certificate, G)  # which engine wins the race (tree or milp) may vary
 
 
 @pytest.mark.parametrize("n, p, seed", [pytest.param(30, 0.5, 30000, marks=pytest.mark.slow),
