@@ -277,9 +277,7 @@ class _Check:
             R = np.array(a.rref, dtype=float)  # distance of parallel affine sets
             diff = np.array([float(u - v) for u, v in zip(a.x, b.x, strict=True)])
             return float(np.linalg.norm(R.T @ np.linalg.lstsq(R.T, diff, rcond=None)[0]))
-        return max(abs(self.support(s, k)[0] - self.support(ref, k)[0])
-                   if math.isfinite(self.support(s, k)[0] + self.support(ref, k)[0])
-                   else (0.0 if self.support(s, k)[0] == self.support(ref, k)[0] else math.inf)
+        return max(_difference(self.support(s, k)[0], self.support(ref, k)[0])
                    for k in range(len(self.dirs)))
 
     def tolerance(self, sets: list[_Set]) -> float:
@@ -333,8 +331,9 @@ class _Check:
             return {"subsets": [s.members, ref.members], "direction": None,
                     "support": None, "points": [_pt(s.point), _pt(ref.point)],
                     "exact": False, "reason": "one of the two sums is unbounded below"}
-        diffs = [abs(self.support(s, k)[0] - self.support(ref, k)[0]) for k in range(len(self.dirs))]
-        k = int(np.nanargmax(np.nan_to_num(diffs, nan=math.inf)))
+        diffs = [_difference(self.support(s, k)[0], self.support(ref, k)[0])
+                 for k in range(len(self.dirs))]
+        k = int(np.argmax(diffs))
         (h1, p1), (h2, p2) = self.support(s, k), self.support(ref, k)
         return {"subsets": [s.members, ref.members], "direction": self.dirs[k].tolist(),
                 "support": [h1, h2], "points": [_pt(p1), _pt(p2)], "exact": False,
@@ -420,6 +419,11 @@ def _separation(s1: _Set, s2: _Set) -> dict[str, Any] | None:
             "exact": True, "reason": ("the second sum is unbounded below" if proof == "unbounded"
                                       else "x1 minimises the first sum but not the second"),
             "_proof": (s1, s2, proof)}
+
+
+def _difference(h1: float, h2: float) -> float:
+    """|h1 − h2| for support values, which may be +inf (0 when both are)."""
+    return 0.0 if h1 == h2 else abs(h1 - h2)
 
 
 def _outside(s: _Set, x: list[Fraction]) -> bool:
