@@ -103,7 +103,10 @@ def _rows(x: Any, where: str, d: int) -> list[tuple[Vec, Fraction]]:
     return out
 
 
-def _cost(x: Any, where: str, d: int) -> _Cost:
+def _cost(x: Any, where: str, d: int) -> _Cost | None:
+    """An agent's recorded cost; null: not recorded (no sum using it can be checked)."""
+    if x is None:
+        return None
     _obj(x, where, ("H", "g", "blocks", "norms"))
     c = _Cost(d)
     H = _array(x["H"], f"{where}.H")
@@ -142,7 +145,7 @@ def _psd(M: list[Vec]) -> bool:
 
 
 def _head(c: dict, optional: tuple[str, ...], required: tuple[str, ...] = ()
-          ) -> tuple[int, int, int, list[_Cost]]:
+          ) -> tuple[int, int, int, list[_Cost | None]]:
     _obj(c, "certificate", _COMMON + required, optional)
     d = _int(c["d"], "d", 1)
     if d > MAX_DIM:
@@ -177,9 +180,11 @@ def _subset(x: Any, where: str, N: int, sizes: tuple[int, ...]) -> tuple[int, ..
     return idx
 
 
-def _sum(costs: list[_Cost], S: tuple[int, ...], d: int) -> _Cost:
+def _sum(costs: list[_Cost | None], S: tuple[int, ...], d: int) -> _Cost:
     F = _Cost(d)
     for i in S:
+        if costs[i] is None:
+            raise Invalid(f"a sum uses agent {i}, whose cost is not recorded (null)")
         F.add(costs[i])
     return F
 

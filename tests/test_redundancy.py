@@ -220,6 +220,16 @@ def test_norm2_at_its_kink_is_exact():
         "mu", [["1", "0"]])).verdict == "invalid"
 
 
+def test_exact_witness_among_subsets_without_the_other_costs():
+    """Agent 0 (Huber) is not piecewise quadratic; pairs of the others differ exactly."""
+    rep = check_redundancy(["huber(x1, 1)", "x1^2", "(x1-1)^2", "(x1-2)^2"], r=2)
+    assert not rep.holds and rep.exact
+    cert = rep.certificate
+    assert cert["costs"][0] is None and check_certificate(cert).valid
+    forged = _tampered(cert, lambda c: c["witness"].__setitem__("S2", [0, 1]))
+    assert forged.verdict == "invalid" and "not recorded" in forged.reason
+
+
 def test_norm2_term_with_tight_multiplier_is_not_claimed_exact():
     """‖x‖₂ + (x1 − 1)²: the minimiser (0.5, 0)... is off the norm's kink: numerical."""
     rep = check_redundancy(["sqrt(x1^2 + x2^2)", "(x1 - 2)^2 + x2^2"], r=0)

@@ -362,8 +362,11 @@ class _Check:
         return {"rescon_certificate": 1, "kind": kind, "d": self.d, "r": self.r,
                 "agents": [_label(x) for x in self.labels]}
 
-    def _costs_json(self) -> list[dict[str, Any]]:
-        return [{"H": [[fraction_str(v) for v in row] for row in F.H],
+    def _costs_json(self) -> list[dict[str, Any] | None]:
+        """Every agent's exact cost data; None for costs that are not piecewise
+        quadratic (a violation certificate may not need them)."""
+        return [None if F is None else
+                {"H": [[fraction_str(v) for v in row] for row in F.H],
                  "g": [fraction_str(v) for v in F.g],
                  "blocks": [[[fraction_str(v) for v in (*a, b)] for a, b in blk]
                             for blk in F.blocks],
