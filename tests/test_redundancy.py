@@ -230,6 +230,19 @@ def test_exact_witness_among_subsets_without_the_other_costs():
     assert forged.verdict == "invalid" and "not recorded" in forged.reason
 
 
+def test_cvxpy_costs_in_one_variable():
+    import cvxpy as cp
+
+    x = cp.Variable(2)
+    costs = [cp.sum_squares(x) + cp.exp(x[0]), cp.exp(x[0]) + cp.sum_squares(x),
+             cp.abs(x[1]) + cp.exp(x[0]) + cp.sum_squares(x)]
+    rep = check_redundancy(costs, r=1)
+    assert rep.holds and not rep.exact
+    assert not check_redundancy(costs + [cp.sum_squares(x - 1)], r=1).holds
+    with pytest.raises(InputError, match="cost of agent [01]: .*one Variable"):
+        check_redundancy([costs[0], cp.exp(cp.Variable(2)[0]) + 0], r=1)
+
+
 def test_norm2_term_with_tight_multiplier_is_not_claimed_exact():
     """‖x‖₂ + (x1 − 1)²: the minimiser (0.5, 0)... is off the norm's kink: numerical."""
     rep = check_redundancy(["sqrt(x1^2 + x2^2)", "(x1 - 2)^2 + x2^2"], r=0)

@@ -37,7 +37,7 @@ import dataclasses
 import itertools
 import math
 import warnings
-from collections.abc import Hashable, Mapping
+from collections.abc import Hashable, Iterator, Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
@@ -547,7 +547,9 @@ class _Cvx:
         import cvxpy as cp
 
         self.cp = cp
-        self.x = cp.Variable(d)
+        xs = {id(g.x): g.x for o in oracles for g in _grad_parts(o)}
+        user = next(iter(xs.values())) if len(xs) == 1 else None
+        self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)
         self.w = cp.Parameter(len(oracles), nonneg=True)
         F = sum(self.w[i] * _to_cvxpy(cp, o, self.x) for i, o in enumerate(oracles))
         self.u, self.level = cp.Parameter(d), cp.Parameter()
@@ -588,9 +590,28 @@ class _Cvx:
         return float(self.psup.value), np.array(self.x.value, dtype=float)
 
 
-def _to_cvxpy(cp: Any, o: Any, x: Any) -> Any:
-    """The CVXPY expression of an atom tree (InputError for other oracles)."""
+def _grad_parts(o: Any) -> Iterator[Any]:
+    """The summands CVXPY evaluates itself (``.grad``) in an oracle tree."""
     from . import atoms
+    from .cvxpy_adapter import CvxpyGradOracle
+
+    if isinstance(o, CvxpyGradOracle):
+        yield o
+    for t in getattr(o, "terms", []) if isinstance(o, (atoms.Sum, atoms.MaxOf)) else []:
+        yield from _grad_parts(t)
+    if isinstance(o, atoms.Scaled):
+        yield from _grad_parts(o.term)
+
+
+def _to_cvxpy(cp: Any, o: Any, x: Any) -> Any:
+    """The CVXPY expression of an atom tree; a CVXPY summand evaluated by ``.grad`` is
+    used as is when it is written in ``x`` (every CVXPY cost in one Variable of shape
+    (d,)). InputError for other oracles."""
+    from . import atoms
+    from .cvxpy_adapter import CvxpyGradOracle
+
+    if isinstance(o, CvxpyGradOracle) and o.x is x:
+        return o.expr
 
     if isinstance(o, atoms.Sum):
         return sum(_to_cvxpy(cp, t, x) for t in o.terms)
@@ -615,5 +636,5 @@ def _to_cvxpy(cp: Any, o: Any, x: Any) -> Any:
     if isinstance(o, atoms.Huber):
         return cp.sum(cp.huber(o.A @ x - o.b, o.M))
     raise InputError(f"{o.name}: check_redundancy needs costs built of atoms (an expression "
-                     f"string, atoms, or a CVXPY expression lowered to atoms); got a "
-                     f"{o.kind} oracle")
+                     f"string, atoms) or CVXPY expressions in one Variable of shape (d,); "
+                     f"got a {o.kind} oracle")
