@@ -9,6 +9,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
+import rescon
 from rescon.cli import main
 from rescon.consensus.adversaries import (
     Bait,
@@ -303,3 +304,19 @@ def test_paper_example_zero_policy_drags_states_to_the_origin():
     mh = np.linalg.norm(benign_states(hold).mean(axis=1), axis=1)
     assert mz[-1] < 0.1 * mz[0]
     assert mh[-1] > 0.5 * mh[0]
+
+
+@pytest.mark.parametrize("centre", ["mean", "box"])
+def test_states_near_the_float_limit_do_not_overflow(centre):
+    """F = 0 (no filtering) and an adversary sending 1e308: the benign states are dragged
+    towards it. Means of values near 1.8e308 must not overflow to inf (the centre, the
+    recorded adversary state, the distance to the hull)."""
+    sc = rescon.Scenario(graph=nx.complete_graph(3), x0=[[0.0, 0.0], [1.0, 1.0], [0.0, 0.0]],
+                         F=0, adversaries={2: Constant([1e308, 1e308])}, steps=30,
+                         centre=centre)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rescon.ScenarioWarning)
+        traj = rescon.simulate(sc)
+    assert np.isfinite(traj.states).all()
+    assert traj.states[-1, 0, 0] > 9e307
+    assert np.isfinite(traj.max_validity) and traj.max_validity > 1.4e308

@@ -27,7 +27,6 @@ are computed together (:func:`_kernel_points`).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
@@ -239,14 +238,13 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
     return values, usable, sent
 
 
-def _scaled_mean(rows: np.ndarray) -> np.ndarray:
-    """Mean of the rows of a finite (m, d) array without overflow: the rows are divided
-    by 2^e ≥ max |entry| (exact, a power of two), averaged (|mean| ≤ 1), and scaled back."""
-    top = float(np.abs(rows).max())
-    if top == 0.0:
-        return rows.mean(axis=0)
-    e = math.frexp(top)[1]
-    return np.ldexp((np.ldexp(rows, -e)).mean(axis=0), e)
+def _scaled_mean(a: np.ndarray, axis: int = 0) -> np.ndarray:
+    """Mean of a finite array along ``axis`` without overflow: each slice is divided by
+    its own power of two 2^e ≥ max |entry| (exact), averaged (|mean| ≤ 1), and scaled
+    back — ``a.mean(axis)`` overflows to inf once the sum passes 1.8e308."""
+    top = np.abs(a).max(axis=axis, keepdims=True)
+    e = np.frexp(np.where(top > 0.0, top, 1.0))[1]
+    return np.ldexp(np.ldexp(a, -e).mean(axis=axis), np.squeeze(e, axis=axis))
 
 
 def _auxiliary(sc, links, x, values, usable, benign, d, cache):
@@ -277,7 +275,7 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
         elif sc.algorithm == "wmsr":
             aux[r] = _wmsr(x[i], X, sc.F)
         else:
-            aux[r] = np.vstack([X, x[i]]).mean(axis=0) if len(X) else x[i]
+            aux[r] = _scaled_mean(np.vstack([X, x[i]]))
     points = _kernel_points(problems, sc.F, sc.kernel_point, cache)
     if sc.algorithm == "kernel":
         for (r, _, _), pt in zip(where, points, strict=True):
@@ -296,9 +294,9 @@ def _centre(lam: np.ndarray, centre: str) -> np.ndarray:
     "centroid": the centroid of conv Λ (the paper's definition; exact, per agent,
     :func:`rescon.geometry.centroid.hull_centroid`)."""
     if centre == "box":
-        return (lam.min(axis=1) + lam.max(axis=1)) / 2
+        return _scaled_mean(np.stack([lam.min(axis=1), lam.max(axis=1)]))
     if centre == "mean":
-        return lam.mean(axis=1)
+        return _scaled_mean(lam, axis=1)
     return np.array([hull_centroid(L) for L in lam])
 
 

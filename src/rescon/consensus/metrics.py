@@ -77,7 +77,9 @@ class ValidityMonitor:
         if self.hull.contains(x):
             return 0.0
         y, _ = self.hull.point("project", target=x)
-        return float(np.linalg.norm(x - y))
+        v = x - y
+        dist = float(np.linalg.norm(v))
+        return dist if math.isfinite(dist) else math.hypot(*v)  # squares overflowed
 
     def surely_inside(self, states: np.ndarray) -> np.ndarray:
         """Rows of ``states`` (n, d) that a float filter proves inside the hull (False:
