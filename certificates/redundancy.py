@@ -14,14 +14,17 @@ the same argmin set. Facts used (proofs in FORMAT.md):
 (a) optimality: x with multipliers λ_k (a probability vector on block k, positive only
     on pieces attaining the block's max at x) and μ_l (A_l x = c_l, μ_lᵀμ_l ≤ 1) with
     Hx + g + Σ λ_kj a_kj + Σ A_lᵀμ_l = 0 minimises F; and
-    argmin F = {y : M(y − x) = 0} when rank M = d, or when no μ_l has norm 1 and every
-    normal a_kj' − a_kj₀ (j' outside the support of λ_k) lies in the row space of M —
-    M the rows of H, the differences a_kj − a_kj₀ on the support of λ_k and the rows of
-    A_l with μ_lᵀμ_l < 1.
+    argmin F ⊆ E = {y : M(y − x) = 0} — M the rows of H, the differences a_kj − a_kj₀ on
+    the support of λ_k and the rows of A_l with μ_lᵀμ_l < 1 — and, when rank M = d or no
+    μ_l has norm 1, argmin F = E ∩ {(a_kj' − a_kj₀)ᵀy ≤ b_kj₀ − b_kj' : j' outside the
+    support of λ_k}; each such inequality is canonical once reduced modulo the rows of
+    M's reduced row echelon form (on E, R_i y = R_i x) and scaled to a leading ±1, and
+    dropped when its normal reduces to 0 (constant on E, true at x). Equal E and equal
+    sets of canonical inequalities give equal argmins.
 (b) unboundedness: Hv = 0, A_l v = 0 and gᵀv + Σ_k max_j a_kjᵀv < 0.
 (c) a violation: |S1| = N − r, x1 ∈ argmin F_S1 by (a), and x1 ∉ argmin F_S2 (S2 of
     size N − r or all agents): by (b) for F_S2, or by x2 ∈ argmin F_S2 (a) with
-    F_S2(x2) < F_S2(x1) (no norm terms) or x1 outside the affine set (a) gives. Under
+    F_S2(x2) < F_S2(x1) (no norm terms) or x1 outside the description (a) gives. Under
     r-redundancy argmin F_S1 ≠ ∅ would be the common argmin, which is also the whole
     set's (the whole sum is a positive multiple of the sum of all F_S).
 """
@@ -120,8 +123,8 @@ def _cost(x: Any, where: str, d: int) -> _Cost | None:
     c.g = _vec(x["g"], f"{where}.g", d)
     c.blocks = [_rows(b, f"{where}.blocks[{k}]", d)
                 for k, b in enumerate(_array(x["blocks"], f"{where}.blocks"))]
-    for l, nrm in enumerate(_array(x["norms"], f"{where}.norms")):
-        rows = _rows(nrm, f"{where}.norms[{l}]", d)
+    for k, nrm in enumerate(_array(x["norms"], f"{where}.norms")):
+        rows = _rows(nrm, f"{where}.norms[{k}]", d)
         c.norms.append(([a for a, _ in rows], [b for _, b in rows]))
     return c
 
@@ -161,7 +164,7 @@ def _head(c: dict, optional: tuple[str, ...], required: tuple[str, ...] = ()
     if len(costs) != N:
         raise Invalid(f"costs must have one entry per agent ({N}), got {len(costs)}")
     pieces = 0
-    for i, x in enumerate(costs):
+    for x in costs:
         if isinstance(x, dict):
             pieces += sum(len(b) for k in ("blocks", "norms")
                           for b in x.get(k, []) if isinstance(b, list))
@@ -214,7 +217,8 @@ def _optimal(F: _Cost, x: Any, where: str, d: int) -> tuple[Vec, list[Vec], list
     if len(lam_in) != len(F.blocks) or len(mu_in) != len(F.norms):
         raise Invalid(f"{where}: {len(lam_in)} block and {len(mu_in)} norm multipliers for "
                       f"{len(F.blocks)} blocks and {len(F.norms)} norm terms")
-    lam = [_vec(v, f"{where}.lambda[{k}]", len(b)) for k, (v, b) in enumerate(zip(lam_in, F.blocks))]
+    lam = [_vec(v, f"{where}.lambda[{k}]", len(b))
+           for k, (v, b) in enumerate(zip(lam_in, F.blocks))]
     mu = [_vec(v, f"{where}.mu[{k}]", len(c)) for k, (v, (_, c)) in enumerate(zip(mu_in, F.norms))]
     stat = [_dot(row, p) + gi for row, gi in zip(F.H, F.g)]
     for k, (lk, blk) in enumerate(zip(lam, F.blocks)):
@@ -261,34 +265,44 @@ def _rref(M: list[Vec], n: int) -> tuple[list[Vec], list[int]]:
     return A[:len(piv)], piv
 
 
-def _affine(F: _Cost, p: Vec, lam: list[Vec], mu: list[Vec], where: str, d: int
-            ) -> tuple[list[Vec], Vec]:
-    """Fact (a): argmin F as the affine set {M(y − p) = 0}: (rref of M, p); Invalid when
-    the certificate does not make it affine."""
+def _description(F: _Cost, p: Vec, lam: list[Vec], mu: list[Vec], where: str, d: int
+                 ) -> tuple[list[Vec], frozenset | None]:
+    """Fact (a): (rref of M, canonical inequalities) — None for the inequalities when
+    a norm multiplier has length 1 and rank M < d (then only argmin F ⊆ E is known)."""
     M, ineq, tight = [list(r) for r in F.H if any(r)], [], False
     for lk, blk in zip(lam, F.blocks):
         supp = [j for j, v in enumerate(lk) if v]
-        a0 = blk[supp[0]][0]
+        a0, b0 = blk[supp[0]]
         M += [[u - v for u, v in zip(blk[j][0], a0)] for j in supp[1:]]
-        ineq += [[u - v for u, v in zip(blk[j][0], a0)] for j in range(len(blk)) if j not in supp]
+        ineq += [[u - v for u, v in zip(blk[j][0], a0)] + [b0 - blk[j][1]]
+                 for j in range(len(blk)) if j not in supp]
     for m, (A, _) in zip(mu, F.norms):
         if _dot(m, m) < 1:
             M += [list(a) for a in A]
         else:
             tight = True
     R, piv = _rref(M, d)
-    if len(piv) < d and (tight or not all(_in_rowspace(v, R, piv) for v in ineq)):
-        raise Invalid(f"{where}: the multipliers do not describe the argmin as an affine set")
-    return R, p
+    if tight and len(piv) < d:
+        return R, None
+    faces = (_canonical(v, R, piv, p) for v in ineq)
+    return R, frozenset(f for f in faces if f is not None)
 
 
-def _in_rowspace(v: Vec, R: list[Vec], piv: list[int]) -> bool:
+def _canonical(v: Vec, R: list[Vec], piv: list[int], p: Vec) -> tuple | None:
     w = list(v)
-    for row, p in zip(R, piv):
-        if w[p]:
-            f = w[p]
-            w = [a - f * b for a, b in zip(w, row)]
-    return not any(w)
+    for row, c in zip(R, piv):
+        if w[c]:
+            f = w[c]
+            w = [a - f * b for a, b in zip(w[:-1], row)] + [w[-1] - f * _dot(row, p)]
+    lead = next((a for a in w[:-1] if a), None)
+    return None if lead is None else tuple(a / abs(lead) for a in w)
+
+
+def _outside(R: list[Vec], faces: frozenset | None, p: Vec, y: Vec) -> bool:
+    """y ∉ E = {R(z − p) = 0}, or y breaks a canonical inequality."""
+    diff = [a - b for a, b in zip(y, p)]
+    return (any(_dot(row, diff) for row in R)
+            or any(_dot(list(f[:-1]), y) > f[-1] for f in faces or ()))
 
 
 def _recession(F: _Cost, x: Any, where: str, d: int) -> None:
@@ -324,8 +338,8 @@ def kind_violation(c: dict, ctx: Any) -> str:
     else:
         p2, lam2, mu2 = _optimal(F2, w["x2"], "witness.x2", d)
         if F2.norms:
-            R, _ = _affine(F2, p2, lam2, mu2, "witness.x2", d)
-            if not any(_dot(row, [a - b for a, b in zip(x1, p2)]) for row in R):
+            R, faces = _description(F2, p2, lam2, mu2, "witness.x2", d)
+            if not _outside(R, faces, p2, x1):
                 raise Invalid("witness: x1 lies in the argmin over S2 that x2 describes")
         elif not _value(F2, p2, "witness.x2") < _value(F2, x1, "witness.x2"):
             raise Invalid("witness: x2 does not lower the sum over S2 below its value at x1")
@@ -342,7 +356,7 @@ def kind_holds(c: dict, ctx: Any) -> str:
         raise Unchecked("size", f"C({N}, {r}) = {need} subsets > {MAX_SUBSETS}: beyond the "
                         "checker's limits")
     seen: set[tuple[int, ...]] = set()
-    common: tuple[list[Vec], Vec] | None = None
+    common: tuple[list[Vec], frozenset, Vec] | None = None
     kinds = set()
     for i, s in enumerate(subs):
         where = f"subsets[{i}]"
@@ -358,10 +372,14 @@ def kind_holds(c: dict, ctx: Any) -> str:
         if "unbounded" in s:
             _recession(F, s["unbounded"], f"{where}.unbounded", d)
             continue
-        R, p = _affine(F, *_optimal(F, s["x"], f"{where}.x", d), where, d)
+        p, lam, mu = _optimal(F, s["x"], f"{where}.x", d)
+        R, faces = _description(F, p, lam, mu, where, d)
+        if faces is None:
+            raise Invalid(f"{where}: a norm multiplier of length 1 leaves the argmin undescribed")
         if common is None:
-            common = (R, p)
-        elif R != common[0] or any(_dot(row, [a - b for a, b in zip(p, common[1])]) for row in R):
+            common = (R, faces, p)
+        elif (R, faces) != common[:2] or any(_dot(row, [a - b for a, b in zip(p, common[2])])
+                                             for row in R):
             raise Invalid(f"{where}: its argmin differs from that of {list(min(seen))}")
     if len(seen) != need or seen != set(combinations(range(N), N - r)):
         raise Invalid(f"subsets must list all C({N}, {r}) = {need} subsets of {N - r} agents")

@@ -191,8 +191,12 @@ def test_interval_argmins():
     assert not rep.holds and rep.exact and rep.gap == pytest.approx(1.0)
     assert rep.witness["points"] == [[1.0], [0.0]]
     assert check_certificate(rep.certificate).valid
-    same = check_redundancy([box, box, box], r=1)  # equal intervals: no exact proof (yet)
-    assert same.holds and not same.exact and same.gap <= same.tolerance
+    same = check_redundancy([box, box, box], r=1)  # the same inequalities: exact
+    assert same.holds and same.exact and same.gap == 0.0
+    assert check_certificate(same.certificate).valid
+    # equal intervals whose descriptions differ by a redundant x ≤ 5: numerical
+    slack = check_redundancy([box, box, box + " + pos(x1 - 5)"], r=1)
+    assert slack.holds and not slack.exact and slack.gap <= slack.tolerance
 
 
 def test_nonpolyhedral_costs_get_a_numerical_verdict_unchecked():
@@ -313,6 +317,11 @@ def test_forged_holds_certificate_with_valid_proofs_is_rejected():
     specs = ["(x1-1)^2 + x2^2", "(x1+1)^2 + x2^2", "abs(x1) + abs(x2)", "x1^2"]
     chk = _Check(list(range(4)), [rescon.cost(f, d=2) for f in specs], 2, 1)
     subs = [chk.argmin(m) for m in itertools.combinations(range(4), 3)]
+    res = check_certificate(chk.holds_certificate(subs))
+    assert res.verdict == "invalid" and "differs" in res.reason
+    box1, box2 = "abs(x1 - 1) + abs(x1 + 1)", "abs(x1 - 2) + abs(x1 + 2)"  # [−1, 1], [−2, 2]
+    chk = _Check(list(range(3)), [rescon.cost(f, d=1) for f in (box1, box2, box2)], 1, 1)
+    subs = [chk.argmin(m) for m in itertools.combinations(range(3), 2)]
     res = check_certificate(chk.holds_certificate(subs))
     assert res.verdict == "invalid" and "differs" in res.reason
 

@@ -26,11 +26,14 @@ complementary slackness holds at y, and ‖A_l y − c_l‖ = μ_lᵀ(A_l y − 
     argmin F = { y : H y = H x̄,  a_kjᵀy + b_kj ≥ a_kj'ᵀy + b_kj'  (λ_kj > 0, all j'),
                  A_l y = c_l (μ_lᵀμ_l < 1),  ‖A_l y − c_l‖ = μ_lᵀ(A_l y − c_l) (else) }.
 
-It is the affine set E = {y : M(y − x̄) = 0}, M = the rows of H, the differences
-a_kj − a_kj₀ of the pieces in the support of λ_k and the rows of A_l with μ_lᵀμ_l < 1,
-whenever every remaining inequality's normal a_kj' − a_kj₀ lies in the row space of M
-(then it is constant on E) and no μ_l has norm 1; or when rank M = d (a single point). Two such affine sets are equal iff the reduced row
-echelon forms of their M agree and each contains the other's point.
+So argmin F ⊆ E = {y : M(y − x̄) = 0}, M = the rows of H, the differences a_kj − a_kj₀
+of the pieces in the support of λ_k and the rows of A_l with μ_lᵀμ_l < 1; and when no
+μ_l has norm 1 (or rank M = d: a single point), argmin F = E ∩ {the inequalities
+(a_kj' − a_kj₀)ᵀy ≤ b_kj₀ − b_kj', j' outside the support}. Each inequality is made
+canonical by reducing its normal modulo the reduced row echelon form R of M (on E,
+R_i y = R_i x̄) and scaling it to a leading ±1; it is dropped when the normal reduces to
+0 (then it is constant on E, and true at x̄). Equal R, a common point and equal sets of
+canonical inequalities prove two argmins equal (E alone: affine sets, e.g. quadratics).
 
 **Unboundedness certificate.** A direction v with Hv = 0 and gᵀv + Σ_k max_j a_kjᵀv < 0:
 F(x + tv) decreases without bound in t.
@@ -198,12 +201,26 @@ class Optimal:
     lam: Mult
     mu: Mult
     rref: list[list[Fraction]]  # canonical basis of the row space of M
-    affine: bool  # argmin F = {y : M (y − x) = 0}
+    faces: frozenset[tuple[Fraction, ...]] | None  # canonical inequalities; None: not linear
+
+    @property
+    def affine(self) -> bool:
+        """argmin F = E = {y : M(y − x) = 0}."""
+        return self.faces == frozenset()
+
+    @property
+    def describable(self) -> bool:
+        """argmin F = E ∩ {the ``faces``} (no norm term with |μ| = 1, or a single point)."""
+        return self.faces is not None
 
     def contains(self, y: list[Fraction]) -> bool:
-        """y ∈ the affine set {M(y − x) = 0} (meaningful when ``affine``)."""
+        """y ∈ E, which contains argmin F (always)."""
         diff = [a - b for a, b in zip(y, self.x, strict=True)]
         return all(_dot(row, diff) == 0 for row in self.rref)
+
+    def violates_face(self, y: list[Fraction]) -> bool:
+        """y breaks one of the ``faces`` (n·y ≤ h, stored as (*n, h))."""
+        return any(_dot(f[:-1], y) > f[-1] for f in self.faces or ())
 
 
 def check_optimal(F: PQ, x: list[Fraction], lam: Mult, mu: Mult) -> str | None:
@@ -239,12 +256,12 @@ def _axpy(stat: list[Fraction], coefs: list[Fraction], rows: list) -> list[Fract
 def describe(F: PQ, x: list[Fraction], lam: Mult, mu: Mult) -> Optimal:
     """The argmin set certified by (x, lam, mu) (module docstring)."""
     M = [list(row) for row in F.H if any(row)]
-    ineq = []
+    ineq = []  # n·y ≤ h as [*n, h]: piece j' ≤ piece j₀ of the support
     for lk, blk in zip(lam, F.blocks, strict=True):
         supp = [j for j, v in enumerate(lk) if v]
-        a0 = blk[supp[0]][0]
+        a0, b0 = blk[supp[0]]
         M += [[u - v for u, v in zip(blk[j][0], a0, strict=True)] for j in supp[1:]]
-        ineq += [[u - v for u, v in zip(blk[j][0], a0, strict=True)]
+        ineq += [[u - v for u, v in zip(blk[j][0], a0, strict=True)] + [b0 - blk[j][1]]
                  for j in range(len(blk)) if j not in supp]
     tight = False
     for m, (A, _) in zip(mu, F.norms, strict=True):
@@ -254,17 +271,23 @@ def describe(F: PQ, x: list[Fraction], lam: Mult, mu: Mult) -> Optimal:
             tight = True
     piv = _rref(M, F.d) if M else []
     R = M[:len(piv)]
-    affine = len(piv) == F.d or (not tight and all(_in_rowspace(v, R, piv) for v in ineq))
-    return Optimal(x, lam, mu, R, affine)
+    faces = None if tight and len(piv) < F.d else frozenset(
+        f for f in (_canonical(v, R, piv, x) for v in ineq) if f is not None)
+    return Optimal(x, lam, mu, R, faces)
 
 
-def _in_rowspace(v: list[Fraction], R: list[list[Fraction]], piv: list[int]) -> bool:
+def _canonical(v: list[Fraction], R: list[list[Fraction]], piv: list[int], x: list[Fraction]
+               ) -> tuple[Fraction, ...] | None:
+    """The inequality n·y ≤ h (v = [*n, h]) restricted to E = {R(y − x) = 0}: n reduced
+    modulo the rows of R (h shifted by their values R_i·x on E), scaled so its first
+    nonzero entry is ±1; None when n reduces to 0 (constant on E, true at x)."""
     w = list(v)
     for row, p in zip(R, piv, strict=True):
         if w[p]:
             f = w[p]
-            w = [a - f * b for a, b in zip(w, row, strict=True)]
-    return not any(w)
+            w = [a - f * b for a, b in zip(w[:-1], row, strict=True)] + [w[-1] - f * _dot(row, x)]
+    lead = next((a for a in w[:-1] if a), None)
+    return None if lead is None else tuple(a / abs(lead) for a in w)
 
 
 def rational(v: float) -> Fraction:

@@ -19,8 +19,12 @@ sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functi
   multipliers, or a recession direction when the sum is unbounded below);
 * x ∉ A_S2 is proved by exact evaluation: F_S2(y) < F_S2(x) for a certified y ∈ A_S2,
   or F_S2 unbounded below;
-* equality is proved when the certified argmins are affine sets (single points, or
-  affine subspaces as for quadratics): same reduced row echelon form and a common point.
+* equality is proved when the certified argmins have the same canonical description:
+  the affine set E (reduced row echelon form and a common point) and the inequalities
+  that cut it, reduced modulo E and normalised (:mod:`rescon.optim._pq`) — always the
+  case for equal single points and affine subspaces (quadratics), and for polyhedra
+  described by the same inequalities; equal polyhedra whose descriptions differ by a
+  redundant inequality get a numerical verdict.
 
 Everything else is numerical (``exact=False``): support functions h_A(u) = max_{x∈A} uᵀx
 in the fixed directions ±e_i and ±u_j (j < d, u_j seeded Gaussian unit vectors, seed 0),
@@ -206,7 +210,7 @@ class _Check:
             status, data = _clarabel(F)
             if status == "optimal":
                 s.opt = _pq.certify(F, *data)
-                if s.opt is not None and F.norms and not s.opt.affine:
+                if s.opt is not None and not s.opt.describable:
                     s.opt = None  # a norm term with |μ| = 1: not described by linear data
                 s.status, s.point = "optimal", data[0]
             elif status == "unbounded":
@@ -258,17 +262,21 @@ class _Check:
         return self.report(holds, False, wit, gap, unbounded, alone, tol=tol)
 
     def equal(self, s: _Set, t: _Set) -> bool:
-        """A_S = A_T proven exactly (both certified affine sets, or both certified empty)."""
+        """A_S = A_T proven exactly: both certified empty, or the same canonical
+        description (affine set E and reduced inequalities; sufficient, not necessary
+        when a description has redundant inequalities)."""
         if s.ray is not None or t.ray is not None:
             return s.ray is not None and t.ray is not None
         a, b = s.opt, t.opt
-        return (a is not None and b is not None and a.affine and b.affine and a.rref == b.rref
-                and b.contains(a.x))
+        return (a is not None and b is not None and a.rref == b.rref and b.contains(a.x)
+                and a.faces == b.faces)
 
     def gap(self, s: _Set, ref: _Set) -> float:
         """Hausdorff distance of two nonempty argmins: exact formula for affine sets,
         else the largest support difference over the directions."""
         a, b = s.opt, ref.opt
+        if self.equal(s, ref):
+            return 0.0
         if a is not None and b is not None and a.affine and b.affine:
             if a.rref != b.rref:
                 return math.inf
@@ -433,7 +441,7 @@ def _outside(s: _Set, x: list[Fraction]) -> bool:
     """x ∉ A_S, exactly, from s's certified minimiser."""
     if not s.F.norms:
         return s.F.value(s.opt.x) < s.F.value(x)
-    return s.opt.affine and not s.opt.contains(x)
+    return not s.opt.contains(x) or s.opt.violates_face(x)
 
 
 def _dot_f(u: list[Fraction], x: list[Fraction]) -> float:
@@ -485,8 +493,8 @@ def _clarabel(F: _pq.PQ) -> tuple[str, Any]:
                        sp.csc_matrix((-np.ones(m), (np.arange(m), f["block"])), shape=(m, K)),
                        sp.csc_matrix((m, L))])]
     rhs, cones = [-f["b"]], [clarabel.NonnegativeConeT(m)]
-    for l, (A, c) in enumerate(f["norms"]):  # (s_l, A_l x − c_l) in the second-order cone
-        top = sp.csc_matrix(([-1.0], ([0], [d + K + l])), shape=(1, n))
+    for k, (A, c) in enumerate(f["norms"]):  # (s_k, A_k x − c_k) in the second-order cone
+        top = sp.csc_matrix(([-1.0], ([0], [d + K + k])), shape=(1, n))
         rows.append(sp.vstack([top, sp.hstack([sp.csc_matrix(-A),
                                                sp.csc_matrix((len(c), K + L))])]))
         rhs.append(np.concatenate([[0.0], -c]))
@@ -499,7 +507,7 @@ def _clarabel(F: _pq.PQ) -> tuple[str, Any]:
     x, z = np.array(res.x), np.array(res.z)
     if status in ("Solved", "AlmostSolved"):
         mus, at = [], m
-        for A, c in f["norms"]:
+        for _, c in f["norms"]:
             mus.append(-z[at + 1:at + 1 + len(c)])
             at += len(c) + 1
         return "optimal", (x[:d], [z[:m][f["block"] == k] for k in range(K)], mus)
