@@ -8,8 +8,8 @@ the library (BENCHMARKS.md §2). Both enumerate the C(n, F) subsets, as publishe
   ``scipy.optimize.linprog(method="highs")``, default settings.
 * **subset-hull intersection via qhull** (:func:`subset_hull_qhull`): for every subset
   S, ``scipy.spatial.ConvexHull(X[S])`` gives its facet halfspaces; facets repeated in
-  several subsets (same vertex indices, same orientation) are stacked once; an interior point comes from
-  the Chebyshev LP (HiGHS) and ``scipy.spatial.HalfspaceIntersection`` gives the
+  several subsets (same vertex indices, same orientation) are stacked once; an interior
+  point comes from the Chebyshev LP (HiGHS) and ``scipy.spatial.HalfspaceIntersection`` gives the
   vertices of Ψ. Qhull only handles full-dimensional kernels: degenerate subsets (a
   flat S) or a kernel without interior are reported as ``n/a``.
 

@@ -36,8 +36,9 @@ F values (:func:`f_values`): ``{1, ⌊n/10⌋, h, h+1, h+2, h+3}`` (only those w
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from typing import Callable, Iterable, Iterator, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 

@@ -153,7 +153,8 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
                      + (" | – |" if np.isnan(ratio) else f" | {ratio:.0f}× |"))
     per_point = [r["seconds_per_1e4"] / N * 1e3 for r in rows
                  if r["kind"] == "cvxpy-grad" and not np.isnan(r["seconds_per_1e4"])]
-    lines += ["", (f"CVXPY's own value + `.grad` costs {min(per_point):.2g}–{max(per_point):.2g} ms "
+    lo, hi = min(per_point), max(per_point)
+    lines += ["", (f"CVXPY's own value + `.grad` costs {lo:.2g}–{hi:.2g} ms "
               "per point; the lowered CVXPY costs evaluate the same functions through the "
               "atom library, as fast as the cost strings.")]
     (out / "oracles.md").write_text("\n".join(lines) + "\n", encoding="utf-8")

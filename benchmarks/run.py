@@ -31,9 +31,10 @@ import statistics
 import sys
 import time
 import traceback
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any
 
 import networkx as nx
 import numpy as np
@@ -348,7 +349,8 @@ def run_robustness(cfg: Config, log: Any = sys.stderr) -> int:
                 n = inst.params["n"]
                 answers: dict[str, Answer] = {}
                 secs: dict[str, float] = {}
-                a, t = _timed(_guard(lambda: cand_fn(inst.G, cfg.time_limit)), cfg.repeats)
+                a, t = _timed(_guard(lambda G=inst.G: cand_fn(G, cfg.time_limit)),
+                              cfg.repeats)
                 answers[cand], secs[cand] = a, t
                 for b in cfg.baselines:
                     if (b == "leblanc" and n > cfg.leblanc_max_n) or (
@@ -356,7 +358,7 @@ def run_robustness(cfg: Config, log: Any = sys.stderr) -> int:
                     ):
                         continue
                     fn = BASELINES[b]
-                    a, t = _timed(_guard(lambda fn=fn: fn(inst.G, cfg.time_limit)),
+                    a, t = _timed(_guard(lambda fn=fn, G=inst.G: fn(G, cfg.time_limit)),
                                   1 if b == "milp" else cfg.repeats)
                     answers[b], secs[b] = a, t
                 new = [_row(inst, m, answers[m], secs[m]) for m in answers]
@@ -478,7 +480,7 @@ def summarise(rows: list[dict[str, Any]], cfg: Config, cand: str, cand_desc: str
     status = ("**All answers agree** (candidate, baselines and closed forms)." if not errors else
               f"**{len(errors)} instance(s) with disagreements or failures — see Errors.**")
     lines += [
-        f"- Generated {_dt.datetime.now(_dt.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')} by "
+        f"- Generated {_dt.datetime.now(_dt.UTC).strftime('%Y-%m-%d %H:%M UTC')} by "
         f"`python -m benchmarks.run {' '.join(cfg.argv)}` in {wall:.0f} s.",
         f"- Candidate `{cand}`: {cand_desc}.",
         f"- Baselines: {', '.join(cfg.baselines) or 'none'} "
@@ -501,7 +503,7 @@ def summarise(rows: list[dict[str, Any]], cfg: Config, cand: str, cand_desc: str
     # targets
     def collect(pred: Callable[[int], bool], base: str) -> tuple[list[float], bool]:
         ratios, lower = [], False
-        for (fam, par, n), insts in cells.items():
+        for (_fam, _par, n), insts in cells.items():
             if not pred(n):
                 continue
             for ms in insts:
@@ -931,7 +933,7 @@ def _kernel_rows(rec: KernelRecord) -> list[dict[str, Any]]:
         rows.append({**common, "method": "check", "empty": "", "dim": "", "vertices": "",
                      "seconds": "", "status": "error", "cert": "",
                      "detail": "; ".join(rec.errors)})
-    for b, issue in rec.base_issues.items():
+    for issue in rec.base_issues.values():
         rows.append({**common, "method": "check", "empty": "", "dim": "", "vertices": "",
                      "seconds": "", "cert": "", "detail": issue,
                      "status": "baseline_wrong" if "WRONG" in issue else "baseline_failed"})
@@ -1100,7 +1102,7 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
     status += (f" Baselines: {n_wrong} answer(s) refuted by rescon's verified certificates, "
                f"{n_bfail} solver failure(s) (see the baseline section).")
     lines += [
-        f"- Generated {_dt.datetime.now(_dt.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')} by "
+        f"- Generated {_dt.datetime.now(_dt.UTC).strftime('%Y-%m-%d %H:%M UTC')} by "
         f"`python -m benchmarks.run {' '.join(cfg.argv)}` in {wall:.0f} s.",
         f"- Set `{cfg.set.name}`: {cfg.set.description}.",
         f"- Candidate: {desc}.",
@@ -1113,7 +1115,8 @@ def summarise_kernels(recs: list[KernelRecord], cfg: KernelConfig, desc: str, wa
         f"- {len(recs)} clouds ({n_empty} with an empty kernel); {status}",
         f"- Certificates (rescon.check_certificate, not timed): kernel/emptiness "
         f"{cert_counts('kcert')}; point {cert_counts('pcert')}. `trusted` = not fully "
-        f"checked (halfspace membership beyond the checker's limit), `too_large` = beyond the checker's work limit, "
+        f"checked (halfspace membership beyond the checker's limit), `too_large` = beyond "
+        f"the checker's work limit, "
         f"`timeout` = the checker ran longer than {cfg.cert_timeout:g} s (both: not "
         f"verified, not counted as failures).",
         "",

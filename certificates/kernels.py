@@ -46,7 +46,8 @@ MAX_DIM = 8  # largest dimension d
 MAX_CONSTRAINTS = 10_000  # halfspaces / equalities / facets per certificate
 MAX_EVAL_WORK = 20_000_000  # (#constraints) * n, evaluating constraints at the points
 MAX_RATIONAL_CHARS = 100_000  # longest "p/q" string (exact vertex means get long)
-MAX_HALFSPACE_WORK = 4_000_000  # C(u, k) * (u + #test points + normal cost) for (b); beyond: unchecked
+#: C(u, k) * (u + #test points + normal cost) for (b); beyond: unchecked
+MAX_HALFSPACE_WORK = 4_000_000
 MAX_POLY_WORK = 3_000_000  # vertex / ray enumeration of P; beyond: unchecked
 MAX_NUMBER_BITS = 32_768  # numerator / denominator of one input rational; beyond: unchecked
 MAX_DIGITS = MAX_NUMBER_BITS * 30_103 // 100_000 + 1  # decimal digits of such a number

@@ -10,8 +10,8 @@ so it is only for small graphs (n <= 8: 3^8 = 6561 ordered pairs).
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import Hashable
 
 import networkx as nx
 import pytest

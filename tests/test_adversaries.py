@@ -109,9 +109,11 @@ def test_time_presets():
     assert hash(FunctionOfTime.preset("paper_x12")) == hash(FunctionOfTime.preset("paper_x12"))
     with pytest.raises(InputError, match=r"preset must be one of .*; got 'cos'"):
         TimePreset("cos")
-    with pytest.raises(InputError, match=r"preset 'linear' is missing parameter\(s\) \['velocity'\]"):
+    with pytest.raises(InputError,
+                       match=r"preset 'linear' is missing parameter\(s\) \['velocity'\]"):
         TimePreset("linear", start=[0, 0])
-    with pytest.raises(InputError, match=r"preset 'paper_x2' has unknown parameter\(s\) \['scale'\]"):
+    with pytest.raises(InputError,
+                       match=r"preset 'paper_x2' has unknown parameter\(s\) \['scale'\]"):
         TimePreset("paper_x2", scale=2)
     with pytest.raises(InputError, match="phase must be a number or a list of length 2; got 3"):
         TimePreset("sin", amplitude=[1, 1], phase=[0, 0, 0])
@@ -323,7 +325,8 @@ def test_adversary_messages_errors():
         def to_dict(self):
             return {}
 
-    with pytest.raises(InputError, match=r"Broken of sender 0 must return shape \(3, 2\); got \(1, 1\)"):
+    with pytest.raises(InputError,
+                       match=r"Broken of sender 0 must return shape \(3, 2\); got \(1, 1\)"):
         adversary_messages({0: Broken()}, {0: np.array([1, 2, 3])}, make_view())
     with pytest.raises(InputError, match=r"behaviours\[0\] must be a Behaviour"):
         adversary_messages({0: "constant"}, {}, make_view())
@@ -350,7 +353,8 @@ def test_step_view_validation():
         StepView(0, 0.0, v.states[:, 0], v.benign, v.in_neighbours, v.rng)
     with pytest.raises(InputError, match=r"benign must be a bool array of shape \(8,\)"):
         StepView(0, 0.0, v.states, v.benign.astype(int), v.in_neighbours, v.rng)
-    with pytest.raises(InputError, match=r"in_neighbours must have one entry per agent \(8\); got 7"):
+    with pytest.raises(InputError,
+                       match=r"in_neighbours must have one entry per agent \(8\); got 7"):
         StepView(0, 0.0, v.states, v.benign, v.in_neighbours[:7], v.rng)
     with pytest.raises(InputError, match="rng must be a numpy.random.Generator"):
         StepView(0, 0.0, v.states, v.benign, v.in_neighbours, 0)

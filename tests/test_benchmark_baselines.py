@@ -223,7 +223,10 @@ def test_harness_runs_and_writes_results(tmp_path):
 
 def test_harness_flags_a_wrong_candidate(tmp_path, monkeypatch):
     def wrong():
-        return (lambda G, time_limit=None: R.Answer(B.leblanc_rho(G) + 1, None, "exact")), "deliberately wrong"
+        def wrong(G, time_limit=None):
+            return R.Answer(B.leblanc_rho(G) + 1, None, "exact")
+
+        return wrong, "deliberately wrong"
 
     monkeypatch.setitem(R.CANDIDATES, "wrong", wrong)
     assert _run(tmp_path, "--candidate", "wrong", "--name", "w") == 1

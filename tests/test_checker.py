@@ -485,7 +485,7 @@ def test_complete_graphs_all_r_s():
 
 def test_construction_certificates_and_tampering():
     rng = random.Random(5)
-    for trial in range(40):
+    for _trial in range(40):
         r = rng.randint(1, 3)
         s = rng.randint(1, 3)
         m = max(2 * r - 1, r + s - 1, 1) + rng.randint(0, 1)
@@ -559,7 +559,7 @@ def test_seed_proof_with_s_above_seed_size():
 def test_search_trees_on_random_graphs():
     rng = random.Random(2024)
     accepted = rejected = 0
-    for trial in range(150):
+    for _trial in range(150):
         n = rng.randint(2, 8)
         edges = rand_edges(rng, n, rng.uniform(0.3, 1.0), undirected=rng.random() < 0.5)
         inm = in_masks(n, edges)

@@ -93,7 +93,7 @@ def hull_weights(pts, x):
         if j < n:
             lam[j] = T[i][-1]
     assert sum(lam) == 1 and all(t >= 0 for t in lam)
-    assert all(sum(l * Fraction(p[j]) for l, p in zip(lam, pts)) == Fraction(x[j])
+    assert all(sum(w * Fraction(p[j]) for w, p in zip(lam, pts)) == Fraction(x[j])
                for j in range(d))
     return lam
 

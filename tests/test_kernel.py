@@ -553,7 +553,8 @@ def test_projection_onto_a_tiny_far_kernel_is_guided(n, seed, monkeypatch):
     # n = 100 in R³: re-deriving every candidate plane is beyond the checker's work
     # limit, so that part (and only that part) is left unchecked, never refuted
     assert res.valid or (res.verdict == "unchecked" and n == 100
-                         and all("enumerating the hyperplanes" in part for part in res.unchecked)), res
+                         and all("enumerating the hyperplanes" in part
+                                 for part in res.unchecked)), res
     assert len(calls) <= 50, len(calls)
     # the answer is the exact projection: no vertex of Ψ is nearer to the mean
     exact = [Fraction(v) for v in cert["x"]]

@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 
 import rescon
 from benchmarks.baselines import leblanc_max_s, leblanc_rho
-from tests.test_robustness import check_valid
 from rescon.graphs import bounds as bd
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import decide_r_robust, min_cost_pair
+from tests.test_robustness import check_valid
 
 SCHEMA = json.loads(
     (Path(__file__).parents[1] / "certificates" / "schema" / "certificate.schema.json").read_text()

@@ -48,7 +48,9 @@ def _duplicates(rng, m):
 
 def _collinear(rng, m):
     t = rng.integers(-5, 6, size=m).astype(float)
-    return np.column_stack([t, 3 * t + 1]) if rng.random() < 0.5 else np.column_stack([t * 0 + 2, t])
+    if rng.random() < 0.5:
+        return np.column_stack([t, 3 * t + 1])
+    return np.column_stack([t * 0 + 2, t])
 
 
 @pytest.mark.parametrize("family", [_grid, _converged, _duplicates, _collinear])

@@ -8,6 +8,9 @@ standalone checker in ``certificates/`` (see :func:`check_certificate`).
 from __future__ import annotations
 
 from .certify import CheckResult, check_certificate
+from .consensus.engine import simulate
+from .consensus.scenario import Scenario, ScenarioWarning
+from .consensus.trajectory import Trajectory
 from .errors import (
     CertificateError,
     EmptyKernel,
@@ -19,6 +22,8 @@ from .errors import (
     SolverNotFound,
     TimeLimitReached,
 )
+from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kernel
+from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.attacks import check_assumption2, check_attack_model
 from .graphs.robustness import (
     RobustnessCheck,
@@ -28,11 +33,6 @@ from .graphs.robustness import (
     max_s,
     robustness,
 )
-from .consensus.engine import simulate
-from .consensus.scenario import Scenario, ScenarioWarning
-from .consensus.trajectory import Trajectory
-from .geometry.kernel import SafeKernel, kernel_point, kernel_points, safe_kernel
-from .geometry.tverberg import TverbergPartition, tverberg_partition
 from .graphs.sarymsakov import is_sarymsakov
 from .optim import check_subgradient, cost
 from .optim.redundancy import RedundancyReport, check_redundancy

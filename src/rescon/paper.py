@@ -501,7 +501,8 @@ def _benign_mean(traj: Any, k: int) -> np.ndarray:
 
 def _run_summary(traj: Any) -> dict[str, Any]:
     return {"steps": len(traj.times) - 1, "policy": traj.info.get("policy"),
-            "centre": traj.info.get("centre"), "initial_diameter": float(traj.metrics["diameter"][0]),
+            "centre": traj.info.get("centre"),
+            "initial_diameter": float(traj.metrics["diameter"][0]),
             "final_diameter": traj.final_diameter, "max_validity": traj.max_validity,
             "final_benign_mean": _benign_mean(traj, -1).tolist(),
             "assumptions_violated": traj.info.get("assumptions_violated", []),

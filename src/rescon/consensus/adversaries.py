@@ -407,7 +407,8 @@ class TwoFacedTable:
         if self._default is not None:
             dims.add(len(self._default))
         if len(dims) > 1:
-            raise InputError(f"two_faced vectors must all have one length; got lengths {sorted(dims)}")
+            raise InputError("two_faced vectors must all have one length; got lengths "
+                             f"{sorted(dims)}")
 
     def __call__(self, t: float, receiver: int) -> np.ndarray:
         if self._cycle:

@@ -231,8 +231,9 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
 
     A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
     (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
-    the precise one (both plus ``floor``, 0 when c_err = 0). The scan of a subset stops once both sides surely hold more than
-    F points (it can then bound no valid halfspace), so counts above F are not exact."""
+    the precise one (both plus ``floor``, 0 when c_err = 0). The scan of a subset stops
+    once both sides surely hold more than F points (it can then bound no valid
+    halfspace), so counts above F are not exact."""
     n, k = Y.shape
     count = subsets.shape[0]
     plus = np.zeros(count, dtype=np.int64)

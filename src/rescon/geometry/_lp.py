@@ -11,10 +11,10 @@ combinatorial question).
 The safe-kernel systems have thousands of rows in k ≤ 5 variables and only k + 1
 matter, so the LP is solved on the rows nearest a deep point (the caller's; by default
 the box centre), the rows its solution violates are added (at most ``ADD_ROWS`` per
-round, most violated first), and HiGHS re-solves from the previous basis: a few small solves instead of one
-large one (measured: 2–3 ms instead of 12 ms for 3 200 rows in R⁴). The box keeps
-every partial LP bounded; callers pass one containing the sets they study (the data's
-bounding box contains Ψ), so it does not change the answer.
+round, most violated first), and HiGHS re-solves from the previous basis: a few small
+solves instead of one large one (measured: 2–3 ms instead of 12 ms for 3 200 rows in
+R⁴). The box keeps every partial LP bounded; callers pass one containing the sets they
+study (the data's bounding box contains Ψ), so it does not change the answer.
 """
 
 from __future__ import annotations

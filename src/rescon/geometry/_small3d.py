@@ -362,15 +362,15 @@ def _radon5(Y, x):
             return 0.0
     for i in range(5):
         for j in range(i + 1, 5):
-            k, l, r = _others(i, j)[:3]
-            s1 = orient3(Y, i, j, k, l)
-            s2 = orient3(Y, i, j, l, r)
+            k, m, r = _others(i, j)[:3]
+            s1 = orient3(Y, i, j, k, m)
+            s2 = orient3(Y, i, j, m, r)
             s3 = orient3(Y, i, j, r, k)
             if s1 == 0 or s2 == 0 or s3 == 0:
                 return -1.0
             if not (s1 == s2 == s3):
                 continue
-            di, dj = det3(Y, k, l, r, i), det3(Y, k, l, r, j)
+            di, dj = det3(Y, k, m, r, i), det3(Y, k, m, r, j)
             if not di * dj < 0.0:
                 continue
             t = di / (di - dj)

@@ -37,6 +37,9 @@ from .._rounding import underflow_floor
 from ._budget import PYTHON_STEP, fits
 from .exact import solve_exact
 
+#: an exact vector
+Vector = tuple[Fraction, ...]
+
 #: component range of the directions tried: {−R..R}^d (primitive vectors), by dimension
 _RANGE = {1: 1, 2: 3, 3: 2, 4: 1, 5: 1}
 #: share of the budget the directions may take (they are only a shortcut)
@@ -63,7 +66,7 @@ def _directions_fit(n: int, d: int) -> bool:
 
 
 def empty_certificate(X: np.ndarray, F: int
-                      ) -> tuple[dict[str, Any], list[tuple[tuple[Fraction, ...], Fraction]]] | None:
+                      ) -> tuple[dict[str, Any], list[tuple[Vector, Fraction]]] | None:
     """A ``kernel_empty`` certificate for Ψ(X, F) from directional halfspaces and those
     halfspaces (a, b) exactly, or None.
 

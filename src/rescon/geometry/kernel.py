@@ -120,7 +120,9 @@ class _Exact:
     def contains(self, x: tuple[Fraction, ...]) -> bool:
         if not self.vertices:
             return False
-        dot = lambda a: sum(map(operator.mul, a, x))
+        def dot(a: tuple[Fraction, ...]) -> Fraction:
+            return sum(map(operator.mul, a, x))
+
         return (all(dot(a) == b for a, b in self.equalities)
                 and all(dot(a) <= b for a, b in self.constraints))
 

@@ -16,9 +16,10 @@ format of certificates/FORMAT.md:
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any, Iterable
+from typing import Any
 
 import networkx as nx
 import numpy as np

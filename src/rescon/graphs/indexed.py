@@ -7,8 +7,9 @@ parallel edges of a multigraph count once.
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import Any, Hashable
+from typing import Any
 
 import networkx as nx
 
@@ -56,7 +57,7 @@ class IndexedGraph:
         """The ``graph`` object of a certificate (certificates/FORMAT.md)."""
         return {"n": self.n, "nodes": [_json_label(v) for v in self.nodes], "edges": self.edges()}
 
-    def induced(self, order: list[int]) -> "IndexedGraph":
+    def induced(self, order: list[int]) -> IndexedGraph:
         """Subgraph induced on ``order``, re-indexed so that ``order[j]`` becomes j."""
         pos = {v: j for j, v in enumerate(order)}
         return IndexedGraph(

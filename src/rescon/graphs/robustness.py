@@ -16,8 +16,9 @@ and bound raced against the MILP (n ≤ 64), else the MILP.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
-from typing import Any, Callable, Hashable
+from typing import Any
 
 import numpy as np
 
@@ -267,7 +268,8 @@ def _milp_decision(ig: IndexedGraph, r: int, out: MilpOutcome) -> _Decision:
         return _Decision(None, method="milp")
     pair = bd.Pair(*out.pair)
     if not (pair.S1 and pair.S2 and bd.violates(ig, pair, r, 1)):
-        raise SolverError(f"the robustness MILP returned a pair that does not violate {r}-robustness")
+        raise SolverError("the robustness MILP returned a pair that does not violate "
+                          f"{r}-robustness")
     return _Decision(False, pair=pair, method="milp")
 
 
@@ -368,8 +370,8 @@ def _s_star(
             return _SStar(n, n, n, {"method": "dp"}, None, "dp")
         return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
     if method == "search":
-        return _cost_search_result(ig, r, min_cost_pair(ig, r, upper, lower=lower, deadline=deadline),
-                                   lower, upper, proof, pair)
+        found = min_cost_pair(ig, r, upper, lower=lower, deadline=deadline)
+        return _cost_search_result(ig, r, found, lower, upper, proof, pair)
     return _milp_s_result(ig, r, _milp_s(ig, r, lower, upper, deadline).outcome(), lower, upper,
                           proof, pair)
 
@@ -612,7 +614,8 @@ def is_rs_robust(
     return _check_result(ig, r, s, dec, time.perf_counter() - t0)
 
 
-def _check_result(ig: IndexedGraph, r: int, s: int, dec: _Decision, seconds: float) -> RobustnessCheck:
+def _check_result(ig: IndexedGraph, r: int, s: int, dec: _Decision,
+                  seconds: float) -> RobustnessCheck:
     if dec.holds is None:
         return RobustnessCheck(r, s, None, None, None, None, dec.method, seconds)
     if dec.holds:

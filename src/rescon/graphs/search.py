@@ -17,8 +17,8 @@ is tiny on graphs whose robustness is decided by small or large sets.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
