@@ -100,7 +100,8 @@ def main(argv: list[str] | None = None) -> int:
              (f"{machine}; median of {args.repeat} warm runs; C(N, 2) subsets + the whole set "
               "+ each agent alone. exact: certificate verified valid by certificates/check.py; "
               "numerical: unchecked."), "",
-             "| family | N | holds | exact | gap | seconds | target |", "|---|---|---|---|---|---|---|"]
+             "| family | N | holds | exact | gap | seconds | target |",
+             "|---|---|---|---|---|---|---|"]
     lines += [f"| {r['family']} | {r['N']} | {r['holds']} | {r['exact']} | {r['gap']:.3g} | "
               f"{r['seconds']:.3f} | ≤ {r['target']:g} s |" for r in rows]
     (args.out / "redundancy.md").write_text("\n".join(lines) + "\n")

@@ -201,7 +201,7 @@ def test_construction_orders_pass_the_independent_checker(monkeypatch):
         (lambda: circulant(1, 1), r"n must be an integer >= 2"),
         (lambda: two_cliques(3, 4), r"b must be an integer with 0 <= b <= m = 3; got b=4"),
         (lambda: two_cliques(0, 0), r"m must be an integer >= 1"),
-        (lambda: two_cliques(3, -1), r"b must be an integer >= 0"),
+        (lambda: two_cliques(3, -1), r"b must be a nonnegative integer"),
     ],
 )
 def test_argument_errors(call, pattern):

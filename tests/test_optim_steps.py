@@ -49,9 +49,9 @@ def test_callables_are_checked_on_a_horizon():
 
 
 @pytest.mark.parametrize("spec, match", [
-    (-0.1, "step_size must be a positive"),
-    (0, "step_size must be a positive"),
-    (float("nan"), "step_size must be a positive"),
+    (-0.1, "step_size must be a finite number > 0"),
+    (0, "step_size must be a finite number > 0"),
+    (float("nan"), "step_size must be a finite number > 0"),
     ("fast", "step_size must be 'paper'"),
     ([0.1], "step_size must be 'paper'"),
     (True, "step_size must be 'paper'"),
@@ -64,9 +64,9 @@ def test_bad_step_sizes(spec, match):
 def test_bad_preset_parameters_and_callable_values():
     with pytest.raises(InputError, match="a must be"):
         steps.harmonic(-1, 1)
-    with pytest.raises(InputError, match="b must be a positive"):
+    with pytest.raises(InputError, match="b must be a finite number > 0"):
         steps.harmonic(1, 0)
-    with pytest.raises(InputError, match="c must be a positive"):
+    with pytest.raises(InputError, match="c must be a finite number > 0"):
         steps.sqrt_decay(-2)
     with pytest.raises(InputError, match=r"step_size\(3\) must be a finite number >= 0"):
         steps.step_size(lambda k: 1.0 if k < 3 else -1.0).assumption5(horizon=10)

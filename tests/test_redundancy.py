@@ -340,7 +340,7 @@ def test_numerical_certificate_cannot_pass_as_valid():
 def test_errors():
     with pytest.raises(InputError, match="r must be an integer < N = 2"):
         check_redundancy(["x1^2", "x1^2"], r=2)
-    with pytest.raises(InputError, match="r must be an integer"):
+    with pytest.raises(InputError, match="r must be a nonnegative integer"):
         check_redundancy(["x1^2", "x1^2"], r=-1)
     with pytest.raises(InputError, match="cost of agent a: dimension 2, not d = 3"):
         check_redundancy({"a": atoms.Quadratic(np.eye(2)), "b": atoms.Quadratic(np.eye(3))}, r=1)

@@ -282,9 +282,9 @@ def test_infeasible_claim_against_tverberg_is_an_error(monkeypatch):
     (np.zeros((3, 0)), r"\(n, d\) array"),
     ([["a", "b"]], r"\(n, d\) array"),
     (np.ones((2, 2), dtype=bool), r"\(n, d\) array"),
-    (np.ones((2, 2), dtype=complex), r"\(n, d\) array"),
-    ([[0.0, np.nan], [np.inf, 1.0]], "2 NaN or infinite"),
-    ([[2**60, 0], [0, 1]], "2\\^53"),
+    (np.ones((2, 2), dtype=complex), "must be real"),
+    ([[0.0, np.nan], [np.inf, 1.0]], "must be finite.* 1 NaN and 1 infinite"),
+    ([[2**60 + 1, 0], [0, 1]], "2\\^53"),
 ])
 def test_bad_points(X, match):
     with pytest.raises(InputError, match=match):
@@ -293,13 +293,14 @@ def test_bad_points(X, match):
 
 @pytest.mark.parametrize("parts", [0, 4, -1, 2.0, True, "2", None])
 def test_bad_parts(parts):
-    with pytest.raises(InputError, match=r"parts must be an integer with 1 ≤ parts ≤ n = 3"):
+    with pytest.raises(InputError, match=r"parts must be an integer in \[1, 3\]"):
         tverberg_partition(np.zeros((3, 2)), parts)
 
 
 @pytest.mark.parametrize("limit", [0, -1.0, float("nan"), float("inf"), "1", True])
 def test_bad_time_limit(limit):
-    with pytest.raises(InputError, match="time_limit must be a positive number"):
+    with pytest.raises(InputError,
+                       match="time_limit must be a (real number|finite number of seconds > 0)"):
         tverberg_partition(np.zeros((3, 2)), 2, time_limit=limit)
 
 

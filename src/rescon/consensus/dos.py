@@ -48,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import integer, nonnegative, positive, real
 from ..errors import InputError
 from ._config import check_keys
 
@@ -82,27 +83,6 @@ _LONG_RUN_MAX_WINDOWS = 200_000
 # --------------------------------------------------------------------------- #
 # input validation
 # --------------------------------------------------------------------------- #
-
-
-def _real(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InputError(f"{name} must be a real number; got {value!r}")
-    return float(value)
-
-
-def _time(name: str, value: Any) -> float:
-    """A finite time >= 0."""
-    v = _real(name, value)
-    if not math.isfinite(v) or v < 0:
-        raise InputError(f"{name} must be a finite number >= 0; got {value!r}")
-    return v
-
-
-def _positive(name: str, value: Any) -> float:
-    v = _real(name, value)
-    if not math.isfinite(v) or v <= 0:
-        raise InputError(f"{name} must be a finite number > 0; got {value!r}")
-    return v
 
 
 def _merge(windows: Iterable[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
@@ -177,9 +157,9 @@ class Periodic(Schedule):
     offset: float = 0.0
 
     def __post_init__(self) -> None:
-        period = _positive("period", self.period)
-        duration = _positive("duration", self.duration)
-        offset = _time("offset", self.offset)
+        period = positive("period", self.period)
+        duration = positive("duration", self.duration)
+        offset = nonnegative("offset", self.offset)
         if duration > period:
             raise InputError(
                 f"duration must be <= period; got duration={duration!r} > period={period!r}"
@@ -194,7 +174,7 @@ class Periodic(Schedule):
         return self.duration / self.period
 
     def windows(self, horizon: float) -> list[tuple[float, float]]:
-        horizon = _time("horizon", horizon)
+        horizon = nonnegative("horizon", horizon)
         if horizon <= self.offset:
             return []
         n = math.ceil((horizon - self.offset) / self.period) + 1
@@ -207,7 +187,7 @@ class Periodic(Schedule):
         return out
 
     def active(self, t: float) -> bool:
-        t = _time("t", t)
+        t = nonnegative("t", t)
         if t < self.offset:
             return False
         m = math.floor((t - self.offset) / self.period)
@@ -260,19 +240,19 @@ class Explicit(Schedule):
                 raise InputError(
                     f"windows[{k}] must be a (start, end) pair; got {w!r}"
                 ) from None
-            s = _time(f"windows[{k}] start", s)
-            e = _time(f"windows[{k}] end", e)
+            s = nonnegative(f"windows[{k}] start", s)
+            e = nonnegative(f"windows[{k}] end", e)
             if not s < e:
                 raise InputError(f"windows[{k}] must have start < end; got ({s!r}, {e!r})")
             clean.append((s, e))
         object.__setattr__(self, "intervals", tuple(_merge(clean)))
 
     def windows(self, horizon: float) -> list[tuple[float, float]]:
-        horizon = _time("horizon", horizon)
+        horizon = nonnegative("horizon", horizon)
         return [w for w in self.intervals if w[0] < horizon]
 
     def active(self, t: float) -> bool:
-        t = _time("t", t)
+        t = nonnegative("t", t)
         k = bisect.bisect_right(self.intervals, (t, math.inf)) - 1
         return k >= 0 and t < self.intervals[k][1]
 
@@ -323,13 +303,10 @@ class RandomDoS(Schedule):
                                    compare=False, hash=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "rate", _positive("rate", self.rate))
-        object.__setattr__(self, "mean_duration", _positive("mean_duration",
+        object.__setattr__(self, "rate", positive("rate", self.rate))
+        object.__setattr__(self, "mean_duration", positive("mean_duration",
                                                             self.mean_duration))
-        if (isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer))
-                or self.seed < 0):
-            raise InputError(f"seed must be a nonnegative integer; got {self.seed!r}")
-        object.__setattr__(self, "seed", int(self.seed))
+        object.__setattr__(self, "seed", integer("seed", self.seed, low=0))
 
     @property
     def fraction(self) -> float:
@@ -360,13 +337,13 @@ class RandomDoS(Schedule):
         return merged
 
     def windows(self, horizon: float) -> list[tuple[float, float]]:
-        horizon = _time("horizon", horizon)
+        horizon = nonnegative("horizon", horizon)
         merged = self._extend(horizon)
         k = bisect.bisect_left([w[0] for w in merged], horizon)
         return [(s, e) for s, e in merged[:k]]
 
     def active(self, t: float) -> bool:
-        t = _time("t", t)
+        t = nonnegative("t", t)
         ws = self.windows(math.nextafter(t, math.inf))
         return bool(ws) and ws[-1][0] <= t < ws[-1][1]
 
@@ -514,7 +491,7 @@ def blocked_links(attacks: Iterable[DoSAttack], t: float) -> frozenset[Link]:
     ([(1, 3), (1, 7)], [])
     """
     atts = _attacks(attacks)
-    t = _time("t", t)
+    t = nonnegative("t", t)
     out: set[Link] = set()
     for a in atts:
         if a.links and a.schedule.active(t):
@@ -564,7 +541,7 @@ def blocked_mask(attacks: Iterable[DoSAttack], links_index: Mapping[Link, int], 
     n = _index_size(links_index)
     if strict:
         _unknown_links(atts, links_index)
-    t = _time("t", t)
+    t = nonnegative("t", t)
     mask = np.zeros(n, dtype=bool)
     for a in atts:
         if a.links and a.schedule.active(t):
@@ -722,7 +699,7 @@ class Assumption3Report:
 
 
 def _check_T_d(T_d: Any) -> float:
-    v = _real("T_d", T_d)
+    v = real("T_d", T_d)
     if math.isnan(v) or not v > 1:
         raise InputError(f"T_d must be a number > 1 (inf allowed); got {T_d!r}")
     return v
@@ -904,9 +881,9 @@ def check_assumption3(attacks: Iterable[DoSAttack], horizon: float, *,
     (False, (0.0, 10.0, 10.0), False)
     """
     atts = _attacks(attacks)
-    horizon = _time("horizon", horizon)
+    horizon = nonnegative("horizon", horizon)
     if mu_d is not None:
-        mu_d = _positive("mu_d", mu_d)
+        mu_d = positive("mu_d", mu_d)
     if T_d is not None:
         T_d = _check_T_d(T_d)
     notes: list[str] = []

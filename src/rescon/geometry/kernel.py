@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import check_F, check_points
 from ..errors import EmptyKernel, InputError
 from .emptiness import empty_certificate, empty_from_halfspaces
 from .exact import (
@@ -34,77 +35,12 @@ from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .polytope import ExactPolytope, clip_to_fixpoint
 
-__all__ = ["SafeKernel", "check_F", "check_points", "kernel_point", "kernel_points", "safe_kernel"]
+__all__ = ["SafeKernel", "kernel_point", "kernel_points", "safe_kernel"]
 
 
 #: below this many valid halfspaces exact clipping is faster than the fast path's
 #: LP + qhull set-up (and tiny kernels are often flat, which the fast path declines)
 FAST_PATH_MIN_HALFSPACES = 60
-
-
-def check_points(X: Any, name: str = "X") -> np.ndarray:
-    """X as a finite float array (n, d), n ≥ 1, d ≥ 1, or InputError saying what came.
-
-    Every entry must be a float64 exactly: complex numbers, integers above 2^53 (or
-    Fractions, long doubles) that a float cannot hold are refused, not rounded — the
-    kernel is exact for the floats it is given, and its certificate states them."""
-    try:
-        raw = np.asarray(X)
-        complex_ = raw.dtype.kind == "c" or (raw.dtype == object and any(
-            isinstance(v, (complex, np.complexfloating)) for v in raw.flat))
-        arr = None if complex_ else np.array(raw, dtype=np.float64)
-    except OverflowError:
-        raise InputError(f"{name} has an entry outside the float64 range") from None
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be a finite (n, d) array of numbers; got "
-                         f"{type(X).__name__} that is not numeric ({exc})") from None
-    if arr is None:
-        raise InputError(f"{name} must be real; got complex entries")
-    _check_exact_floats(raw, arr, name)
-    if arr.ndim != 2:
-        raise InputError(f"{name} must be a finite (n, d) array; got shape {arr.shape}")
-    n, d = arr.shape
-    if n == 0 or d == 0:
-        raise InputError(f"{name} must have n >= 1 points in d >= 1 dimensions; got shape "
-                         f"{arr.shape}")
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        nan = int(np.isnan(arr).sum())
-        raise InputError(f"{name} must be finite; got shape {arr.shape} with {nan} NaN and "
-                         f"{int(bad.sum()) - nan} infinite entries")
-    return arr
-
-
-def _check_exact_floats(raw: np.ndarray, arr: np.ndarray, name: str) -> None:
-    """InputError when a finite entry of ``raw`` is not exactly its float64 ``arr``
-    (integer dtypes: only |v| > 2^53 can differ; object: each entry as a Fraction)."""
-    kind = raw.dtype.kind
-    flat_raw, flat = raw.ravel(), arr.ravel()
-    if kind in "iu":
-        suspects = np.flatnonzero(np.abs(flat) >= 2.0**53)
-    elif kind == "f" and raw.dtype.itemsize > 8:
-        suspects = np.flatnonzero(np.isfinite(flat) & (flat.astype(raw.dtype) != flat_raw))
-    elif kind == "O":
-        suspects = np.flatnonzero(np.isfinite(flat))
-    else:
-        return
-    for i in suspects.tolist():
-        v = flat_raw[i]
-        if kind == "f" or Fraction(v) != Fraction(float(flat[i])):
-            text = str(v) if len(str(v)) <= 24 else f"{str(v)[:20]}… ({len(str(v))} chars)"
-            raise InputError(f"{name}[{i // arr.shape[-1]}, {i % arr.shape[-1]}] = {text} is "
-                             f"not exactly a float64 (it would be rounded); give floats, "
-                             f"or integers of magnitude at most 2^53")
-
-
-def check_F(F: Any, n: int) -> int:
-    """F as an int with 0 ≤ F < n."""
-    if isinstance(F, bool) or not isinstance(F, (int, np.integer)):
-        raise InputError(f"F must be an integer 0 <= F < n = {n}; got {F!r}")
-    F = int(F)
-    if not 0 <= F < n:
-        raise InputError(f"F must satisfy 0 <= F < n = {n}; got F = {F}")
-    return F
 
 
 @dataclass(frozen=True)

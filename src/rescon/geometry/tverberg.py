@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, SolverError, TimeLimitReached
+from .._validate import check_points, integer, positive
+from ..errors import SolverError, TimeLimitReached
 from ..models.backends import require_backend, silent_highs
 
 __all__ = ["TverbergPartition", "tverberg_partition"]
@@ -170,26 +171,11 @@ def tverberg_partition(
 
 def _check_input(X: Any, parts: Any, time_limit: Any) -> tuple[np.ndarray, int]:
     """X as a finite float64 (n, d) array and ``parts`` as an int in 1..n."""
-    arr = np.asarray(X)
-    if arr.dtype.kind not in "iuf" or arr.ndim != 2 or 0 in arr.shape:
-        raise InputError("X must be a finite (n, d) array of real numbers with n, d ≥ 1; "
-                         f"got shape {arr.shape} of dtype {arr.dtype}")
-    if arr.dtype.kind in "iu" and np.any(np.abs(arr.astype(object)) > 2**53):
-        raise InputError("X has integers of magnitude > 2^53, not all exact in float64")
-    arr = arr.astype(np.float64)
-    bad = np.count_nonzero(~np.isfinite(arr))
-    if bad:
-        raise InputError(f"X must be finite; got {bad} NaN or infinite value(s)")
-    n = arr.shape[0]
-    if isinstance(parts, bool) or not isinstance(parts, (int, np.integer)) or not 1 <= parts <= n:
-        raise InputError(f"parts must be an integer with 1 ≤ parts ≤ n = {n}; got {parts!r}")
-    if time_limit is not None and (
-        isinstance(time_limit, bool)
-        or not isinstance(time_limit, (int, float, np.number))
-        or not (time_limit > 0 and np.isfinite(time_limit))
-    ):
-        raise InputError(f"time_limit must be a positive number of seconds; got {time_limit!r}")
-    return arr, int(parts)
+    arr = check_points(X)
+    parts = integer("parts", parts, low=1, high=arr.shape[0])
+    if time_limit is not None:
+        positive("time_limit", time_limit, what="finite number of seconds")
+    return arr, parts
 
 
 # --------------------------------------------------------------------------- #

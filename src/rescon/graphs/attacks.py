@@ -10,8 +10,7 @@ from collections.abc import Hashable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
+from .._validate import integer
 from ..errors import InputError
 from .indexed import IndexedGraph, index_graph
 
@@ -103,7 +102,7 @@ def check_attack_model(G: Any, adversaries: Iterable[Hashable], F: int, *,
     ((3, (1, 2)),)
     """
     ig = index_graph(G, min_nodes=1)
-    F = _nonneg_int("F", F)
+    F = integer("F", F, low=0)
     if model not in _MODELS:
         raise InputError(f"model must be one of {_MODELS}; got {model!r}")
     adv = _adversary_indices(ig, adversaries)
@@ -154,8 +153,8 @@ def check_assumption2(G: Any, d: int, F: int, *,
     ((0, 6), (1, 6), (2, 6), (3, 6), (4, 6), (5, 6), (6, 6))
     """
     ig = index_graph(G, min_nodes=1)
-    d = _nonneg_int("d", d)
-    F = _nonneg_int("F", F)
+    d = integer("d", d, low=0)
+    F = integer("F", F, low=0)
     adv = _adversary_indices(ig, adversaries)
     required = (d + 1) * F + 1
     bad = [
@@ -164,12 +163,6 @@ def check_assumption2(G: Any, d: int, F: int, *,
         if i not in adv and len(ig.in_nbrs[i]) < required
     ]
     return Assumption2Report(holds=not bad, required=required, violations=tuple(bad))
-
-
-def _nonneg_int(name: str, value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise InputError(f"{name} must be a nonnegative integer; got {value!r}")
-    return int(value)
 
 
 def _adversary_indices(ig: IndexedGraph, adversaries: Any) -> frozenset[int]:

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
 from .indexed import IndexedGraph, index_graph
@@ -112,16 +113,6 @@ class RobustnessCheck:
 # --------------------------------------------------------------------------- #
 # input validation
 # --------------------------------------------------------------------------- #
-
-
-def _int_arg(name: str, value: Any, low: int, high: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InputError(f"{name} must be an integer; got {value!r}")
-    value = int(value)
-    if value < low or (high is not None and value > high):
-        upper = f" and ≤ {high}" if high is not None else ""
-        raise InputError(f"{name} must be ≥ {low}{upper}; got {value}")
-    return value
 
 
 def _check_options(method: str, time_limit: float | None) -> float | None:
@@ -593,8 +584,8 @@ def is_rs_robust(
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
     _check_method_size(method, ig.n)
-    r = _int_arg("r", r, 0)
-    s = _int_arg("s", s, 1, ig.n)
+    r = integer("r", r, low=0)
+    s = integer("s", s, low=1, high=ig.n)
     seeds = bd.greedy_cliques(ig)
     dec = _decide_r(ig, r, method, deadline, seeds)
     if dec.holds and s > 1:
@@ -660,7 +651,7 @@ def max_s(
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
     _check_method_size(method, ig.n)
-    r = _int_arg("r", r, 0)
+    r = integer("r", r, low=0)
     if r == 0:
         return ig.n
     seeds = bd.greedy_cliques(ig)

@@ -130,7 +130,7 @@ def is_sarymsakov(A: Any, *, time_limit: float | None = None) -> SarymsakovResul
     deadline = None
     if time_limit is not None:
         deadline = time.monotonic() + positive("time_limit", time_limit,
-                                                      what="number of seconds")
+                                                      what="finite number of seconds")
     sigma = maximum_bipartite_matching(csr_matrix(S), perm_type="column")
     if (sigma >= 0).all():
         witness, exact, method = _source_components(S, sigma), True, "matching"
