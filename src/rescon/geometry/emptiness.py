@@ -35,7 +35,7 @@ import numpy as np
 from .._rounding import UNIT_ROUNDOFF as _EPS
 from .._rounding import underflow_floor
 from ._budget import PYTHON_STEP, fits
-from .exact import solve_exact
+from .exact import fraction_str, halfspaces_json, solve_exact
 
 #: an exact vector
 Vector = tuple[Fraction, ...]
@@ -102,11 +102,9 @@ def empty_certificate(X: np.ndarray, F: int
     lam = _farkas(normals, b, d)
     if lam is None:
         return None
-    from .kernel import _q
-
     cert = {"rescon_certificate": 1, "kind": "kernel_empty", "points": X.tolist(), "F": F,
-            "halfspaces": [{"a": [_q(v) for v in u], "b": _q(bb)} for u, bb in zip(normals, b)],
-            "multipliers": [_q(v) for v in lam], "equalities": [], "eq_multipliers": []}
+            "halfspaces": halfspaces_json(zip(normals, b)),
+            "multipliers": [fraction_str(v) for v in lam], "equalities": [], "eq_multipliers": []}
     return cert, list(zip(normals, b))
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 
@@ -22,6 +23,7 @@ __all__ = [
     "exact_points",
     "float_view",
     "fraction_str",
+    "halfspaces_json",
     "nullspace_exact",
     "solve_exact",
 ]
@@ -235,6 +237,12 @@ def fraction_str(x: Fraction) -> str:
     x = Fraction(x)
     num = _int_str(x.numerator)
     return num if x.denominator == 1 else f"{num}/{_int_str(x.denominator)}"
+
+
+def halfspaces_json(rows) -> list[dict[str, Any]]:
+    """Rows (a, b) of a·x ≤ b (or = b) as certificate JSON: {"a": [...], "b": ...}, the
+    rationals written by :func:`fraction_str`."""
+    return [{"a": [fraction_str(v) for v in a], "b": fraction_str(b)} for a, b in rows]
 
 
 def nullspace_exact(M: list[list[Fraction]]) -> list[list[Fraction]]:

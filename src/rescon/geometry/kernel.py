@@ -28,11 +28,13 @@ from .exact import (
     exact_points,
     float_view,
     fraction_str,
+    halfspaces_json,
     nullspace_exact,
     solve_exact,
 )
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
+from .points import kernel_point_of
 from .polytope import ExactPolytope, clip_to_fixpoint
 
 __all__ = ["SafeKernel", "kernel_point", "kernel_points", "safe_kernel"]
@@ -133,8 +135,6 @@ class SafeKernel:
               target: Any = None) -> tuple[np.ndarray, dict[str, Any]]:
         """A canonical point of Ψ and its ``kernel_point`` certificate; see
         :func:`rescon.kernel_point`."""
-        from .points import kernel_point_of
-
         return kernel_point_of(self, method=method, backend=backend, target=target)
 
     def plot(self, ax: Any = None, *, point: Any = None, path: Any = None) -> Any:
@@ -142,10 +142,6 @@ class SafeKernel:
         from ..plot.kernel import plot_kernel
 
         return plot_kernel(self, ax=ax, point=point, path=path)
-
-
-def _q(x: Fraction) -> str:
-    return fraction_str(x)
 
 
 def _ambient(hull: AffineHull, d: int, a: tuple[int, ...], b: int, scale: int
@@ -275,9 +271,8 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
 
     def certificate() -> dict[str, Any]:
         return {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(),
-                "F": F, "dim": dim, "vertices": [[_q(v) for v in x] for x in verts],
-                "equalities": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in eqs],
-                "facets": [{"a": [_q(v) for v in a], "b": _q(bb)} for a, bb in constraints],
+                "F": F, "dim": dim, "vertices": [[fraction_str(v) for v in x] for x in verts],
+                "equalities": halfspaces_json(eqs), "facets": halfspaces_json(constraints),
                 "proof": {"method": "halfspaces"}}
 
     V = np.array([[float(v) for v in x] for x in verts])
@@ -414,8 +409,8 @@ def _empty_certificate(Xa, F, hull, poly, scale, d) -> dict[str, Any]:
     assert far is not None
     hs = [_ambient(hull, d, poly.a[i], poly.b[i], scale) for i in far.ids]
     return {"rescon_certificate": 1, "kind": "kernel_empty", "points": Xa.tolist(), "F": F,
-            "halfspaces": [{"a": [_q(v) for v in a], "b": _q(b)} for a, b in hs],
-            "multipliers": [_q(x) for x in far.multipliers],
+            "halfspaces": halfspaces_json(hs),
+            "multipliers": [fraction_str(x) for x in far.multipliers],
             "equalities": [], "eq_multipliers": []}
 
 
