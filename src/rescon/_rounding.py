@@ -17,6 +17,8 @@ UNIT_ROUNDOFF = 2.0**-53
 MIN_NORMAL = sys.float_info.min
 #: largest finite double, (2 − 2^-52)·2^1023
 MAX_FINITE = sys.float_info.max
+#: smallest positive (subnormal) double, 2^-1074: the spacing of the subnormal range
+MIN_SUBNORMAL = 2.0**-1074
 
 
 def underflow_floor(k: int, M: float) -> float:

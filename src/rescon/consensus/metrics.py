@@ -14,7 +14,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from .._rounding import UNIT_ROUNDOFF
+from .._rounding import MIN_SUBNORMAL, UNIT_ROUNDOFF
 from ..geometry.kernel import safe_kernel
 
 __all__ = ["ValidityMonitor", "diameter", "spread"]
@@ -102,7 +102,7 @@ class ValidityMonitor:
         with np.errstate(over="ignore", invalid="ignore"):
             S = states @ A.T - b
             bound = (2 * (d + 2) * UNIT_ROUNDOFF * (np.abs(states) @ np.abs(A).T + np.abs(b))
-                     + (d + 2) * 2.0**-1074 * (np.abs(states).max(axis=1) + 1)[:, None])
+                     + (d + 2) * MIN_SUBNORMAL * (np.abs(states).max(axis=1) + 1)[:, None])
         return S, bound
 
     def distances(self, states: np.ndarray) -> np.ndarray:
