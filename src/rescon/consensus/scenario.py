@@ -103,12 +103,27 @@ def _bytes(b: float) -> str:
     return f"{b:.3g} {units[k]}"
 
 
+@dataclass(frozen=True)
+class Residual:
+    """ε(t) = r^t (r ∈ (0, 1)), or ε ≡ 0 when r = 0: a picklable callable whose spec
+    (:meth:`spec`) reads back through :func:`_residual`."""
+
+    r: float = 0.0
+
+    def __call__(self, t: float) -> float:
+        return self.r**t if self.r else 0.0
+
+    def spec(self) -> str:
+        """"none" or "r^t" (r written so that float() gives r back exactly)."""
+        return f"{self.r!r}^t" if self.r else "none"
+
+
 def _residual(spec: Any) -> Callable[[float], float]:
     """ε(t): "none" (0), "0.1^t" / a number r ∈ (0, 1) (r^t), or a callable."""
     if callable(spec):
         return spec
     if spec in (None, "none", 0, 0.0):
-        return lambda t: 0.0
+        return Residual()
     if isinstance(spec, str) and spec.endswith("^t"):
         try:
             spec = float(spec[:-2])
@@ -116,8 +131,7 @@ def _residual(spec: Any) -> Callable[[float], float]:
             raise InputError(f"residual must be 'none', 'r^t' or a number r in (0, 1); "
                              f"got {spec!r}") from None
     if isinstance(spec, (int, float)) and not isinstance(spec, bool) and 0 < spec < 1:
-        r = float(spec)
-        return lambda t: r**t
+        return Residual(float(spec))
     raise InputError(f"residual must be 'none', 'r^t' or a number r in (0, 1); got {spec!r}")
 
 
@@ -426,7 +440,43 @@ class Scenario:
         [costs] or [step_size] describes an RMDO run and is refused here: read it with
         :func:`rescon.optim.read_rmdo` (``rescon rmdo``)."""
         p = Path(path)
-        return _from_dict(read_toml(p), p.parent, str(p))
+        return cls.from_dict(read_toml(p), base=p.parent, where=str(p))
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], *, base: str | Path = ".",
+                  where: str = "scenario") -> Scenario:
+        """The scenario of a scenario file's tables as a dict ({"scenario": {...},
+        "graph": {...}, "initial": {...}, "adversaries": {...}, "dos": [...]}) — the one
+        parser behind :meth:`from_toml` and sweep grids; files it names are relative to
+        ``base``; ``where`` prefixes error messages."""
+        if not isinstance(data, Mapping):
+            raise InputError(f"{where}: a scenario must be a dict of tables; got "
+                             f"{type(data).__name__}")
+        return _from_dict(data, Path(base), where)
+
+    def to_dict(self) -> dict[str, Any]:
+        """This scenario as plain data (lists, numbers, strings; TOML-ready with node
+        labels as keys): ``Scenario.from_dict(s.to_dict())`` rebuilds it. A callable
+        residual or a behaviour without a dict form (e.g. a TwoFaced given a Python
+        function) has none: InputError naming it."""
+        if not isinstance(self.residual, Residual):
+            raise InputError("residual: a callable residual has no dict form (use 'none', "
+                             "'r^t' or a number r)")
+        alpha = (float(self.alpha[0]) if (self.alpha == self.alpha[0]).all()
+                 else {str(v): float(a) for v, a in zip(self.nodes, self.alpha, strict=True)})
+        sc = {"F": self.F, "T": self.T, "steps": self.steps, "model": self.model,
+              "policy": self.policy, "algorithm": self.algorithm, "centre": self.centre,
+              "alpha": alpha, "c": float(self.c), "residual": self.residual.spec(),
+              "seed": self.seed, "kernel_point": self.kernel_point,
+              "check_robustness": self.check_robustness}
+        return {"scenario": sc,
+                "graph": {"nodes": self.nodes, "edges": [[u, v] for u, v in self.graph.edges]},
+                "initial": {str(v): x.tolist() for v, x in zip(self.nodes, self.x0,
+                                                                 strict=True)},
+                "adversaries": {str(v): _behaviour_dict(v, b)
+                                for v, b in self.adversaries.items()},
+                "dos": [{"name": a.name, "links": sorted([i, j] for i, j in a.links),
+                         "schedule": a.schedule.to_dict()} for a in self.dos]}
 
 
 def read_toml(path: Path) -> dict:
@@ -445,7 +495,20 @@ _TOP = {"scenario", "graph", "initial", "adversaries", "dos"}
 RMDO_TABLES = ("costs", "step_size")
 _SCENARIO = {"F", "T", "steps", "model", "policy", "algorithm", "centre", "alpha", "c",
              "residual", "seed", "kernel_point", "paper_example", "check_robustness"}
-_GRAPH = {"edgelist", "edges", "undirected"}
+_GRAPH = {"edgelist", "edges", "undirected", "nodes"}
+
+
+def _behaviour_dict(node: Hashable, beh: Behaviour) -> dict[str, Any]:
+    """``beh.to_dict()`` when it reads back to an equal behaviour, else InputError."""
+    try:
+        d = beh.to_dict()
+        same = behaviour_from_dict(d) == beh
+    except (InputError, TypeError, ValueError):
+        same = False
+    if not same:
+        raise InputError(f"adversaries[{node!r}]: {type(beh).__name__} has no dict form "
+                         "(a Python function is not data)")
+    return d
 
 
 def _keys(d: Mapping, allowed: set[str], where: str) -> None:
@@ -507,6 +570,8 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
                              f"states, adversaries and DoS attacks; remove {', '.join(given)}")
         return Scenario.paper_example(**sc)
     sc.pop("paper_example", None)
+    if isinstance(sc.get("alpha"), Mapping):  # TOML keys are strings; labels as in [initial]
+        sc["alpha"] = {_label(k): v for k, v in sc["alpha"].items()}
     if "graph" not in data or "initial" not in data or "F" not in sc:
         raise InputError(f"{where}: needs [graph], [initial] and scenario.F "
                          "(or scenario.paper_example = true)")
@@ -523,7 +588,9 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
 
 def _graph(g: Mapping, base: Path, where: str) -> nx.DiGraph:
     """[graph]: ``edgelist`` (a graph file, any format of :func:`rescon.io.read_graph`)
-    or ``edges`` (a list of [u, v], u → v, labels integers or strings); ``undirected``."""
+    or ``edges`` (a list of [u, v], u → v, labels integers or strings); ``undirected``;
+    ``nodes`` (with ``edges``, optional): every label in the order of the agents'
+    indices (the order of first appearance in ``edges`` otherwise)."""
     _keys(g, _GRAPH, where)
     undirected = _flag(g, "undirected", where)
     if ("edgelist" in g) == ("edges" in g):
@@ -531,11 +598,14 @@ def _graph(g: Mapping, base: Path, where: str) -> nx.DiGraph:
     if "edgelist" in g:
         from ..io import read_graph
 
+        if "nodes" in g:
+            raise InputError(f"{where}: nodes goes with edges, not with edgelist")
         return read_graph(_path(g, "edgelist", base, where), undirected=undirected)
     edges = g["edges"]
     if not isinstance(edges, list):
         raise InputError(f"{where}: edges must be a list of [u, v]; got {edges!r}")
     G = nx.DiGraph()
+    G.add_nodes_from(_node_list(g.get("nodes", []), where))
     for e in edges:
         if not (isinstance(e, list) and len(e) == 2 and all(
                 isinstance(v, (int, str)) and not isinstance(v, bool) for v in e)):
@@ -543,6 +613,15 @@ def _graph(g: Mapping, base: Path, where: str) -> nx.DiGraph:
                              f"labels; got {e!r}")
         G.add_edge(e[0], e[1])
     return G.to_undirected().to_directed() if undirected else G
+
+
+def _node_list(nodes: Any, where: str) -> list[Hashable]:
+    """[graph] nodes: a list of distinct integer or string labels."""
+    if not (isinstance(nodes, list) and all(isinstance(v, (int, str)) and not isinstance(
+            v, bool) for v in nodes) and len(set(nodes)) == len(nodes)):
+        raise InputError(f"{where}: nodes must be a list of distinct integer or string "
+                         f"labels; got {nodes!r}")
+    return nodes
 
 
 def _initial(init: Mapping, base: Path, where: str) -> Any:
