@@ -49,7 +49,7 @@ from .oracle import Oracle
 from .paper import paper_costs
 from .steps import StepSize, constant, harmonic, sqrt_decay
 
-__all__ = ["RMDOFile", "read_costs", "read_rmdo"]
+__all__ = ["RMDOFile", "read_costs", "read_rmdo", "rmdo_from_dict"]
 
 _RESERVED = {"module", "paper", "f7", "algorithm"}
 #: [step_size] kinds → (their parameters, the preset built from them)
@@ -83,7 +83,16 @@ def read_rmdo(path: str | Path) -> RMDOFile:
         [step_size]. Agents without a cost are refused by :func:`rescon.rmdo`.
     """
     p = Path(path)
-    data = dict(read_toml(p))
+    return rmdo_from_dict(read_toml(p), path=p)
+
+
+def rmdo_from_dict(data: Mapping[str, Any], *, path: str | Path = "rmdo") -> RMDOFile:
+    """An RMDO file's tables as a dict, by the parser of :func:`read_rmdo` (sweep grids
+    use it: costs as expression strings are plain data). ``path``: the file the data
+    came from, real or notional — its directory resolves the file and module names the
+    data gives, its name prefixes error messages."""
+    p = Path(path)
+    data = dict(data)
     if "costs" not in data:
         raise InputError(f"{p}: an RMDO file needs a [costs] table (one cost per benign "
                          "agent); without it, run Algorithm 1 with `rescon simulate`")
