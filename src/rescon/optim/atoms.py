@@ -27,7 +27,7 @@ float values, and any element chosen is a subgradient up to that rounding):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from fractions import Fraction
 from typing import Any
 
@@ -134,14 +134,16 @@ def _scalar(name: str, value: Any) -> float:
     return float(v.reshape(()))
 
 
-def _mean_active(vals: np.ndarray, grads: np.ndarray) -> np.ndarray:
-    """Mean of ``grads[:, i]`` over the pieces i attaining the row maximum of ``vals``
-    (B, m); ``grads`` (B, m, d) or (m, d) when the same for every row."""
+def _active(vals: np.ndarray) -> np.ndarray:
+    """(B, m) weights 1/|I_b| on the pieces I_b attaining the row maximum of ``vals``."""
     active = (vals == vals.max(axis=1, keepdims=True)).astype(float)
-    active /= active.sum(axis=1, keepdims=True)
-    if grads.ndim == 2:
-        return active @ grads
-    return np.einsum("bm,bmd->bd", active, grads)
+    return active / active.sum(axis=1, keepdims=True)
+
+
+def _mean_active(vals: np.ndarray, grads: np.ndarray) -> np.ndarray:
+    """Mean of ``grads[:, i]`` (B, m, d) over the pieces i attaining the row maximum of
+    ``vals`` (B, m)."""
+    return np.einsum("bm,bmd->bd", _active(vals), grads)
 
 
 class Atom(Oracle):
@@ -150,6 +152,17 @@ class Atom(Oracle):
 
     kind = "atom"
     exact: dict[str, Any] | None = None
+
+    # -- the stacked fast path (internal; see Stacked) --------------------- #
+
+    def _signature(self) -> Hashable | None:
+        """(class, data shapes or the terms' signatures): atoms with equal signatures
+        stack; None when this one cannot (a term that is not a library atom)."""
+        return None
+
+    def _data(self) -> Any:
+        """This atom's float data as a tree (dicts / lists of arrays) of fixed shapes."""
+        raise NotImplementedError
 
 
 class Quadratic(Atom):
@@ -183,6 +196,22 @@ class Quadratic(Atom):
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
         return (Z - self.c) @ self.Q + self.q
 
+    def _signature(self) -> Hashable:
+        return (Quadratic, self.d)
+
+    def _data(self) -> dict[str, Any]:
+        return {"Q": self.Q, "c": self.c, "q": self.q, "const": self.const}
+
+    @staticmethod
+    def _value_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+        W = Z - S["c"]
+        return (0.5 * (np.einsum("bd,bde->be", W, S["Q"]) * W).sum(axis=1)
+                + (Z * S["q"]).sum(axis=1) + S["const"])
+
+    @staticmethod
+    def _subgradient_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+        return np.einsum("bd,bde->be", Z - S["c"], S["Q"]) + S["q"]
+
 
 class Affine(Atom):
     """f(x) = aᵀx + b; ∇f = a."""
@@ -203,10 +232,31 @@ class Affine(Atom):
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
         return np.broadcast_to(self.a, Z.shape).copy()
 
+    def _signature(self) -> Hashable:
+        return (Affine, self.d)
+
+    def _data(self) -> dict[str, Any]:
+        return {"a": self.a, "b": self.b}
+
+    @staticmethod
+    def _value_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+        return (Z * S["a"]).sum(axis=1) + S["b"]
+
+    @staticmethod
+    def _subgradient_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+        return S["a"].copy()
+
 
 class _Rows(Atom):
     """Atoms of the rows of A x with data (A: (m, d), b: (m,)): residual atoms use
-    r = A x − b, piece atoms A x + b."""
+    r = A x − b, piece atoms (``pieces = True``) r = A x + b.
+
+    A subclass writes f and its subgradient through r only: ``_f(r, M)`` → (B,) and
+    ``_w(r, M)`` → (B, m) with subgradient Aᵀw (``M``: Huber's threshold, else None),
+    so that the per-oracle path and the stacked path (:class:`Stacked`, row i with
+    agent i's A_i, b_i) use one formula and one convention at kinks."""
+
+    pieces = False
 
     def __init__(self, A: Any, b: Any = None, *, name: str = "cost") -> None:
         self.A = _matrix("A", A)
@@ -215,11 +265,37 @@ class _Rows(Atom):
         self._At = np.ascontiguousarray(self.A.T)  # Z @ A.T is ~100x slower than this
         self.exact = {"A": _rational(A, self.A.shape), "b": _rational(b, self.b.shape)}
 
-    def _r(self, Z: np.ndarray) -> np.ndarray:
-        return Z @ self._At - self.b
+    M: Any = None
 
-    def _pieces(self, Z: np.ndarray) -> np.ndarray:
-        return Z @ self._At + self.b
+    def _r(self, Z: np.ndarray) -> np.ndarray:
+        return Z @ self._At + (self.b if self.pieces else -self.b)
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        return self._f(self._r(Z), self.M)
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        return self._w(self._r(Z), self.M) @ self.A
+
+    def _signature(self) -> Hashable:
+        return (type(self), self.A.shape)
+
+    def _data(self) -> dict[str, Any]:
+        return {"A": self.A, "b": self.b, "M": np.nan if self.M is None else self.M}
+
+    @classmethod
+    def _each_r(cls, Z: np.ndarray, S: dict[str, Any]) -> np.ndarray:
+        """Row b's r = A_b z_b ∓ b_b (B, m)."""
+        AZ = np.einsum("bd,bmd->bm", Z, S["A"])
+        return AZ + S["b"] if cls.pieces else AZ - S["b"]
+
+    @classmethod
+    def _value_each(cls, Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+        return cls._f(cls._each_r(Z, S), S["M"][:, None])
+
+    @classmethod
+    def _subgradient_each(cls, Z: np.ndarray, S: dict[str, Any], sig: Hashable
+                          ) -> np.ndarray:
+        return np.einsum("bm,bmd->bd", cls._w(cls._each_r(Z, S), S["M"][:, None]), S["A"])
 
 
 class _OneRow(_Rows):
@@ -234,26 +310,30 @@ class _OneRow(_Rows):
             raise InputError(f"a must be a vector; got shape {self.A.shape}")
 
 
-class AbsAffine(_OneRow):
-    """f(x) = |aᵀx − b|; subgradient sign(r)·a, 0 at r = 0 (minimum norm)."""
-
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        return np.abs(self._r(Z))[:, 0]
-
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        return np.sign(self._r(Z)) @ self.A
-
-
-class Norm1(_Rows):
-    """f(x) = ‖Ax − b‖₁; subgradient Aᵀ sign(r) with sign(0) = 0."""
+class _AbsRows:
+    """φ = |·| on every residual: f = Σ_i |r_i|, subgradient Aᵀ sign(r), sign(0) = 0."""
 
     polyhedral = True
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        return np.abs(self._r(Z)).sum(axis=1)
+    @staticmethod
+    def _phi(r: np.ndarray, M: Any) -> np.ndarray:
+        return np.abs(r)
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        return np.sign(self._r(Z)) @ self.A
+    @classmethod
+    def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
+        return cls._phi(r, M).sum(axis=1)
+
+    @staticmethod
+    def _w(r: np.ndarray, M: Any) -> np.ndarray:
+        return np.sign(r)
+
+
+class Norm1(_AbsRows, _Rows):
+    """f(x) = ‖Ax − b‖₁; subgradient Aᵀ sign(r) with sign(0) = 0."""
+
+
+class AbsAffine(_AbsRows, _OneRow):
+    """f(x) = |aᵀx − b|; subgradient sign(r)·a, 0 at r = 0 (minimum norm)."""
 
 
 class Norm2(_Rows):
@@ -262,20 +342,22 @@ class Norm2(_Rows):
     The residual is divided by max|r_i| before squaring, so neither the value nor the
     direction under- or overflows."""
 
-    def _unit(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        r = self._r(Z)
+    @staticmethod
+    def _unit(r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s = np.abs(r).max(axis=1, initial=0.0)
         u = r / np.where(s > 0, s, 1.0)[:, None]
         n = np.sqrt((u * u).sum(axis=1))
         return s, u, n
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        s, _, n = self._unit(Z)
+    @classmethod
+    def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
+        s, _, n = cls._unit(r)
         return s * n
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        _, u, n = self._unit(Z)
-        return (u / np.where(n > 0, n, 1.0)[:, None]) @ self.A
+    @classmethod
+    def _w(cls, r: np.ndarray, M: Any) -> np.ndarray:
+        _, u, n = cls._unit(r)
+        return u / np.where(n > 0, n, 1.0)[:, None]
 
 
 class NormInf(_Rows):
@@ -284,38 +366,46 @@ class NormInf(_Rows):
 
     polyhedral = True
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        return np.abs(self._r(Z)).max(axis=1, initial=0.0)
+    @staticmethod
+    def _f(r: np.ndarray, M: Any) -> np.ndarray:
+        return np.abs(r).max(axis=1, initial=0.0)
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        r = self._r(Z)
+    @staticmethod
+    def _w(r: np.ndarray, M: Any) -> np.ndarray:
         a = np.abs(r)
         w = np.sign(r) * (a == a.max(axis=1, keepdims=True))
-        w /= np.maximum((w != 0).sum(axis=1, keepdims=True), 1)
-        return w @ self.A
+        return w / np.maximum((w != 0).sum(axis=1, keepdims=True), 1)
 
 
 class MaxAffine(_Rows):
     """f(x) = max_i (a_iᵀx + b_i) (pieces, so b enters with a plus sign); subgradient
     the mean of the active a_i."""
 
-    polyhedral = True
+    polyhedral = pieces = True
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        return self._pieces(Z).max(axis=1)
+    @staticmethod
+    def _f(r: np.ndarray, M: Any) -> np.ndarray:
+        return r.max(axis=1)
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        return _mean_active(self._pieces(Z), self.A)
+    @staticmethod
+    def _w(r: np.ndarray, M: Any) -> np.ndarray:
+        return _active(r)
 
 
 class Hinge(_OneRow):
-    """f(x) = max(0, aᵀx − b); subgradient a where r > 0, else 0 (minimum norm)."""
+    """f(x) = max(0, aᵀx − b) = φ(r); subgradient a where r > 0, else 0 (minimum norm)."""
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        return np.maximum(self._r(Z)[:, 0], 0.0)
+    @staticmethod
+    def _phi(r: np.ndarray, M: Any) -> np.ndarray:
+        return np.maximum(r, 0.0)
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        return (self._r(Z) > 0).astype(float) @ self.A
+    @classmethod
+    def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
+        return cls._phi(r, M).sum(axis=1)
+
+    @staticmethod
+    def _w(r: np.ndarray, M: Any) -> np.ndarray:
+        return (r > 0).astype(float)
 
 
 class Huber(_Rows):
@@ -329,26 +419,34 @@ class Huber(_Rows):
             raise InputError(f"M must be a positive number; got {M!r}")
         self.exact["M"] = _rational(M, ())
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        a = np.abs(self._r(Z))
-        return np.where(a <= self.M, a * a, 2 * self.M * a - self.M**2).sum(axis=1)
+    @staticmethod
+    def _phi(r: np.ndarray, M: Any) -> np.ndarray:
+        a = np.abs(r)
+        return np.where(a <= M, a * a, 2 * M * a - M**2)
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        return np.clip(2 * self._r(Z), -2 * self.M, 2 * self.M) @ self.A
+    @classmethod
+    def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
+        return cls._phi(r, M).sum(axis=1)
+
+    @staticmethod
+    def _w(r: np.ndarray, M: Any) -> np.ndarray:
+        return np.clip(2 * r, -2 * M, 2 * M)
 
 
 class LogSumExp(_Rows):
     """f(x) = log Σ_i exp(a_iᵀx + b_i); gradient Aᵀ softmax (shifted by the max)."""
 
-    def _value(self, Z: np.ndarray) -> np.ndarray:
-        P = self._pieces(Z)
-        m = P.max(axis=1)
-        return m + np.log(np.exp(P - m[:, None]).sum(axis=1))
+    pieces = True
 
-    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        P = self._pieces(Z)
-        E = np.exp(P - P.max(axis=1, keepdims=True))
-        return (E / E.sum(axis=1, keepdims=True)) @ self.A
+    @staticmethod
+    def _f(r: np.ndarray, M: Any) -> np.ndarray:
+        m = r.max(axis=1)
+        return m + np.log(np.exp(r - m[:, None]).sum(axis=1))
+
+    @staticmethod
+    def _w(r: np.ndarray, M: Any) -> np.ndarray:
+        E = np.exp(r - r.max(axis=1, keepdims=True))
+        return E / E.sum(axis=1, keepdims=True)
 
 
 def _val(t: Oracle, Z: np.ndarray) -> np.ndarray:
@@ -389,6 +487,20 @@ class Sum(Atom):
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
         return np.sum([_sub(t, Z) for t in self.terms], axis=0)
 
+    def _signature(self) -> Hashable | None:
+        return _composite(Sum, self.terms)
+
+    def _data(self) -> list[Any]:
+        return [t._data() for t in self.terms]
+
+    @staticmethod
+    def _value_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
+        return np.sum(_terms_each("_value_each", Z, S, sig), axis=0)
+
+    @staticmethod
+    def _subgradient_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
+        return np.sum(_terms_each("_subgradient_each", Z, S, sig), axis=0)
+
 
 class Scaled(Atom):
     """f = coef · term with coef ≥ 0; subgradient coef · g."""
@@ -408,6 +520,22 @@ class Scaled(Atom):
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
         return self.coef * _sub(self.term, Z)
 
+    def _signature(self) -> Hashable | None:
+        return _composite(Scaled, [self.term])
+
+    def _data(self) -> list[Any]:
+        return [self.coef, self.term._data()]
+
+    @staticmethod
+    def _value_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
+        (t,) = sig[1]
+        return S[0] * t[0]._value_each(Z, S[1], t)
+
+    @staticmethod
+    def _subgradient_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
+        (t,) = sig[1]
+        return S[0][:, None] * t[0]._subgradient_each(Z, S[1], t)
+
 
 class MaxOf(Atom):
     """f = max_j f_j of convex terms; subgradient the mean of the active terms' ones
@@ -425,3 +553,76 @@ class MaxOf(Atom):
         vals = np.stack([_val(t, Z) for t in self.terms], axis=1)
         grads = np.stack([_sub(t, Z) for t in self.terms], axis=1)
         return _mean_active(vals, grads)
+
+    def _signature(self) -> Hashable | None:
+        return _composite(MaxOf, self.terms)
+
+    def _data(self) -> list[Any]:
+        return [t._data() for t in self.terms]
+
+    @staticmethod
+    def _value_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
+        return np.max(_terms_each("_value_each", Z, S, sig), axis=0)
+
+    @staticmethod
+    def _subgradient_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
+        vals = np.stack(_terms_each("_value_each", Z, S, sig), axis=1)
+        grads = np.stack(_terms_each("_subgradient_each", Z, S, sig), axis=1)
+        return _mean_active(vals, grads)
+
+
+def signature(o: Any) -> Hashable | None:
+    """The atom structure of ``o`` (classes and data shapes, recursively through sums,
+    scalings and maxima), or None when ``o`` is not built of library atoms only."""
+    return o._signature() if isinstance(o, Atom) else None
+
+
+def _composite(cls: type, terms: Sequence[Oracle]) -> Hashable | None:
+    sigs = tuple(signature(t) for t in terms)
+    return None if None in sigs else (cls, sigs)
+
+
+def _terms_each(method: str, Z: np.ndarray, S: list[Any], sig: Hashable) -> list[np.ndarray]:
+    """Every term's ``method`` on its own slice ``s`` of the stacked data."""
+    return [getattr(t[0], method)(Z, s, t) for t, s in zip(sig[1], S, strict=True)]
+
+
+def _stack(trees: list[Any]) -> Any:
+    """Trees of one structure (:meth:`Atom._data`) → one tree, leaves stacked on axis 0."""
+    if isinstance(trees[0], dict):
+        return {k: _stack([t[k] for t in trees]) for k in trees[0]}
+    if isinstance(trees[0], list):
+        return [_stack([t[i] for t in trees]) for i in range(len(trees[0]))]
+    return np.stack([np.asarray(t, dtype=float) for t in trees])
+
+
+def _take(tree: Any, idx: np.ndarray) -> Any:
+    if isinstance(tree, dict):
+        return {k: _take(v, idx) for k, v in tree.items()}
+    if isinstance(tree, list):
+        return [_take(v, idx) for v in tree]
+    return tree[idx]
+
+
+class Stacked:
+    """Library atoms of one :func:`signature` (one per agent, say) with their data
+    stacked, evaluated in one vectorised call: ``value(Z, idx)`` / ``subgradient(Z,
+    idx)`` evaluate row b of Z with atom ``idx[b]``'s data. An internal fast path of
+    :func:`rescon.rmdo` (the Oracle protocol is unchanged): the formulas are the atoms'
+    own (the same ``_f``/``_w`` of the residuals), so values and subgradients agree with
+    ``atoms[idx[b]].value/subgradient(z_b)`` up to the rounding of the d-term dot
+    products (einsum instead of matmul), ties at kinks being decided, as documented
+    above, on the computed residuals. Nothing is checked: the caller checks that the
+    answers are finite (and falls back to the atoms' checked calls to report)."""
+
+    def __init__(self, members: Sequence[Atom]) -> None:
+        self.sig = signature(members[0])
+        if self.sig is None or any(signature(a) != self.sig for a in members):
+            raise InputError("Stacked needs library atoms of one signature")
+        self.data = _stack([a._data() for a in members])
+
+    def value(self, Z: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        return self.sig[0]._value_each(Z, _take(self.data, idx), self.sig)
+
+    def subgradient(self, Z: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        return self.sig[0]._subgradient_each(Z, _take(self.data, idx), self.sig)
