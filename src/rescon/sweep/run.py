@@ -1,0 +1,241 @@
+"""``rescon.sweep``: run a grid's cells as Dask tasks and stream the rows to Parquet.
+
+Output directory (``out``): ``grid.json`` (the grid's canonical SHA-256 and the grid),
+``parts/cell-NNNNNN.parquet`` (one file per finished cell, written as it finishes),
+``results.parquet`` (every finished row, consolidated at the end) and, with matplotlib,
+``summary.png``. A rerun in the same directory skips the finished cells; a different
+grid there is refused.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError, MissingDependency
+from .cell import METRICS, run_cell
+from .grid import Grid, read_grid
+
+__all__ = ["sweep"]
+
+#: seconds to reach a scheduler given by address before giving up
+CONNECT_SECONDS = 5
+
+
+def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
+          workers: int | None = None, out: str | Path | None = None,
+          progress: bool | None = None) -> Any:
+    """Run every cell of ``grid`` (TOML file or dict; format: :mod:`rescon.sweep.grid`)
+    and return a pandas DataFrame, one row per cell in grid order: one column per
+    axis, ``repetition``, ``seed``, ``status`` ("ok" / "failed"), ``error``,
+    ``final_diameter``, ``max_validity`` (max over time and benign agents of the
+    distance to conv(benign x0)), ``steps_to_consensus`` (first k with diameter(t_k) ≤
+    ε·diameter(t_0), ε = [run] epsilon, default 1e-6; null if never),
+    ``blocked_links`` (Σ over steps of the links under DoS), ``final_gap`` (RMDO: the
+    optimality gap at the last step), ``seconds`` (wall time of the cell),
+    ``rescon_version``.
+
+    scheduler : address of a running Dask scheduler ("tcp://host:8786"); default an
+        embedded ``distributed.LocalCluster`` of ``workers`` processes (default: the
+        machine's CPU count), one thread each. ``workers=0``: serially in this process.
+    out : directory for ``results.parquet`` (resumable); None: nothing written.
+    progress : a bar on stderr (default: when stderr is a terminal).
+    """
+    g = read_grid(grid)
+    if scheduler is not None and workers is not None:
+        raise InputError("workers: give either scheduler (an existing cluster) or workers")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 0):
+        raise InputError(f"workers must be an integer >= 0; got {workers!r}")
+    pd = _pandas()
+    folder = _prepare(out, g) if out is not None else None
+    cells = g.cells()
+    done = _finished(folder) if folder is not None else {}
+    todo = [c for c in cells if c["cell"] not in done]
+    show = sys.stderr.isatty() if progress is None else progress
+    for row in _bar(_execute(todo, scheduler, workers), len(cells), len(done), show):
+        cell = row.pop("cell")
+        done[cell] = {k: _encode(v) for k, v in row.items()}
+        if folder is not None:
+            _write_part(folder, cell, done[cell])
+    table = _frame(pd, g, [done[c["cell"]] for c in cells])
+    if folder is not None:
+        table.to_parquet(folder / "results.parquet", index=False)
+        _plot(table, g, folder)
+    return table
+
+
+def _pandas() -> Any:
+    try:
+        import pandas as pd
+        import pyarrow  # noqa: F401 (the Parquet engine)
+    except ImportError:
+        raise MissingDependency("rescon sweep needs pandas and pyarrow: install "
+                                "rescon[dask]") from None
+    return pd
+
+
+def _execute(cells: list[dict[str, Any]], scheduler: str | None,
+             workers: int | None) -> Iterator[dict[str, Any]]:
+    """The rows of ``cells`` (each with its "cell" index) as they finish."""
+    if not cells:
+        return
+    if workers == 0:
+        for c in cells:
+            yield {"cell": c["cell"], **run_cell(c)}
+        return
+    with _client(scheduler, workers) as client:
+        from distributed import as_completed
+
+        futures = client.map(run_cell, cells, pure=False)
+        index = {f.key: c["cell"] for f, c in zip(futures, cells, strict=True)}
+        for fut in as_completed(futures):
+            yield {"cell": index[fut.key], **fut.result()}
+            fut.release()
+
+
+def _client(scheduler: str | None, workers: int | None) -> Any:
+    """A distributed.Client on ``scheduler`` (refused within CONNECT_SECONDS when
+    unreachable) or on an embedded LocalCluster of processes (closed with the client)."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise MissingDependency("rescon sweep needs dask[distributed]: install "
+                                "rescon[dask]") from None
+    if scheduler is not None:
+        if not isinstance(scheduler, str) or not scheduler:
+            raise InputError(f"scheduler must be an address such as tcp://host:8786; got "
+                             f"{scheduler!r}")
+        try:
+            return Client(scheduler, timeout=CONNECT_SECONDS)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError(f"scheduler {scheduler}: cannot connect within "
+                             f"{CONNECT_SECONDS} s ({type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return _Owned(Client(cluster), cluster)
+
+
+class _Owned:
+    """A client with the LocalCluster it owns: both closed on exit."""
+
+    def __init__(self, client: Any, cluster: Any) -> None:
+        self.client, self.cluster = client, cluster
+
+    def __enter__(self) -> Any:
+        return self.client
+
+    def __exit__(self, *exc: Any) -> None:
+        self.client.close()
+        self.cluster.close()
+
+
+def _prepare(out: str | Path, g: Grid) -> Path:
+    """``out`` as a directory holding this grid: created with grid.json when new; a
+    directory of another grid (or a file) is refused."""
+    from ..io import output_path
+
+    folder = output_path(out, "out", directory=True)
+    stamp = folder / "grid.json"
+    record = {"sha256": g.digest, "base": g.base, "axes": g.axes,
+              "run": {"repetitions": g.repetitions, "epsilon": g.epsilon}}
+    if stamp.exists():
+        try:
+            old = json.loads(stamp.read_text(encoding="utf-8")).get("sha256")
+        except (ValueError, AttributeError):
+            old = None
+        if old != g.digest:
+            raise InputError(f"out {folder}: holds the results of another grid (sha256 "
+                             f"{str(old)[:12]}…, this grid {g.digest[:12]}…); use another "
+                             "directory")
+    else:
+        stamp.write_text(json.dumps(record, sort_keys=True) + "\n", encoding="utf-8")
+    (folder / "parts").mkdir(exist_ok=True)
+    return folder
+
+
+def _finished(folder: Path) -> dict[int, dict[str, Any]]:
+    """The rows already written in ``folder``, by cell index."""
+    import pyarrow.parquet as pq
+
+    out = {}
+    for part in sorted((folder / "parts").glob("cell-*.parquet")):
+        for row in pq.read_table(part).to_pylist():
+            out[int(part.stem.split("-")[1])] = row
+    return out
+
+
+def _write_part(folder: Path, cell: int, row: dict[str, Any]) -> None:
+    """One finished row as parts/cell-NNNNNN.parquet (written under a temporary name,
+    then renamed: an interrupted write leaves no half file behind)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    target = folder / "parts" / f"cell-{cell:06d}.parquet"
+    tmp = target.with_suffix(".tmp")
+    pq.write_table(pa.Table.from_pylist([row]), tmp)
+    tmp.replace(target)
+
+
+def _encode(value: Any) -> Any:
+    """An axis value as a column entry: lists and tables as their JSON text."""
+    return json.dumps(value, sort_keys=True) if isinstance(value, (list, dict)) else value
+
+
+def _frame(pd: Any, g: Grid, rows: list[dict[str, Any]]) -> Any:
+    """The rows as a DataFrame with fixed columns and dtypes (nullable integers)."""
+    columns = [*g.axes, "repetition", "seed", *METRICS]
+    table = pd.DataFrame(rows, columns=columns)
+    for name in ("steps_to_consensus", "blocked_links", "repetition"):
+        table[name] = table[name].astype("Int64")
+    for name in ("final_diameter", "max_validity", "final_gap", "seconds"):
+        table[name] = table[name].astype("float64")
+    return table
+
+
+def _bar(rows: Iterator[dict[str, Any]], total: int, done: int,
+         show: bool) -> Iterator[dict[str, Any]]:
+    """``rows`` passed through, with a tqdm bar on stderr when ``show``."""
+    if not show:
+        yield from rows
+        return
+    from tqdm import tqdm
+
+    with tqdm(total=total, initial=done, desc="sweep", unit="cell", file=sys.stderr) as bar:
+        for row in rows:
+            bar.update(1)
+            yield row
+
+
+def _plot(table: Any, g: Grid, folder: Path) -> None:
+    """summary.png: per axis, the success rate (status ok and ε-consensus reached) and
+    the mean steps to ε-consensus against the axis values (when matplotlib is there)."""
+    try:
+        import matplotlib
+    except ImportError:
+        return
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    axes = list(g.axes) or ["repetition"]
+    fig, ax = plt.subplots(2, len(axes), figsize=(4 * len(axes), 6), squeeze=False)
+    reached = (table["status"] == "ok") & table["steps_to_consensus"].notna()
+    for j, key in enumerate(axes):
+        labels = [str(v) for v in table[key]]
+        order = list(dict.fromkeys(labels))
+        rate = [reached[[x == v for x in labels]].mean() for v in order]
+        steps = [table["steps_to_consensus"][[x == v for x in labels]].astype(
+            "float64").mean() for v in order]
+        ax[0, j].bar(order, rate)
+        ax[0, j].set(ylim=(0, 1), ylabel="success rate (ε-consensus)", title=key)
+        ax[1, j].plot(order, steps, "o-")
+        ax[1, j].set(xlabel=key, ylabel="mean steps to ε-consensus")
+    fig.tight_layout()
+    fig.savefig(folder / "summary.png", dpi=120)
+    plt.close(fig)
