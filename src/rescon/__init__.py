@@ -38,6 +38,7 @@ from .optim import check_subgradient, cost
 from .optim.redundancy import RedundancyReport, check_redundancy
 from .optim.rmdo import rmdo
 from .paper import PaperReport, reproduce_paper
+from .sweep import sweep  # the function; the package stays importable as rescon.sweep.*
 
 __version__ = "0.1.0"
 
@@ -78,5 +79,6 @@ __all__ = [
     "robustness",
     "safe_kernel",
     "simulate",
+    "sweep",
     "tverberg_partition",
 ]

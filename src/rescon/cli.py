@@ -316,6 +316,24 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    """Run a grid; exit 0 when every cell ran (failed cells are rows, not errors).
+    ``--json``: cells, ok, failed, out, seconds."""
+    import time
+
+    from .sweep import sweep
+
+    t0 = time.perf_counter()
+    table = sweep(args.grid, scheduler=args.scheduler, workers=args.workers, out=args.out)
+    ok = int((table["status"] == "ok").sum())
+    out = {"cells": len(table), "ok": ok, "failed": len(table) - ok,
+           "out": str(Path(args.out) / "results.parquet"),
+           "seconds": round(time.perf_counter() - t0, 3)}
+    _emit(out, args.json, [f"{out['cells']} cells: {ok} ok, {out['failed']} failed; "
+                           f"rows in {out['out']} ({out['seconds']:.1f} s)"])
+    return 0
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     """Exit 0 valid, 1 invalid, 2 unreadable, 3 unchecked (the standalone checker's codes);
     ``--json``: one object with ``verdict``, ``valid``, ``readable``, ``reason``,
@@ -419,6 +437,19 @@ def _parser() -> argparse.ArgumentParser:
                      help="figures, certificates, summary.json, report.md (default out/paper)")
     pap.add_argument("--json", action="store_true", help="one JSON object on stdout (summary)")
     pap.set_defaults(func=_cmd_paper)
+
+    swp = sub.add_parser("sweep", help="run a grid of scenarios as Dask tasks (Parquet rows)")
+    swp.add_argument("grid", help="grid TOML: [base], [axes], [run]")
+    swp.add_argument("--scheduler", metavar="ADDRESS",
+                     help="a running Dask scheduler, e.g. tcp://host:8786 (default: a "
+                          "local cluster)")
+    swp.add_argument("--workers", type=int, metavar="N",
+                     help="local worker processes (default: the CPU count; 0: serial)")
+    swp.add_argument("--out", metavar="DIR", default="out/sweep",
+                     help="results.parquet, resumable (default out/sweep)")
+    swp.add_argument("--json", action="store_true",
+                     help="one JSON object: cells, ok, failed, out, seconds")
+    swp.set_defaults(func=_cmd_sweep)
 
     chk = sub.add_parser("check", help="verify a certificate with the standalone checker")
     chk.add_argument("certificate", help="certificate JSON file")
