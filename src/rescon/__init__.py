@@ -7,6 +7,7 @@ standalone checker in ``certificates/`` (see :func:`check_certificate`).
 
 from __future__ import annotations
 
+from . import sweep  # callable: rescon.sweep(grid, ...) is rescon.sweep.sweep
 from .certify import CheckResult, check_certificate
 from .consensus.engine import simulate
 from .consensus.scenario import Scenario, ScenarioWarning
@@ -38,7 +39,6 @@ from .optim import check_subgradient, cost
 from .optim.redundancy import RedundancyReport, check_redundancy
 from .optim.rmdo import rmdo
 from .paper import PaperReport, reproduce_paper
-from .sweep import sweep  # the function; the package stays importable as rescon.sweep.*
 
 __version__ = "0.1.0"
 
