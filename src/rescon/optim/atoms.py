@@ -27,6 +27,7 @@ float values, and any element chosen is a subgradient up to that rounding):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Hashable, Sequence
 from fractions import Fraction
 from typing import Any
@@ -626,3 +627,138 @@ class Stacked:
 
     def subgradient(self, Z: np.ndarray, idx: np.ndarray) -> np.ndarray:
         return self.sig[0]._subgradient_each(Z, _take(self.data, idx), self.sig)
+
+
+class Merged(Atom):
+    """F = Σ_j w_j f_j (weights w_j ≥ 0, terms any oracles of dimension d) as one
+    oracle built once, evaluated in a few vectorised calls instead of one per term.
+
+    The terms are flattened through sums and scalings (Scaled(c, f) with weight w is f
+    with weight wc), then:
+
+    * Quadratic and Affine terms collapse into one quadratic
+      ½(x − m)ᵀH(x − m) + gᵀ(x − m) + F₀ with H = Σ w_j Q_j, centred at m, a
+      least-squares solution of Hm = −ℓ (ℓ = Σ w_j (q_j − Q_j c_j) + Σ w_j a_j, the
+      linear part), g = Hm + ℓ (≈ 0), and F₀ = Σ w_j f_j(m) summed exactly rounded
+      (``math.fsum``): the large constants are summed once, at the minimiser of that
+      part when it has one, so nothing cancels near X*;
+    * the separable row atoms stack their rows with their weights, one matrix per
+      kind: Σ_k w_k φ(a_kᵀx − b_k) with φ = |·| (AbsAffine, Norm1), max(0, ·) (Hinge),
+      h_M (Huber, per-row M); subgradient Aᵀ(w ⊙ φ'(r)) with the atoms' own φ';
+    * the other library atoms are grouped by :func:`signature`, each group one
+      :class:`Stacked` evaluation over (points × terms) weighted by w;
+    * any other oracle (callables, CasADi, CVXPY) is called as itself (checked).
+
+    Values (and subgradients) are summed in that order. They equal Σ_j w_j f_j up to
+    rounding: the collapsed quadratic differs from the term-by-term sum by a few ulps
+    of Σ_j w_j |f_j| (from H, ℓ, m), the rest by the order of the sums.
+    """
+
+    def __init__(self, terms: Sequence[tuple[float, Oracle]], d: int, *,
+                 name: str = "global cost") -> None:
+        super().__init__(d, name)
+        flat: list[tuple[float, Oracle]] = []
+        for w, o in terms:
+            _flatten(o, float(w), flat)
+        quad = [(w, o) for w, o in flat if isinstance(o, (Quadratic, Affine))]
+        self._quad = _collapse(quad, d) if quad else None
+        rest = [t for t in flat
+                if self._quad is None or not isinstance(t[1], (Quadratic, Affine))]
+        self._rows = _row_kinds([t for t in rest if _row_kind(t[1])])
+        rest = [t for t in rest if not _row_kind(t[1])]
+        packs: dict[Hashable, list[tuple[float, Oracle]]] = {}
+        for w, o in rest:
+            packs.setdefault(signature(o), []).append((w, o))
+        self._others = packs.pop(None, [])
+        self._packs = [(Stacked([o for _, o in p]), np.array([w for w, _ in p]))
+                       for p in packs.values()]
+
+    def _value(self, Z: np.ndarray) -> np.ndarray:
+        F = np.zeros(len(Z))
+        if self._quad is not None:
+            H, m, g, F0 = self._quad
+            W = Z - m
+            F += 0.5 * ((W @ H) * W).sum(axis=1) + W @ g + F0
+        for kind, At, b, M, w in self._rows:
+            F += np.einsum("pk,k->p", kind._phi(_residuals(Z, At, b), M), w)
+        for st, w in self._packs:
+            n = len(w)
+            F += st.value(np.repeat(Z, n, axis=0), np.tile(np.arange(n), len(Z))
+                          ).reshape(len(Z), n) @ w
+        for w, o in self._others:
+            F += w * o.value(Z)
+        return F
+
+    def _subgradient(self, Z: np.ndarray) -> np.ndarray:
+        G = np.zeros(Z.shape)
+        if self._quad is not None:
+            H, m, g, _ = self._quad
+            G += (Z - m) @ H + g
+        for kind, At, b, M, w in self._rows:
+            G += np.einsum("pk,dk->pd", kind._w(_residuals(Z, At, b), M) * w, At)
+        for st, w in self._packs:
+            n = len(w)
+            S = st.subgradient(np.repeat(Z, n, axis=0), np.tile(np.arange(n), len(Z)))
+            G += np.einsum("pnd,n->pd", S.reshape(len(Z), n, -1), w)
+        for w, o in self._others:
+            G += w * o.subgradient(Z)
+        return G
+
+
+def _residuals(Z: np.ndarray, At: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Z Aᵀ − b (P, K) by einsum: for a few columns d and many rows K, several times
+    faster than BLAS matmul here (measured 3 ms against 20 ms at P = K = 1000, d = 2)."""
+    return np.einsum("pd,dk->pk", Z, At) - b
+
+
+def _flatten(o: Oracle, w: float, out: list[tuple[float, Oracle]]) -> None:
+    """(weight, term) pairs of w·o through Sum and Scaled."""
+    if isinstance(o, Sum):
+        for t in o.terms:
+            _flatten(t, w, out)
+    elif isinstance(o, Scaled):
+        _flatten(o.term, w * o.coef, out)
+    else:
+        out.append((w, o))
+
+
+def _collapse(quad: list[tuple[float, Oracle]], d: int
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float] | None:
+    """(H, m, g, F₀) of Σ w_j f_j over Quadratic / Affine terms (see :class:`Merged`);
+    None when a number overflows (those terms then go the stacked way)."""
+    H, lin = np.zeros((d, d)), np.zeros(d)
+    with np.errstate(all="ignore"):
+        for w, o in quad:
+            if isinstance(o, Quadratic):
+                H += w * o.Q
+                lin += w * (o.q - o.Q @ o.c)
+            else:
+                lin += w * o.a
+        if not (np.isfinite(H).all() and np.isfinite(lin).all()):
+            return None
+        m = np.linalg.lstsq(H, -lin, rcond=None)[0]
+        g = H @ m + lin
+        F0 = math.fsum(w * float(o._value(m[None])[0]) for w, o in quad)
+    if not (np.isfinite(m).all() and np.isfinite(g).all() and math.isfinite(F0)):
+        return None
+    return H, m, g, F0
+
+
+def _row_kind(o: Oracle) -> type | None:
+    """The separable row kind of ``o`` (φ applied to each residual), or None."""
+    return next((k for k in (_AbsRows, Hinge, Huber) if isinstance(o, k)), None)
+
+
+def _row_kinds(terms: list[tuple[float, Oracle]]) -> list[tuple]:
+    """Per kind (kind, Aᵀ, b, M, w) of all its terms' rows, each row weighted by its
+    term's weight (M: Huber's per-row threshold, else NaN)."""
+    out = []
+    for kind in (_AbsRows, Hinge, Huber):
+        ts = [(w, o) for w, o in terms if _row_kind(o) is kind]
+        if ts:
+            A = np.vstack([o.A for _, o in ts])
+            rows = [len(o.b) for _, o in ts]
+            out.append((kind, np.ascontiguousarray(A.T), np.concatenate([o.b for _, o in ts]),
+                        np.repeat([np.nan if o.M is None else o.M for _, o in ts], rows),
+                        np.repeat([w for w, _ in ts], rows)))
+    return out

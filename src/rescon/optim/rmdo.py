@@ -9,8 +9,13 @@ update rule and :class:`CostMonitor` the per-step cost metrics; both are passed 
 :func:`rescon.consensus.engine.run`, the one loop behind :func:`rescon.simulate`
 (``optim`` imports ``consensus``, never the reverse).
 
-Subgradients of a step are computed for all moving agents together: one vectorised
-call per distinct oracle on the stacked points of the agents that share it.
+Subgradients of a step are computed for all moving agents together: agents whose
+oracles are library atoms of one structure (:func:`rescon.optim.atoms.signature`: same
+classes, same shapes; e.g. one ``½‖x − c_i‖² + |a_iᵀx − b_i|`` per agent) are evaluated
+in one vectorised call with their data stacked (:class:`rescon.optim.atoms.Stacked`),
+the others in one call per distinct oracle on the stacked points of the agents that
+share it. The global cost F = Σ_{j∈B} f_j of the metrics is built once as one merged
+oracle (:class:`rescon.optim.atoms.Merged`).
 """
 
 from __future__ import annotations
@@ -95,9 +100,11 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
     for msg in violated:
         warnings.warn(f"Assumption 5: {msg}", ScenarioWarning, stacklevel=2)
     benign = [v for v in sc.nodes if v not in sc.adversaries]
-    opt = Optimum.find(groups, sc.d, optimum, sc.x0[[sc.nodes.index(v) for v in benign]])
+    F = GlobalCost(groups, sc.d)
+    opt = Optimum.find(groups, F, sc.d, optimum,
+                       sc.x0[[sc.nodes.index(v) for v in benign]])
     rule = SubgradientStep(groups, len(sc.nodes), betas, sc.nodes)
-    monitor = CostMonitor(groups, sc.steps, sc.T, len(benign), opt)
+    monitor = CostMonitor(F, sc.steps, sc.T, len(benign), opt)
     info = {"assumptions_violated": problems, "update": "rmdo", "step_size": repr(beta),
             "assumption5_violated": violated, "oracles": len(groups), "optimum": opt.info}
     return run(sc, rule, monitors=[ConsensusMonitor(sc), monitor], progress=progress,
@@ -164,9 +171,12 @@ def _works(oracle: Oracle, method: str, Z: np.ndarray) -> bool:
 class SubgradientStep:
     """Algorithm 2's update x_i ← z_i − β_k d_i, d_i ∈ ∂f_i(z_i) (``betas[k]`` = β_k).
 
-    The rows of a step are grouped by oracle, each group evaluated in one call. A
-    subgradient that is not finite or of the wrong shape, or a step that overflows, is
-    an InputError naming the agent, the step and the point."""
+    Groups whose oracles share one atom signature form a pack, evaluated in one
+    :class:`~rescon.optim.atoms.Stacked` call (agent row i with its own oracle's data);
+    every other group is evaluated in one call of its oracle. A pack that answers
+    NaN/inf is re-evaluated group by group through the oracles' checked calls, so that
+    a subgradient that is not finite or of the wrong shape, or a step that overflows,
+    is an InputError naming the agent, the step and the point."""
 
     name = "rmdo"
 
@@ -174,16 +184,30 @@ class SubgradientStep:
                  nodes: list[Hashable]) -> None:
         self.groups, self.betas, self.nodes = groups, betas, nodes
         self.group_of = np.full(n, -1, dtype=np.int64)
+        by_sig: dict[Hashable, list[int]] = {}
         for g, grp in enumerate(groups):
             self.group_of[grp.rows] = g
+            sig = atoms.signature(grp.oracle)
+            if sig is not None:
+                by_sig.setdefault(sig, []).append(g)
+        packed = [gs for gs in by_sig.values() if len(gs) > 1]
+        self.packs = [atoms.Stacked([groups[g].oracle for g in gs]) for gs in packed]
+        self.pack_of = np.full(len(groups), -1, dtype=np.int64)
+        self.member = np.zeros(len(groups), dtype=np.int64)
+        for p, gs in enumerate(packed):
+            self.pack_of[gs], self.member[gs] = p, np.arange(len(gs))
 
     def __call__(self, k: int, t: float, z: np.ndarray, agents: np.ndarray) -> np.ndarray:
         D = np.empty_like(z)
         gid = self.group_of[agents]
-        for g in np.unique(gid):
-            sel = np.flatnonzero(gid == g)
-            D[sel] = _call(self.groups[g].oracle, "subgradient", z[sel],
-                           lambda r, sel=sel: self.nodes[agents[sel[r]]], _at(k, t))
+        pid = self.pack_of[gid]
+        for p in np.unique(pid[pid >= 0]):
+            sel = np.flatnonzero(pid == p)
+            with np.errstate(all="ignore"):
+                D[sel] = self.packs[p].subgradient(z[sel], self.member[gid[sel]])
+            if not np.isfinite(D[sel]).all():
+                self._per_group(D, k, t, z, agents, sel)
+        self._per_group(D, k, t, z, agents, np.flatnonzero(pid < 0))
         with np.errstate(over="ignore", invalid="ignore"):
             new = z - self.betas[k] * D
         bad = np.flatnonzero(~np.isfinite(new).all(axis=1))
@@ -194,16 +218,25 @@ class SubgradientStep:
                              f"{self.betas[k]:g}, subgradient {D[r].tolist()}")
         return new
 
+    def _per_group(self, D: np.ndarray, k: int, t: float, z: np.ndarray, agents: np.ndarray,
+                   rows: np.ndarray) -> None:
+        """D[rows] by one checked call per group (its oracle on its agents' points)."""
+        gid = self.group_of[agents[rows]]
+        for g in np.unique(gid):
+            sel = rows[gid == g]
+            D[sel] = _call(self.groups[g].oracle, "subgradient", z[sel],
+                           lambda r, sel=sel: self.nodes[agents[sel[r]]], _at(k, t))
+
 
 class CostMonitor:
     """Per step: F(x_i) = Σ_{j∈B} f_j(x_i) for every benign state (``cost``), F at the
     benign mean (``cost_at_mean``), its change rate (``cost_rate``), and with a known
-    nonempty X* ``distance_to_optimum`` and ``optimality_gap`` (see :func:`rmdo`). Each
-    distinct oracle is called once per step on all benign states and their mean."""
+    nonempty X* ``distance_to_optimum`` and ``optimality_gap`` (see :func:`rmdo`). F is
+    evaluated once per step on all benign states and their mean (:class:`GlobalCost`)."""
 
-    def __init__(self, groups: list[_Group], steps: int, T: float, n_benign: int,
+    def __init__(self, F: GlobalCost, steps: int, T: float, n_benign: int,
                  optimum: Optimum) -> None:
-        self.groups, self.T, self.optimum = groups, T, optimum
+        self.F, self.T, self.optimum = F, T, optimum
         K = steps
         self.metrics = {"cost": np.empty((K + 1, n_benign)), "cost_at_mean": np.empty(K + 1),
                         "cost_rate": np.full(K + 1, np.nan)}
@@ -213,7 +246,7 @@ class CostMonitor:
 
     def record(self, k: int, t: float, xb: np.ndarray) -> None:
         P = np.vstack([xb, xb.mean(axis=0)])
-        F = global_cost(self.groups, P, _at(k, t))
+        F = self.F(P, _at(k, t))
         m = self.metrics
         m["cost"][k], m["cost_at_mean"][k] = F[:-1], F[-1]
         if k:
@@ -227,10 +260,27 @@ def _at(k: int, t: float) -> str:
     return f"at step {k} (t = {t:g})"
 
 
+class GlobalCost:
+    """F(p) = Σ_{j∈B} f_j(p) = Σ over distinct oracles of (number of agents sharing it)
+    × f, built once as one :class:`~rescon.optim.atoms.Merged` oracle (how it sums: see
+    there). Should that fail or answer NaN/inf, :func:`global_cost` is called instead,
+    so that the error names the agent, ``where`` (the step) and the point."""
+
+    def __init__(self, groups: list[_Group], d: int) -> None:
+        self.groups = groups
+        self.merged = atoms.Merged([(len(g.rows), g.oracle) for g in groups], d)
+
+    def __call__(self, P: np.ndarray, where: str = "while computing X*") -> np.ndarray:
+        try:
+            return self.merged.value(P)
+        except Exception:  # noqa: BLE001 (re-evaluated below, which names the agent)
+            return global_cost(self.groups, P, where)
+
+
 def global_cost(groups: list[_Group], P: np.ndarray, where: str = "while computing X*"
                 ) -> np.ndarray:
     """F(p) = Σ_{j∈B} f_j(p) at every row of ``P``: Σ over distinct oracles of
-    (number of agents sharing it) × its values (one call per oracle)."""
+    (number of agents sharing it) × its values (one checked call per oracle)."""
     F = np.zeros(len(P))
     for grp in groups:
         F += len(grp.rows) * _call(grp.oracle, "value", P, lambda r, grp=grp: grp.labels[0],
@@ -259,21 +309,22 @@ class Optimum:
         return np.linalg.norm(R, axis=1)
 
     @classmethod
-    def find(cls, groups: list[_Group], d: int, given: Any, x0: np.ndarray) -> Optimum:
+    def find(cls, groups: list[_Group], F: GlobalCost, d: int, given: Any, x0: np.ndarray
+             ) -> Optimum:
         """From ``given`` (a point), else exactly for quadratic/affine atoms, else
-        numerically from the benign initial states ``x0``."""
+        numerically from the benign initial states ``x0``; F* by ``F``."""
         if given is not None:
             p = _given_point(given, d)
-            val = float(global_cost(groups, p[None])[0])
+            val = float(F(p[None])[0])
             return cls(p, None, val, {"method": "given", "exact": False, "point": p.tolist(),
                                       "value": val})
         H = _quadratic_hessian(groups, d)
         if H is not None:
-            return cls._exact(groups, d, *H)
-        return cls._numerical(groups, x0)
+            return cls._exact(F, d, *H)
+        return cls._numerical(F, x0)
 
     @classmethod
-    def _exact(cls, groups: list[_Group], d: int, H: list[list[Fraction]],
+    def _exact(cls, F: GlobalCost, d: int, H: list[list[Fraction]],
                g: list[Fraction]) -> Optimum:
         """F(x) = ½ xᵀHx + gᵀx + const with H ⪰ 0 (exact rationals of the atoms' float
         data): X* = {x : Hx = −g}, solved by exact row reduction; empty (F unbounded
@@ -293,23 +344,23 @@ class Optimum:
         p = np.array([float(v) for v in x])
         null = nullspace_exact(H)
         U = np.linalg.qr(np.array(null, dtype=float).T)[0] if null else None
-        val = float(global_cost(groups, p[None])[0])
+        val = float(F(p[None])[0])
         info.update(point=p.tolist(), value=val, dimension=len(null))
         return cls(p, U, val, info)
 
     @classmethod
-    def _numerical(cls, groups: list[_Group], x0: np.ndarray) -> Optimum:
+    def _numerical(cls, F: GlobalCost, x0: np.ndarray) -> Optimum:
         """Nelder–Mead (scipy) from the benign mean, restarted from its answer until F
         stops decreasing; X* is taken as the point found (a numerical estimate)."""
         from scipy.optimize import minimize
 
-        def F(x: np.ndarray) -> float:
-            return float(global_cost(groups, x[None])[0])
+        def Fx(x: np.ndarray) -> float:
+            return float(F(x[None])[0])
 
         x, best = x0.mean(axis=0), math.inf
         scale = 1.0 + float(np.abs(x0).max())
         for _ in range(10):
-            res = minimize(F, x, method="Nelder-Mead",
+            res = minimize(Fx, x, method="Nelder-Mead",
                            options={"xatol": 1e-12 * scale, "fatol": 0.0,
                                     "maxiter": 4000 * len(x), "maxfev": 8000 * len(x)})
             if not res.fun < best:
