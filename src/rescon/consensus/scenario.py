@@ -561,6 +561,8 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
     _keys(data, _TOP, where)
     sc = dict(_table(data, "scenario", where))
     _keys(sc, _SCENARIO, f"{where} [scenario]")
+    if isinstance(sc.get("alpha"), Mapping):  # TOML keys are strings; labels as in [initial]
+        sc["alpha"] = {_label(k): v for k, v in sc["alpha"].items()}
     if _flag(sc, "paper_example", f"{where} [scenario]"):
         del sc["paper_example"]
         given = [f"[{k}]" for k in ("graph", "initial", "adversaries") if k in data]
@@ -570,8 +572,6 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
                              f"states, adversaries and DoS attacks; remove {', '.join(given)}")
         return Scenario.paper_example(**sc)
     sc.pop("paper_example", None)
-    if isinstance(sc.get("alpha"), Mapping):  # TOML keys are strings; labels as in [initial]
-        sc["alpha"] = {_label(k): v for k, v in sc["alpha"].items()}
     if "graph" not in data or "initial" not in data or "F" not in sc:
         raise InputError(f"{where}: needs [graph], [initial] and scenario.F "
                          "(or scenario.paper_example = true)")

@@ -66,6 +66,16 @@ class _Exact:
 
 
 @dataclass(frozen=True)
+class _Given:
+    """A certificate builder that returns an already built certificate (picklable)."""
+
+    certificate: dict[str, Any]
+
+    def __call__(self) -> dict[str, Any]:
+        return self.certificate
+
+
+@dataclass(frozen=True)
 class SafeKernel:
     """Ψ(X, F) as an exact polytope.
 
@@ -107,6 +117,11 @@ class SafeKernel:
         if "certificate" not in self._cache:
             self._cache["certificate"] = self._make_certificate()
         return self._cache["certificate"]
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled with its certificate built (the builder is a closure): a kernel
+        computed on a Dask worker travels whole."""
+        return {**self.__dict__, "_make_certificate": _Given(self.certificate)}
 
     @property
     def is_empty(self) -> bool:

@@ -1,0 +1,297 @@
+"""rescon.sweep and the plain-data scenario it rests on (issue 12 §2).
+
+Services are started here, on loopback: a LocalCluster of 2 worker processes, and a
+scheduler + worker started as separate processes with Dask's own `dask scheduler` /
+`dask worker` commands on a free port (killed in the fixture's finaliser)."""
+
+from __future__ import annotations
+
+import pickle
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import rescon
+from rescon import InputError, Scenario
+from rescon.cli import main
+from rescon.sweep import cell as cell_mod
+from rescon.sweep import run as run_mod
+from rescon.sweep.cell import steps_to_consensus
+from rescon.sweep.grid import read_grid
+
+ROOT = Path(__file__).resolve().parents[1]
+SMALL = ROOT / "examples" / "sweeps" / "small.toml"
+
+#: 8 cells: 2 policies × 2 centres × 2 repetitions of the paper's example, 15 steps
+GRID8 = {"base": {"scenario": {"paper_example": True, "steps": 15,
+                               "check_robustness": False}},
+         "axes": {"scenario.policy": ["hold", "zero"], "scenario.centre": ["mean", "box"]},
+         "run": {"repetitions": 2}}
+
+
+def _same_rows(a: pd.DataFrame, b: pd.DataFrame) -> None:
+    """Every column but the wall time equal, row for row."""
+    cols = [c for c in a.columns if c != "seconds"]
+    assert list(a.columns) == list(b.columns)
+    pd.testing.assert_frame_equal(a[cols].reset_index(drop=True),
+                                  b[cols].reset_index(drop=True))
+
+
+@pytest.fixture(scope="module")
+def serial8() -> pd.DataFrame:
+    return rescon.sweep(GRID8, workers=0)
+
+
+# ---------------------------------------------------------------- plain-data scenarios
+
+
+def _custom() -> Scenario:
+    """Nodes in a non-sorted order, per-agent α, a DoS attack, residual none."""
+    data = {"scenario": {"F": 1, "steps": 5, "alpha": {"c": 0.4, "a": 0.6},
+                         "residual": "none", "check_robustness": False},
+            "graph": {"nodes": ["c", "a", "b", "d"],
+                      "edges": [[u, v] for u in "abcd" for v in "abcd" if u != v]},
+            "initial": {"a": [0.0, 1.0], "b": [2.0, 0.0], "c": [1.0, 1.0], "d": [3.0, 3.0]},
+            "adversaries": {"d": {"kind": "constant", "value": [9.0, 9.0]}},
+            "dos": [{"name": "D", "links": [["a", "b"]],
+                     "schedule": {"kind": "periodic", "period": 2.0, "duration": 1.0}}]}
+    return Scenario.from_dict(data)
+
+
+@pytest.mark.parametrize("make", [lambda: Scenario.paper_example(steps=10), _custom])
+def test_scenario_dict_round_trip_and_pickle(make):
+    s = make()
+    d = s.to_dict()
+    again = Scenario.from_dict(d)
+    assert again.to_dict() == d
+    assert again.nodes == s.nodes
+    np.testing.assert_array_equal(again.x0, s.x0)
+    np.testing.assert_array_equal(again.alpha, s.alpha)
+    back = pickle.loads(pickle.dumps(s))  # the residual used to be a lambda
+    assert back.to_dict() == d
+    a, b = rescon.simulate(again, progress=False), rescon.simulate(back, progress=False)
+    np.testing.assert_array_equal(a.states, b.states)
+
+
+def test_alpha_table_keys_are_node_labels():
+    """A TOML [scenario] alpha table has string keys; they name nodes as [initial] keys
+    do (they used to be ignored, every agent getting 0.5)."""
+    s = _custom()
+    assert dict(zip(s.nodes, s.alpha.tolist())) == {"c": 0.4, "a": 0.6, "b": 0.5, "d": 0.5}
+    paper = Scenario.from_dict({"scenario": {"paper_example": True, "alpha": {"3": 0.4}}})
+    assert paper.alpha[paper.nodes.index(3)] == 0.4
+
+
+def test_to_dict_refuses_what_is_not_data():
+    s = Scenario.paper_example(steps=3, residual=lambda t: 0.0)
+    with pytest.raises(InputError, match="residual"):
+        s.to_dict()
+
+
+def test_from_toml_is_from_dict(tmp_path):
+    text = (ROOT / "examples" / "scenarios" / "paper.toml").read_text()
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    import tomllib
+
+    assert Scenario.from_toml(p).to_dict() == Scenario.from_dict(
+        tomllib.loads(text), base=tmp_path).to_dict()
+
+
+def test_results_pickle():
+    import networkx as nx
+
+    tr = rescon.simulate(Scenario.paper_example(steps=5, check_robustness=False),
+                         progress=False)
+    tr2 = pickle.loads(pickle.dumps(tr))
+    np.testing.assert_array_equal(tr2.metrics["diameter"], tr.metrics["diameter"])
+    rep = rescon.robustness(nx.complete_graph(5).to_directed())
+    assert pickle.loads(pickle.dumps(rep)).r_max == rep.r_max == 3
+    X = np.array([[0.0, 0], [1, 0], [0, 1], [1, 1], [0.5, 0.5]])
+    k = rescon.safe_kernel(X, 1)
+    k2 = pickle.loads(pickle.dumps(k))
+    np.testing.assert_array_equal(k2.vertices, k.vertices)
+
+
+def test_steps_to_consensus_definition():
+    d = np.array([4.0, 2.0, 5e-6, 4e-6, 0.0])  # ε · diameter(t_0) = 4e-6 at ε = 1e-6
+    assert steps_to_consensus(d, 1e-6) == 3
+    assert steps_to_consensus(d, 1e-3) == 2
+    assert steps_to_consensus(np.array([0.0, 0.0]), 1e-6) == 0
+    assert steps_to_consensus(np.array([1.0, np.nan, 0.5]), 1e-6) is None
+
+
+# ---------------------------------------------------------------- grids and cells
+
+
+@pytest.mark.parametrize("grid, match", [
+    ({"base": {}, "axes": {}, "runs": {}}, "unknown keys"),
+    ({"axes": {"scenario.policy": []}}, "non-empty list"),
+    ({"axes": {"policy": ["hold"]}}, "dotted scenario key"),
+    ({"axes": {"nosuch.x": [1]}}, "dotted scenario key"),
+    ({"base": {"scenarios": {}}}, "unknown tables"),
+    ({"run": {"repetitions": 0}}, "repetitions"),
+    ({"run": {"seeds": 3}}, "unknown keys"),
+])
+def test_bad_grid_is_one_line_input_error(grid, match):
+    with pytest.raises(InputError, match=match) as exc:
+        read_grid(grid)
+    assert "\n" not in str(exc.value)
+
+
+def test_failing_cell_is_recorded_and_others_run():
+    grid = {"base": GRID8["base"], "axes": {"scenario.F": [2, 50]}}
+    t = rescon.sweep(grid, workers=0)
+    assert list(t["status"]) == ["ok", "failed"]
+    assert pd.isna(t["error"][0])
+    assert t["error"][1].startswith("InputError: ") and "F = 50" in t["error"][1]
+    assert pd.isna(t["final_diameter"][1]) and t["final_diameter"][0] >= 0
+
+
+def test_rmdo_cell_with_expression_costs():
+    base = {"scenario": {"F": 1, "steps": 30, "check_robustness": False},
+            "graph": {"edges": [[u, v] for u in range(5) for v in range(5) if u != v]},
+            "initial": {str(v): [float(v), -float(v)] for v in range(5)},
+            "adversaries": {"4": {"kind": "constant", "value": [50.0, 50.0]}},
+            "costs": {str(v): "(x1 - 1)^2 + (x2 + 2)^2" for v in range(4)}}
+    t = rescon.sweep({"base": base, "axes": {"scenario.policy": ["hold", "drop"]}},
+                     workers=0)
+    assert list(t["status"]) == ["ok", "ok"], list(t["error"])
+    assert (t["final_gap"] >= 0).all() and (t["final_gap"] < 1).all()
+    assert (t["rescon_version"] == rescon.__version__).all()
+
+
+def test_seed_is_base_seed_plus_repetition():
+    g = read_grid({"base": {"scenario": {"seed": 10}}, "axes": {"scenario.seed": [0, 100]},
+                   "run": {"repetitions": 2}})
+    assert [c["seed"] for c in g.cells()] == [0, 1, 100, 101]
+    assert read_grid({"run": {"repetitions": 3}}).cells()[2]["seed"] == 2
+
+
+# ---------------------------------------------------------------- output directory
+
+
+def test_resume_skips_finished_cells(tmp_path, monkeypatch, serial8):
+    out = tmp_path / "run"
+    first = rescon.sweep(GRID8, workers=0, out=out)
+    _same_rows(first, serial8)
+    stored = pd.read_parquet(out / "results.parquet")
+    _same_rows(stored, serial8)
+    # an interrupted sweep: two cells' parts and the consolidated table are missing
+    for k in (1, 6):
+        (out / "parts" / f"cell-{k:06d}.parquet").unlink()
+    (out / "results.parquet").unlink()
+    ran = []
+    real = cell_mod.run_cell
+    monkeypatch.setattr(run_mod, "run_cell", lambda c: ran.append(c["cell"]) or real(c))
+    again = rescon.sweep(GRID8, workers=0, out=out)
+    assert sorted(ran) == [1, 6]
+    _same_rows(again, serial8)
+    _same_rows(pd.read_parquet(out / "results.parquet"), serial8)
+
+
+def test_changed_grid_is_refused(tmp_path):
+    out = tmp_path / "run"
+    small = {"base": GRID8["base"], "axes": {"scenario.policy": ["hold"]}}
+    rescon.sweep(small, workers=0, out=out)
+    changed = {"base": GRID8["base"], "axes": {"scenario.policy": ["hold", "zero"]}}
+    with pytest.raises(InputError, match="another grid"):
+        rescon.sweep(changed, workers=0, out=out)
+    assert len(pd.read_parquet(out / "results.parquet")) == 1
+
+
+def test_out_that_is_a_file_is_refused(tmp_path):
+    f = tmp_path / "file"
+    f.write_text("x")
+    with pytest.raises(InputError):
+        rescon.sweep(GRID8, workers=0, out=f)
+
+
+def test_cli_small_example(tmp_path, capsys):
+    out = tmp_path / "small"
+    assert main(["sweep", str(SMALL), "--workers", "0", "--out", str(out), "--json"]) == 0
+    import json
+
+    res = json.loads(capsys.readouterr().out)
+    assert res["cells"] == 12 and res["ok"] == 12 and res["failed"] == 0
+    t = pd.read_parquet(out / "results.parquet")
+    assert set(t["scenario.policy"]) == {"hold", "zero", "drop"}
+    hold = t[t["scenario.policy"] == "hold"]
+    assert hold["steps_to_consensus"].notna().all()
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[axes]\n"scenario.policy" = []\n')
+    assert main(["sweep", str(bad), "--workers", "0", "--out", str(tmp_path / "b")]) == 2
+    assert "non-empty list" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- real Dask clusters
+
+
+@pytest.mark.slow
+def test_local_cluster_two_workers_gives_the_serial_rows(serial8, tmp_path):
+    _same_rows(rescon.sweep(GRID8, workers=2, out=tmp_path / "lc"), serial8)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def dask_cluster(tmp_path):
+    """`dask scheduler` and `dask worker` as separate processes on 127.0.0.1."""
+    dask = shutil.which("dask", path=str(Path(sys.executable).parent))
+    if dask is None:
+        pytest.fail("the `dask` command of dask[distributed] is not installed")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port",
+                               address.rsplit(":", 1)[1], "--no-dashboard"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        procs.append(subprocess.Popen(
+            [dask, "worker", address, "--nworkers", "1", "--nthreads", "1",
+             "--no-dashboard", "--local-directory", str(tmp_path / "worker")],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT))
+        from distributed import Client
+
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                with Client(address, timeout=5) as c:
+                    c.wait_for_workers(1, timeout=60)
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.5)
+        yield address
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in reversed(procs):
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+
+@pytest.mark.slow
+def test_separate_scheduler_and_worker_give_the_serial_rows(serial8, dask_cluster):
+    _same_rows(rescon.sweep(GRID8, scheduler=dask_cluster), serial8)
+
+
+@pytest.mark.slow
+def test_unreachable_scheduler_is_a_clear_error_within_seconds():
+    t0 = time.monotonic()
+    with pytest.raises(InputError, match="cannot connect"):
+        rescon.sweep(GRID8, scheduler=f"tcp://127.0.0.1:{_free_port()}")
+    assert time.monotonic() - t0 < 20
