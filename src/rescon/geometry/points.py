@@ -92,6 +92,10 @@ MAX_NEAR = 10
 #: the float guides see the target at most 2^FAR_TARGET kernel sizes away (squared
 #: distances stay finite)
 FAR_TARGET = 400
+#: a QP backend's guide sees the target at most 2^QP_REACH kernel sizes away: the
+#: solvers lose a unit polytope beside a target ≳ 2^24 away (1e20 in one value of X
+#: moves the mean 2^66 kernel sizes away), while the direction fixes the active set
+QP_REACH = 12
 
 
 def _frame(K: SafeKernel, m: np.ndarray | None = None) -> tuple[np.ndarray, int]:
@@ -166,12 +170,12 @@ def _guides(dim: int, framed, m: np.ndarray, backend: str):
 
     A, b, origin, B, V = framed
     if backend not in ("auto", "exact"):
-        yield project(A, b, origin, B, m, backend=backend)
+        yield project(A, b, origin, B, _within_reach(m, V), backend=backend)
     elif backend == "auto" and dim <= 2 and len(V) <= GEOMETRIC_GUIDE_VERTICES:
         yield _geometric_guide(A, b, origin, B, V, dim, m)
     else:
         try:
-            guess = project(A, b, origin, B, m, backend="clarabel")
+            guess = project(A, b, origin, B, _within_reach(m, V), backend="clarabel")
         except SolverError:  # a hint only: the next guide and the exact search decide
             pass
         else:
@@ -181,6 +185,15 @@ def _guides(dim: int, framed, m: np.ndarray, backend: str):
     except (RuntimeError, ValueError):  # scipy's NNLS at its iteration limit: no hint
         return
     yield guess
+
+
+def _within_reach(m: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """The target m seen from the frame's centre (0, the vertex mean) at most
+    2^QP_REACH · max|V| away, on the same ray: m · min(1, 2^QP_REACH max|V| / max|m|).
+    A guide only ranks active sets; the exact KKT test decides."""
+    reach = math.ldexp(float(np.abs(V).max()), QP_REACH)
+    far = float(np.abs(m).max())
+    return m * (reach / far) if far > reach > 0 else m
 
 
 def _near_active_sets(A: np.ndarray, b: np.ndarray, V: np.ndarray, dim: int,

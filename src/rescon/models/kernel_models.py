@@ -642,7 +642,8 @@ def _cvxpy_solve(problem, solver: str) -> None:
     try:
         with quiet:
             problem.solve(solver=solver, **_CVXPY_SOLVERS[solver][1])
-    except cp.error.SolverError as exc:
+    except (cp.error.SolverError, ValueError) as exc:
+        # ValueError: CVXPY's HiGHS interface cannot unpack a solution of status UNKNOWN
         raise SolverError(f"cvxpy:{solver}: {exc}") from exc
     if problem.status != cp.OPTIMAL:
         raise _fail(f"cvxpy:{solver}", problem.status)

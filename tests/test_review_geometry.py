@@ -1,0 +1,80 @@
+"""Hostile review of exact safe kernels and their points (issue 10 §1–§3).
+
+Answers are compared with an independent oracle in Fractions: the Tukey depth of a
+point in the plane, min over closed halfplanes through it of the points they hold,
+evaluated at generic directions (the normal of each p − x turned by a symbolic ±ε),
+so x ∈ Ψ(X, F) iff depth ≥ F + 1.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import rescon
+from rescon.errors import SolverError
+from rescon.models.kernel_models import qp_backends
+
+
+def _depth2(X, x) -> int:
+    """Exact Tukey depth (closed halfplanes) of x among the rows of X, d = 2."""
+    x = [Fraction(v) for v in x]
+    V = [(Fraction(float(p[0])) - x[0], Fraction(float(p[1])) - x[1]) for p in X]
+    moved = [v for v in V if v != (0, 0)]
+    best = len(V)
+    for vi in moved:
+        for sign in (1, -1):
+            u = (-sign * vi[1], sign * vi[0])
+            for turn in (1, -1):
+                ahead = 0
+                for vj in moved:
+                    s = u[0] * vj[0] + u[1] * vj[1]
+                    s = s if s else turn * (vi[0] * vj[0] + vi[1] * vj[1])
+                    ahead += s > 0
+                best = min(best, ahead + len(V) - len(moved))
+    return best
+
+
+def _far_target_cloud(d: int, far: float) -> np.ndarray:
+    X = np.random.default_rng(5).standard_normal((7, d))
+    X[0] = far
+    return X
+
+
+@pytest.mark.parametrize("backend", qp_backends())
+@pytest.mark.parametrize("far", [1e20, 1e40, 1e300])
+def test_explicit_backend_projects_towards_a_far_adversary(backend, far):
+    """One value at 1e20..1e300 puts the default target (the mean) ~2^66+ kernel
+    sizes away: every explicit QP backend raised SolverError (cvxpy:HIGHS a bare
+    ValueError) where "auto" succeeds; the float guide now sees the target moved
+    towards Ψ along the same direction, and the exact KKT search decides."""
+    X = _far_target_cloud(3, far)
+    x, cert = rescon.kernel_point(X, 1, backend=backend)
+    assert np.array_equal(x, rescon.kernel_point(X, 1)[0])
+    assert rescon.check_certificate(cert).valid
+
+
+def test_explicit_backend_far_target_planar_oracle():
+    X = _far_target_cloud(2, 1e40)
+    for backend in ("highs", "proxsuite", "cvxpy:HIGHS"):
+        if backend not in qp_backends():
+            continue
+        x, cert = rescon.kernel_point(X, 1, backend=backend)
+        assert _depth2(X, [Fraction(v) for v in cert["x"]]) >= 2
+
+
+def test_cvxpy_highs_unknown_status_is_a_solver_error():
+    """CVXPY's HiGHS interface raises ValueError ("Cannot unpack invalid solution")
+    when HiGHS ends with status UNKNOWN: that is a SolverError, not a traceback."""
+    if "cvxpy:HIGHS" not in qp_backends():
+        pytest.skip("cvxpy:HIGHS not installed")
+    from rescon.models.kernel_models import project
+
+    A = np.vstack([np.eye(3), -np.eye(3)])
+    try:
+        project(A, np.ones(6), np.zeros(3), np.eye(3), [1e300, -1e300, 1e300],
+                backend="cvxpy:HIGHS")
+    except SolverError:
+        pass
