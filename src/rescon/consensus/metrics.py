@@ -78,7 +78,8 @@ class ValidityMonitor:
             return 0.0
         y, _ = self.hull.point("project", target=x)
         v = x - y
-        dist = float(np.linalg.norm(v))
+        with np.errstate(over="ignore"):
+            dist = float(np.linalg.norm(v))
         return dist if math.isfinite(dist) else math.hypot(*v)  # squares overflowed
 
     def surely_inside(self, states: np.ndarray) -> np.ndarray:
