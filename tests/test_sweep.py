@@ -195,6 +195,18 @@ def test_resume_skips_finished_cells(tmp_path, monkeypatch, serial8):
     assert sorted(ran) == [1, 6]
     _same_rows(again, serial8)
     _same_rows(pd.read_parquet(out / "results.parquet"), serial8)
+    assert (out / "summary.png").stat().st_size > 0
+
+
+def test_axes_of_mixed_or_nested_values_are_json_columns(tmp_path):
+    grid = {"base": GRID8["base"],
+            "axes": {"scenario.residual": ["none", 0.5],
+                     "scenario.alpha": [{"3": 0.4, "1": 0.6}]}}
+    t = rescon.sweep(grid, workers=0, out=tmp_path / "mixed")
+    assert list(t["scenario.residual"]) == ['"none"', "0.5"]
+    assert t["scenario.alpha"][0] == '{"1": 0.6, "3": 0.4}'
+    assert (t["status"] == "ok").all(), list(t["error"])
+    _same_rows(pd.read_parquet(tmp_path / "mixed" / "results.parquet"), t)
 
 
 def test_changed_grid_is_refused(tmp_path):

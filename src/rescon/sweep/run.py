@@ -57,9 +57,10 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     done = _finished(folder) if folder is not None else {}
     todo = [c for c in cells if c["cell"] not in done]
     show = sys.stderr.isatty() if progress is None else progress
+    as_text = {k for k, values in g.axes.items() if len({type(v) for v in values}) > 1}
     for row in _bar(_execute(todo, scheduler, workers), len(cells), len(done), show):
         cell = row.pop("cell")
-        done[cell] = {k: _encode(v) for k, v in row.items()}
+        done[cell] = {k: _encode(v, k in as_text) for k, v in row.items()}
         if folder is not None:
             _write_part(folder, cell, done[cell])
     table = _frame(pd, g, [done[c["cell"]] for c in cells])
@@ -183,9 +184,12 @@ def _write_part(folder: Path, cell: int, row: dict[str, Any]) -> None:
     tmp.replace(target)
 
 
-def _encode(value: Any) -> Any:
-    """An axis value as a column entry: lists and tables as their JSON text."""
-    return json.dumps(value, sort_keys=True) if isinstance(value, (list, dict)) else value
+def _encode(value: Any, as_text: bool = False) -> Any:
+    """An axis value as a column entry (a Parquet column has one type): lists and
+    tables, and every value of an axis mixing types, as JSON text."""
+    if as_text or isinstance(value, (list, dict)):
+        return json.dumps(value, sort_keys=True)
+    return value
 
 
 def _frame(pd: Any, g: Grid, rows: list[dict[str, Any]]) -> Any:
