@@ -362,3 +362,81 @@ def test_random_residual_norms_agree_across_kinds(m, d, seed):
             assert o.path == "lowered"
             assert np.allclose(o.value(P), ref, rtol=1e-12, atol=1e-12)
             assert valid(o, P, samples=16)
+
+
+# --------------------------------------------------------------------------- #
+# the stacked and merged fast paths of rescon.rmdo (issue 11)
+# --------------------------------------------------------------------------- #
+
+
+def like(o, rng):
+    """An atom of ``o``'s structure (classes, shapes) with random data in quarter
+    integers, so that kinks and ties at quarter-integer points are exact."""
+    def r(*shape):
+        return rng.integers(-8, 9, size=shape) / 4
+
+    if isinstance(o, atoms.Quadratic):
+        M = r(2, 2)
+        return atoms.Quadratic(M @ M.T, c=r(2), q=r(2), const=r(1)[0])
+    if isinstance(o, (atoms.Affine, atoms.AbsAffine, atoms.Hinge)):
+        return type(o)(r(2), r(1)[0])
+    if isinstance(o, atoms.Huber):
+        return atoms.Huber(r(*o.A.shape), r(len(o.b)), 1 + rng.integers(0, 4) / 4)
+    if isinstance(o, (atoms.Norm1, atoms.Norm2, atoms.NormInf, atoms.MaxAffine,
+                      atoms.LogSumExp)):
+        return type(o)(r(*o.A.shape), r(len(o.b)))
+    if isinstance(o, atoms.Scaled):
+        return atoms.Scaled(rng.integers(0, 5) / 2, like(o.term, rng))
+    return type(o)([like(t, rng) for t in o.terms])
+
+
+@pytest.mark.parametrize("name", sorted(ATOMS))
+def test_stacked_atoms_agree_with_their_own_calls_kinks_included(name):
+    """Row b evaluated with member idx[b]'s data = that member's own value and
+    subgradient at z_b, to the rounding of the last dot product (A_bᵀw by einsum, not
+    matmul); quarter-integer data and points make the residuals exact, so kinks and
+    ties are decided alike: a different convention would differ by ≥ 1/8, not 1e-14."""
+    rng = np.random.default_rng(sorted(ATOMS).index(name))
+    members = [ATOMS[name]] + [like(ATOMS[name], rng) for _ in range(5)]
+    Z = np.vstack([KINKS, rng.integers(-8, 9, size=(40, 2)) / 4])
+    Z = np.repeat(Z, 3, axis=0)
+    idx = rng.integers(0, len(members), size=len(Z))
+    stacked = atoms.Stacked(members)
+    own_v = np.array([members[i].value(z[None])[0] for i, z in zip(idx, Z)])
+    own_g = np.vstack([members[i].subgradient(z[None]) for i, z in zip(idx, Z)])
+    np.testing.assert_allclose(stacked.value(Z, idx), own_v, rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(stacked.subgradient(Z, idx), own_g, rtol=0, atol=1e-14)
+
+
+def test_stacked_needs_one_signature_of_library_atoms():
+    assert atoms.signature(ATOMS["norm2"]) != atoms.signature(ATOMS["norm2-A"])
+    with pytest.raises(InputError, match="one signature"):
+        atoms.Stacked([ATOMS["norm2"], ATOMS["norm2-A"]])
+    mixed = atoms.Sum([ATOMS["abs"], rescon.cost((np.sum, np.ones_like), d=2)])
+    assert atoms.signature(mixed) is None
+
+
+def test_merged_sum_equals_the_weighted_sum_of_its_terms():
+    """Merged(Σ w_j f_j): quadratics collapsed, rows stacked, atoms stacked by
+    signature, other oracles called — values and subgradients equal to rounding."""
+    rng = np.random.default_rng(5)
+    terms = [(float(rng.integers(1, 4)), like(ATOMS[n], rng)) for n in sorted(ATOMS)
+             for _ in range(3)]
+    terms += [(2.0, rescon.cost((lambda z: float(z @ z), lambda z: 2 * z), d=2)),
+              (0.5, atoms.Scaled(3.0, atoms.Sum([ATOMS["quadratic"], ATOMS["norm1"]])))]
+    merged = atoms.Merged(terms, 2)
+    Z = np.vstack([KINKS, rng.normal(size=(30, 2)) * 5])
+    v = sum(w * o.value(Z) for w, o in terms)
+    scale = sum(w * np.abs(o.value(Z)) for w, o in terms)
+    assert np.all(np.abs(merged.value(Z) - v) <= 1e-13 * scale)
+    G = sum(w * o.subgradient(Z) for w, o in terms)
+    np.testing.assert_allclose(merged.subgradient(Z), G, rtol=1e-12, atol=1e-12 * scale.max())
+    assert valid(merged)
+
+
+def test_merged_quadratic_part_that_overflows_is_evaluated_term_by_term():
+    big = atoms.Quadratic(np.eye(2) * 1e308)
+    merged = atoms.Merged([(4.0, big), (1.0, ATOMS["abs"])], 2)
+    Z = np.array([[1e-3, 0.0], [0.0, -2e-3]])
+    np.testing.assert_allclose(merged.value(Z), 4 * big.value(Z) + ATOMS["abs"].value(Z),
+                               rtol=1e-15)

@@ -173,6 +173,64 @@ def test_one_vectorised_call_per_distinct_oracle_and_step():
     assert tr.info["oracles"] == 2
 
 
+def per_agent_atoms(sc: Scenario, seed: int = 1) -> dict:
+    """½‖x − c_i‖² + |a_iᵀx − b_i|, one distinct atom oracle per benign agent."""
+    rng = np.random.default_rng(seed)
+    return {v: atoms.Sum([atoms.Quadratic(np.eye(sc.d), rng.uniform(0, 10, sc.d)),
+                          atoms.AbsAffine(rng.normal(size=sc.d), rng.uniform(-1, 1))])
+            for v in sc.benign}
+
+
+def test_per_agent_atoms_are_evaluated_stacked_not_one_call_per_agent(monkeypatch):
+    """Issue 11's N = 1000 target: no oracle call per agent and step — the update is
+    one stacked call, the cost monitor one merged global cost (before: N + N calls)."""
+    from rescon.optim.oracle import Oracle
+
+    sc = scenario(Constant([100.0, -50.0]), steps=6)
+    costs = per_agent_atoms(sc)
+    mine = {id(o) for o in costs.values()}
+    calls = []
+
+    def counted(method):
+        orig = getattr(Oracle, method)
+
+        def counting(self, Z):
+            if id(self) in mine:
+                calls.append(method)
+            return orig(self, Z)
+        return counting
+
+    for method in ("value", "subgradient"):
+        monkeypatch.setattr(Oracle, method, counted(method))
+    rmdo(sc, costs, optimum=C)
+    assert calls == []
+
+
+def test_stacked_and_merged_paths_agree_with_per_agent_calls():
+    """The same costs as opaque vectorised oracles (one call per agent, summed per
+    agent): the same states and cost metrics up to rounding."""
+    sc = scenario(Constant([100.0, -50.0]), steps=30)
+    costs = per_agent_atoms(sc)
+    opaque = {v: CallableOracle(o.value, o.subgradient, d=2, vectorised=True)
+              for v, o in costs.items()}
+    fast, slow = rmdo(sc, costs, optimum=C), rmdo(sc, opaque, optimum=C)
+    B = fast.benign
+    np.testing.assert_allclose(fast.states[:, B], slow.states[:, B], rtol=0, atol=1e-9)
+    for key in ("cost", "cost_at_mean", "optimality_gap"):
+        np.testing.assert_allclose(fast.metrics[key], slow.metrics[key], rtol=1e-12)
+
+
+def test_a_stacked_subgradient_that_overflows_names_agent_step_and_point():
+    """‖A_i x − b‖₂ with A_2's entries 1.5e308: finite value, infinite subgradient."""
+    sc = Scenario(graph=nx.complete_graph(4), x0=[[float(i), 0.0] for i in range(4)], F=0,
+                  steps=3, check_robustness=False)
+    A = np.array([[0.0, 1.0], [0.0, 1.0]])
+    costs = {v: atoms.Norm2(A * (1.5e308 if v == 2 else 1.0), [1.0, 1.0]) for v in range(4)}
+    with pytest.raises(InputError, match=r"subgradient of the cost of agent 2 at step 0 "
+                                         r"\(t = 0\), point \[.*\].*not finite"):
+        rmdo(sc, costs, optimum=[0.0, 0.0])
+
+
 def test_starved_agents_hold_and_take_no_subgradient():
     sc = scenario(None, steps=6, dos=False)
     links = frozenset((i, j) for j, i in sc.graph.edges)
