@@ -8,6 +8,7 @@ so x ∈ Ψ(X, F) iff depth ≥ F + 1.
 
 from __future__ import annotations
 
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -78,3 +79,14 @@ def test_cvxpy_highs_unknown_status_is_a_solver_error():
                 backend="cvxpy:HIGHS")
     except SolverError:
         pass
+
+
+def test_emptiness_step_near_the_largest_floats_warns_nothing():
+    """The small-integer test of the emptiness step multiplied max|X| by a direction's
+    1-norm: a RuntimeWarning (an exception under ``-W error``) at 1.7e308."""
+    X = np.array([[1.7e308, 1.7e308], [0, 0], [1, 0], [0, 1], [-1.7e308, 2]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        K = rescon.safe_kernel(X, 2)
+    assert K.is_empty
+    assert rescon.check_certificate(K.certificate).valid

@@ -80,7 +80,7 @@ def empty_certificate(X: np.ndarray, F: int
     V = Xs @ U.T  # (n, m)
     Usum = np.abs(U).sum(axis=1)
     err = 4.0 * d * _EPS * Usum * np.abs(Xs).max() + underflow_floor(d, Usum.max())
-    if np.all(X == np.round(X)) and top * Usum.max() < 2.0**52:
+    if np.all(X == np.round(X)) and top < 2.0**52 / Usum.max():
         err[:] = 0.0  # small integers (exact over 2^e too): exact values, real ties
     order = np.argsort(-V, axis=0, kind="stable")
     ranked = np.take_along_axis(V, order, axis=0)
