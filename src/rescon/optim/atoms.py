@@ -682,9 +682,8 @@ class Merged(Atom):
         for kind, At, b, M, w in self._rows:
             F += np.einsum("pk,k->p", kind._phi(_residuals(Z, At, b), M), w)
         for st, w in self._packs:
-            n = len(w)
-            F += st.value(np.repeat(Z, n, axis=0), np.tile(np.arange(n), len(Z))
-                          ).reshape(len(Z), n) @ w
+            for c in _chunks(len(Z), len(w)):
+                F[c] += _pairs(st.value, Z[c], len(w)) @ w
         for w, o in self._others:
             F += w * o.value(Z)
         return F
@@ -697,12 +696,23 @@ class Merged(Atom):
         for kind, At, b, M, w in self._rows:
             G += np.einsum("pk,dk->pd", kind._w(_residuals(Z, At, b), M) * w, At)
         for st, w in self._packs:
-            n = len(w)
-            S = st.subgradient(np.repeat(Z, n, axis=0), np.tile(np.arange(n), len(Z)))
-            G += np.einsum("pnd,n->pd", S.reshape(len(Z), n, -1), w)
+            for c in _chunks(len(Z), len(w)):
+                G[c] += np.einsum("pnd,n->pd", _pairs(st.subgradient, Z[c], len(w)), w)
         for w, o in self._others:
             G += w * o.subgradient(Z)
         return G
+
+
+def _chunks(p: int, n: int, rows: int = 1 << 16) -> list[slice]:
+    """Slices of p points such that a slice times n terms stays under ``rows`` rows."""
+    step = max(1, rows // max(n, 1))
+    return [slice(i, i + step) for i in range(0, p, step)]
+
+
+def _pairs(method: Any, Z: np.ndarray, n: int) -> np.ndarray:
+    """``method`` of :class:`Stacked` at every (point, term) pair: (p, n, ...)."""
+    out = method(np.repeat(Z, n, axis=0), np.tile(np.arange(n), len(Z)))
+    return out.reshape(len(Z), n, *out.shape[1:])
 
 
 def _residuals(Z: np.ndarray, At: np.ndarray, b: np.ndarray) -> np.ndarray:

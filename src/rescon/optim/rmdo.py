@@ -152,7 +152,8 @@ def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hasha
     the agent ``who(r)`` of the first row r that fails on its own, ``where`` (the step)
     and the point."""
     try:
-        return getattr(oracle, method)(Z)
+        with np.errstate(over="ignore", invalid="ignore"):  # NaN/inf answers are checked
+            return getattr(oracle, method)(Z)
     except Exception as exc:  # a user's oracle may raise anything: report where
         r = next((r for r in range(len(Z)) if not _works(oracle, method, Z[r:r + 1])), 0)
         why = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
@@ -162,7 +163,8 @@ def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hasha
 
 def _works(oracle: Oracle, method: str, Z: np.ndarray) -> bool:
     try:
-        getattr(oracle, method)(Z)
+        with np.errstate(over="ignore", invalid="ignore"):
+            getattr(oracle, method)(Z)
     except Exception:  # noqa: BLE001 (only locating the row; the caller reports the error)
         return False
     return True
