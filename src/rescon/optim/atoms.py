@@ -135,16 +135,43 @@ def _scalar(name: str, value: Any) -> float:
     return float(v.reshape(()))
 
 
+def _reduce(op: np.ufunc, a: np.ndarray, keepdims: bool, initial: float | None
+            ) -> np.ndarray:
+    """``op`` (np.add or np.maximum) over the last axis of ``a``. Fewer than 8 entries
+    (a d-vector, an atom's few rows) are combined slice by slice, left to right: the
+    same numbers as numpy's reduction (which adds fewer than 8 numbers in order), 5 to
+    20 times faster on a (P, n, m) array with small m; longer axes use numpy's."""
+    m = a.shape[-1]
+    if m >= 8:
+        kw = {} if initial is None else {"initial": initial}
+        return op.reduce(a, axis=-1, keepdims=keepdims, **kw)
+    out = np.array(a[..., 0]) if initial is None else op(initial, a[..., 0])
+    for j in range(1, m):
+        out = op(out, a[..., j])
+    return out[..., None] if keepdims else out
+
+
+def _rsum(a: np.ndarray, *, keepdims: bool = False) -> np.ndarray:
+    """Σ over the last axis (see :func:`_reduce`)."""
+    return _reduce(np.add, a, keepdims, None)
+
+
+def _rmax(a: np.ndarray, *, keepdims: bool = False, initial: float | None = None
+          ) -> np.ndarray:
+    """max over the last axis (see :func:`_reduce`)."""
+    return _reduce(np.maximum, a, keepdims, initial)
+
+
 def _active(vals: np.ndarray) -> np.ndarray:
     """(B, m) weights 1/|I_b| on the pieces I_b attaining the row maximum of ``vals``."""
-    active = (vals == vals.max(axis=1, keepdims=True)).astype(float)
-    return active / active.sum(axis=1, keepdims=True)
+    active = (vals == _rmax(vals, keepdims=True)).astype(float)
+    return active / _rsum(active, keepdims=True)
 
 
 def _mean_active(vals: np.ndarray, grads: np.ndarray) -> np.ndarray:
     """Mean of ``grads[:, i]`` (B, m, d) over the pieces i attaining the row maximum of
     ``vals`` (B, m)."""
-    return np.einsum("bm,bmd->bd", _active(vals), grads)
+    return np.einsum("...m,...md->...d", _active(vals), grads)
 
 
 class Atom(Oracle):
@@ -206,12 +233,12 @@ class Quadratic(Atom):
     @staticmethod
     def _value_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
         W = Z - S["c"]
-        return (0.5 * (np.einsum("bd,bde->be", W, S["Q"]) * W).sum(axis=1)
-                + (Z * S["q"]).sum(axis=1) + S["const"])
+        return (0.5 * _rsum(np.einsum("...d,...de->...e", W, S["Q"]) * W)
+                + _rsum(Z * S["q"]) + S["const"])
 
     @staticmethod
     def _subgradient_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
-        return np.einsum("bd,bde->be", Z - S["c"], S["Q"]) + S["q"]
+        return np.einsum("...d,...de->...e", Z - S["c"], S["Q"]) + S["q"]
 
 
 class Affine(Atom):
@@ -241,11 +268,11 @@ class Affine(Atom):
 
     @staticmethod
     def _value_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
-        return (Z * S["a"]).sum(axis=1) + S["b"]
+        return _rsum(Z * S["a"]) + S["b"]
 
     @staticmethod
     def _subgradient_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
-        return S["a"].copy()
+        return np.broadcast_to(S["a"], np.broadcast_shapes(Z.shape, S["a"].shape)).copy()
 
 
 class _Rows(Atom):
@@ -285,18 +312,19 @@ class _Rows(Atom):
 
     @classmethod
     def _each_r(cls, Z: np.ndarray, S: dict[str, Any]) -> np.ndarray:
-        """Row b's r = A_b z_b ∓ b_b (B, m)."""
-        AZ = np.einsum("bd,bmd->bm", Z, S["A"])
+        """Row b's r = A_b z_b ∓ b_b (B, m); leading axes broadcast (see Stacked)."""
+        AZ = np.einsum("...d,...md->...m", Z, S["A"])
         return AZ + S["b"] if cls.pieces else AZ - S["b"]
 
     @classmethod
     def _value_each(cls, Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
-        return cls._f(cls._each_r(Z, S), S["M"][:, None])
+        return cls._f(cls._each_r(Z, S), S["M"][..., None])
 
     @classmethod
     def _subgradient_each(cls, Z: np.ndarray, S: dict[str, Any], sig: Hashable
                           ) -> np.ndarray:
-        return np.einsum("bm,bmd->bd", cls._w(cls._each_r(Z, S), S["M"][:, None]), S["A"])
+        w = cls._w(cls._each_r(Z, S), S["M"][..., None])
+        return np.einsum("...m,...md->...d", w, S["A"])
 
 
 class _OneRow(_Rows):
@@ -322,7 +350,7 @@ class _AbsRows:
 
     @classmethod
     def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
-        return cls._phi(r, M).sum(axis=1)
+        return _rsum(cls._phi(r, M))
 
     @staticmethod
     def _w(r: np.ndarray, M: Any) -> np.ndarray:
@@ -345,9 +373,9 @@ class Norm2(_Rows):
 
     @staticmethod
     def _unit(r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s = np.abs(r).max(axis=1, initial=0.0)
-        u = r / np.where(s > 0, s, 1.0)[:, None]
-        n = np.sqrt((u * u).sum(axis=1))
+        s = _rmax(np.abs(r), initial=0.0)
+        u = r / np.where(s > 0, s, 1.0)[..., None]
+        n = np.sqrt(_rsum(u * u))
         return s, u, n
 
     @classmethod
@@ -358,7 +386,7 @@ class Norm2(_Rows):
     @classmethod
     def _w(cls, r: np.ndarray, M: Any) -> np.ndarray:
         _, u, n = cls._unit(r)
-        return u / np.where(n > 0, n, 1.0)[:, None]
+        return u / np.where(n > 0, n, 1.0)[..., None]
 
 
 class NormInf(_Rows):
@@ -369,13 +397,13 @@ class NormInf(_Rows):
 
     @staticmethod
     def _f(r: np.ndarray, M: Any) -> np.ndarray:
-        return np.abs(r).max(axis=1, initial=0.0)
+        return _rmax(np.abs(r), initial=0.0)
 
     @staticmethod
     def _w(r: np.ndarray, M: Any) -> np.ndarray:
         a = np.abs(r)
-        w = np.sign(r) * (a == a.max(axis=1, keepdims=True))
-        return w / np.maximum((w != 0).sum(axis=1, keepdims=True), 1)
+        w = np.sign(r) * (a == _rmax(a, keepdims=True))
+        return w / np.maximum(_rsum((w != 0).astype(float), keepdims=True), 1)
 
 
 class MaxAffine(_Rows):
@@ -386,7 +414,7 @@ class MaxAffine(_Rows):
 
     @staticmethod
     def _f(r: np.ndarray, M: Any) -> np.ndarray:
-        return r.max(axis=1)
+        return _rmax(r)
 
     @staticmethod
     def _w(r: np.ndarray, M: Any) -> np.ndarray:
@@ -402,7 +430,7 @@ class Hinge(_OneRow):
 
     @classmethod
     def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
-        return cls._phi(r, M).sum(axis=1)
+        return _rsum(cls._phi(r, M))
 
     @staticmethod
     def _w(r: np.ndarray, M: Any) -> np.ndarray:
@@ -427,7 +455,7 @@ class Huber(_Rows):
 
     @classmethod
     def _f(cls, r: np.ndarray, M: Any) -> np.ndarray:
-        return cls._phi(r, M).sum(axis=1)
+        return _rsum(cls._phi(r, M))
 
     @staticmethod
     def _w(r: np.ndarray, M: Any) -> np.ndarray:
@@ -441,13 +469,13 @@ class LogSumExp(_Rows):
 
     @staticmethod
     def _f(r: np.ndarray, M: Any) -> np.ndarray:
-        m = r.max(axis=1)
-        return m + np.log(np.exp(r - m[:, None]).sum(axis=1))
+        m = _rmax(r)
+        return m + np.log(_rsum(np.exp(r - m[..., None])))
 
     @staticmethod
     def _w(r: np.ndarray, M: Any) -> np.ndarray:
-        E = np.exp(r - r.max(axis=1, keepdims=True))
-        return E / E.sum(axis=1, keepdims=True)
+        E = np.exp(r - _rmax(r, keepdims=True))
+        return E / _rsum(E, keepdims=True)
 
 
 def _val(t: Oracle, Z: np.ndarray) -> np.ndarray:
@@ -535,7 +563,7 @@ class Scaled(Atom):
     @staticmethod
     def _subgradient_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
         (t,) = sig[1]
-        return S[0][:, None] * t[0]._subgradient_each(Z, S[1], t)
+        return S[0][..., None] * t[0]._subgradient_each(Z, S[1], t)
 
 
 class MaxOf(Atom):
@@ -567,8 +595,8 @@ class MaxOf(Atom):
 
     @staticmethod
     def _subgradient_each(Z: np.ndarray, S: list[Any], sig: Hashable) -> np.ndarray:
-        vals = np.stack(_terms_each("_value_each", Z, S, sig), axis=1)
-        grads = np.stack(_terms_each("_subgradient_each", Z, S, sig), axis=1)
+        vals = np.stack(_terms_each("_value_each", Z, S, sig), axis=-1)
+        grads = np.stack(_terms_each("_subgradient_each", Z, S, sig), axis=-2)
         return _mean_active(vals, grads)
 
 
@@ -613,8 +641,11 @@ class Stacked:
     own (the same ``_f``/``_w`` of the residuals), so values and subgradients agree with
     ``atoms[idx[b]].value/subgradient(z_b)`` up to the rounding of the d-term dot
     products (einsum instead of matmul), ties at kinks being decided, as documented
-    above, on the computed residuals. Nothing is checked: the caller checks that the
-    answers are finite (and falls back to the atoms' checked calls to report)."""
+    above, on the computed residuals. The same formulas broadcast over leading axes:
+    ``value_pairs(Z)`` / ``subgradient_pairs(Z)`` evaluate every member at every row
+    ((P, n) / (P, n, d)) without copying the data. Nothing is checked: the caller checks
+    that the answers are finite (and falls back to the atoms' checked calls to
+    report)."""
 
     def __init__(self, members: Sequence[Atom]) -> None:
         self.sig = signature(members[0])
@@ -627,6 +658,12 @@ class Stacked:
 
     def subgradient(self, Z: np.ndarray, idx: np.ndarray) -> np.ndarray:
         return self.sig[0]._subgradient_each(Z, _take(self.data, idx), self.sig)
+
+    def value_pairs(self, Z: np.ndarray) -> np.ndarray:
+        return self.sig[0]._value_each(Z[:, None, :], self.data, self.sig)
+
+    def subgradient_pairs(self, Z: np.ndarray) -> np.ndarray:
+        return self.sig[0]._subgradient_each(Z[:, None, :], self.data, self.sig)
 
 
 class Merged(Atom):
@@ -683,7 +720,7 @@ class Merged(Atom):
             F += np.einsum("pk,k->p", kind._phi(_residuals(Z, At, b), M), w)
         for st, w in self._packs:
             for c in _chunks(len(Z), len(w)):
-                F[c] += _pairs(st.value, Z[c], len(w)) @ w
+                F[c] += np.einsum("pn,n->p", st.value_pairs(Z[c]), w)
         for w, o in self._others:
             F += w * o.value(Z)
         return F
@@ -697,7 +734,7 @@ class Merged(Atom):
             G += np.einsum("pk,dk->pd", kind._w(_residuals(Z, At, b), M) * w, At)
         for st, w in self._packs:
             for c in _chunks(len(Z), len(w)):
-                G[c] += np.einsum("pnd,n->pd", _pairs(st.subgradient, Z[c], len(w)), w)
+                G[c] += np.einsum("pnd,n->pd", st.subgradient_pairs(Z[c]), w)
         for w, o in self._others:
             G += w * o.subgradient(Z)
         return G
@@ -707,12 +744,6 @@ def _chunks(p: int, n: int, rows: int = 1 << 16) -> list[slice]:
     """Slices of p points such that a slice times n terms stays under ``rows`` rows."""
     step = max(1, rows // max(n, 1))
     return [slice(i, i + step) for i in range(0, p, step)]
-
-
-def _pairs(method: Any, Z: np.ndarray, n: int) -> np.ndarray:
-    """``method`` of :class:`Stacked` at every (point, term) pair: (p, n, ...)."""
-    out = method(np.repeat(Z, n, axis=0), np.tile(np.arange(n), len(Z)))
-    return out.reshape(len(Z), n, *out.shape[1:])
 
 
 def _residuals(Z: np.ndarray, At: np.ndarray, b: np.ndarray) -> np.ndarray:
