@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import doctest
 import importlib
+import math
 
 import numpy as np
 import pytest
@@ -440,3 +441,15 @@ def test_merged_quadratic_part_that_overflows_is_evaluated_term_by_term():
     Z = np.array([[1e-3, 0.0], [0.0, -2e-3]])
     np.testing.assert_allclose(merged.value(Z), 4 * big.value(Z) + ATOMS["abs"].value(Z),
                                rtol=1e-15)
+
+
+def test_merged_quadratics_are_centred_so_nothing_cancels_near_the_minimiser():
+    """Σ ½‖x − c_j‖² with c_j ≈ 10⁶: expanded as ½xᵀHx + gᵀx + C, F(x*) ≈ 10³ would be
+    the difference of numbers ≈ 10¹⁵ (error ≈ 0.1); centred at the minimiser it is
+    accurate to rounding of F itself."""
+    rng = np.random.default_rng(2)
+    terms = [(1.0, atoms.Quadratic(np.eye(2), 1e6 + rng.uniform(0, 2, 2))) for _ in range(500)]
+    merged = atoms.Merged(terms, 2)
+    Z = np.mean([o.c for _, o in terms], axis=0)[None] + rng.normal(size=(5, 2)) * 1e-3
+    exact = [math.fsum(float(o.value(z[None])[0]) for _, o in terms) for z in Z]
+    np.testing.assert_allclose(merged.value(Z), exact, rtol=1e-12)
