@@ -114,8 +114,7 @@ def _client(scheduler: str | None, workers: int | None) -> Any:
         try:
             return Client(scheduler, timeout=CONNECT_SECONDS)
         except (OSError, TimeoutError, ValueError) as exc:
-            raise InputError(f"scheduler {scheduler}: cannot connect within "
-                             f"{CONNECT_SECONDS} s ({type(exc).__name__}: "
+            raise InputError(f"scheduler {scheduler}: cannot connect ({type(exc).__name__}: "
                              f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
     n = workers if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
