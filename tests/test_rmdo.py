@@ -16,7 +16,7 @@ import pytest
 
 import rescon
 from rescon import InputError, Scenario, ScenarioWarning, rmdo, simulate
-from rescon.consensus.adversaries import Constant, NonFinite
+from rescon.consensus.adversaries import Constant, NonFinite, TwoFaced, TwoFacedTable
 from rescon.consensus.dos import DoSAttack, Explicit, Periodic
 from rescon.graphs.generators import circulant
 from rescon.optim import atoms
@@ -117,6 +117,22 @@ def test_redundant_quadratics_converge_to_the_common_minimiser(adversary):
     final = tr.states[-1, tr.benign]
     assert np.abs(final - C).max() == pytest.approx(0, abs=0.02)
     assert tr.metrics["optimality_gap"][-1] < 1e-3
+    assert tr.metrics["diameter"][-1] < 0.02
+
+
+def test_lasso_like_costs_converge_under_a_two_faced_adversary():
+    """f_i(x) = ½‖D_i(x − C)‖² + λ_i‖x − C‖₁ (a LASSO-like sum whose parts share the
+    minimiser C) with a two-faced adversary sending each receiver a different far
+    value, under periodic hold-last DoS."""
+    rng = np.random.default_rng(11)
+    sc = scenario(TwoFaced(TwoFacedTable(cycle=[[60.0, -40.0], [-80.0, 90.0], [30.0, 30.0]])))
+    costs = {v: f"0.5*({rng.uniform(0.5, 2):.3f}*(x1 - 5)^2 + {rng.uniform(0.5, 2):.3f}"
+                f"*(x2 - 4)^2) + {rng.uniform(0.1, 1):.3f}*norm1(x1 - 5, x2 - 4)"
+             for v in sc.benign}
+    tr = rmdo(sc, costs)
+    assert tr.info["optimum"]["point"] == pytest.approx(C.tolist(), abs=1e-6)
+    dist = tr.metrics["distance_to_optimum"]
+    assert dist[0] > 5 and dist[-1] < 0.02 and dist[-1] < dist[100]
     assert tr.metrics["diameter"][-1] < 0.02
 
 
