@@ -123,23 +123,20 @@ def long_runs(quick: bool) -> list[dict]:
     return rows
 
 
-def write(rows: list[dict], out: Path, seconds: float) -> None:
+def write_results(name: str, header: list[str], rows: list[dict], out: Path) -> None:
+    """``out/name.csv`` (every key of every row) and ``out/name.md``: the header lines,
+    then one table row per case (shared by the consensus and RMDO benchmarks)."""
     out.mkdir(parents=True, exist_ok=True)
-    with (out / "consensus.csv").open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    with (out / f"{name}.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys)
         w.writeheader()
         w.writerows(rows)
+
     def fmt(x, p=3):
         return "–" if x is None else (f"{x:.{p}g}" if isinstance(x, float) else str(x))
 
-    lines = ["# Consensus engine benchmark (BENCHMARKS.md §3)", "",
-             (f"- `python -m benchmarks.consensus_bench` in {seconds:.0f} s on "
-              f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
-              "loop checked to agree to 1e-6 before timing is reported."),
-             ("- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
-              "(benchmarks/consensus_naive.py), run for 1 step."),
-             ("- Long runs: d = 3 as the states converge (they crashed with LinAlgError "
-              "before issue 10); met = finished with max validity <= 1e-9."), "",
+    lines = [*header, "",
              "| case | steps | engine s | engine steps/s | naive steps/s | ratio | target | met |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -147,7 +144,19 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
                      f"{fmt(r['engine_steps_per_s'])} | {fmt(r['naive_steps_per_s'])} | "
                      f"{fmt(r['ratio'])} | {r['target']} | "
                      f"{'' if r['met'] is None else ('met' if r['met'] else 'NOT met')} |")
-    (out / "consensus.md").write_text("\n".join(lines) + "\n")
+    (out / f"{name}.md").write_text("\n".join(lines) + "\n")
+
+
+def write(rows: list[dict], out: Path, seconds: float) -> None:
+    write_results("consensus", [
+        "# Consensus engine benchmark (BENCHMARKS.md §3)", "",
+        (f"- `python -m benchmarks.consensus_bench` in {seconds:.0f} s on "
+         f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
+         "loop checked to agree to 1e-6 before timing is reported."),
+        ("- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
+         "(benchmarks/consensus_naive.py), run for 1 step."),
+        ("- Long runs: d = 3 as the states converge (they crashed with LinAlgError "
+         "before issue 10); met = finished with max validity <= 1e-9.")], rows, out)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -18,7 +18,6 @@ Writes ``rmdo.csv`` and ``rmdo.md``.
 from __future__ import annotations
 
 import argparse
-import csv
 import platform
 import time
 import warnings
@@ -28,7 +27,7 @@ import cvxpy as cp
 import numpy as np
 
 import rescon
-from benchmarks.consensus_bench import case, timed
+from benchmarks.consensus_bench import case, timed, write_results
 from benchmarks.consensus_naive import run_naive
 from rescon.optim.cvxpy_adapter import CvxpyGradOracle
 from rescon.optim.steps import harmonic
@@ -176,17 +175,7 @@ def run(quick: bool) -> list[dict]:
 
 
 def write(rows: list[dict], out: Path, seconds: float) -> None:
-    out.mkdir(parents=True, exist_ok=True)
-    keys = list(dict.fromkeys(k for r in rows for k in r))
-    with (out / "rmdo.csv").open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys)
-        w.writeheader()
-        w.writerows(rows)
-
-    def fmt(x, p=3):
-        return "–" if x is None else (f"{x:.{p}g}" if isinstance(x, float) else str(x))
-
-    lines = ["# RMDO benchmark (issue 11)", "",
+    write_results("rmdo", ["# RMDO benchmark (issue 11)", "",
              (f"- `python -m benchmarks.rmdo_bench` in {seconds:.0f} s on "
               f"{platform.machine()}, Python {platform.python_version()}; engine and naive "
               "loop checked to agree to 1e-6 before timing is reported."),
@@ -201,15 +190,7 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
               "and the update evaluates the agents' same-structure atoms in one stacked call "
               "(per-agent data); before (3.3 steps/s) both made one oracle call per agent."),
              ("- The last row is the validity monitor as before (an exact projection per "
-              "state outside the initial hull), in the same run."), "",
-             "| case | steps | engine s | engine steps/s | naive steps/s | ratio | target | met |",
-             "|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(f"| {r['case']} | {r['steps']} | {fmt(r['engine_s'])} | "
-                     f"{fmt(r['engine_steps_per_s'])} | {fmt(r['naive_steps_per_s'])} | "
-                     f"{fmt(r['ratio'])} | {r['target']} | "
-                     f"{'' if r['met'] is None else 'met' if r['met'] else 'NOT met'} |")
-    (out / "rmdo.md").write_text("\n".join(lines) + "\n")
+              "state outside the initial hull), in the same run.")], rows, out)
 
 
 def main(argv: list[str] | None = None) -> int:
