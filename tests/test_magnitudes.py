@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from rescon_certificates.kernels import _rat
 
 import rescon
 from rescon.errors import EmptyKernel
@@ -40,7 +41,7 @@ def _point(X, F):
     except EmptyKernel:
         return None
     _not_invalid(cert)
-    xq = tuple(Fraction(v) for v in cert["x"])
+    xq = tuple(_rat(v, "x") for v in cert["x"])  # Fraction(str) stops at 4300 digits
     assert x.tolist() == [float(v) for v in xq]
     return xq
 

@@ -228,7 +228,8 @@ class ExactPolytope:
         and scalar part b − a·v* < 0."""
         vals = [Fraction(x, v[0]) for x, v in zip(s, self.verts, strict=True)]
         star = min(range(len(vals)), key=vals.__getitem__)  # min a·y − b
-        tight_ids = [i for i in range(len(self.a)) if self.tight[star] >> i & 1]
+        tight_ids = _nnls_first([i for i in range(len(self.a)) if self.tight[star] >> i & 1],
+                                self.a, a)
         hid = len(self.a)
         for subset in itertools.combinations(tight_ids, self.k):
             cols = [list(self.a[i]) for i in subset] + [list(a)]
@@ -396,3 +397,26 @@ def _clip_rounds(P: ExactPolytope, H, ids: np.ndarray) -> None:
         keep = ~done  # the others hold at every vertex, and P only shrinks: for good
         ids, Af, bf, Aabs, babs, norms = (ids[keep], Af[keep], bf[keep], Aabs[keep],
                                           babs[keep], norms[keep])
+
+
+def _row_floats(row: tuple[int, ...]) -> np.ndarray:
+    """An integer row divided by a power of two into floats of magnitude < 2^64
+    (positive scaling: the signs of multipliers are those of the row itself)."""
+    shift = max(max(abs(v) for v in row).bit_length() - 64, 0)
+    return np.array([float(v >> shift) for v in row])
+
+
+def _nnls_first(ids: list[int], rows, a: tuple[int, ...]) -> list[int]:
+    """The tight constraints ordered for the Farkas search: those a float NNLS
+    min ‖Σ μ_i â_i + â‖, μ ≥ 0 (rows scaled to unit size), puts in the support first,
+    by decreasing μ — at a degenerate vertex (14 tight rows, k = 5, 1239-bit
+    integers) the first subsets then hold the multipliers instead of the last of
+    C(14, 5). Only an order: every subset is still tried and checked exactly."""
+    from scipy.optimize import nnls
+
+    M = np.array([_row_floats(rows[i]) for i in ids]).T
+    try:
+        mu, _ = nnls(M / np.abs(M).max(axis=0), -_row_floats(a) / np.abs(_row_floats(a)).max())
+    except (RuntimeError, ValueError):  # scipy's NNLS at its iteration limit: no order
+        return ids
+    return [ids[j] for j in np.argsort(-mu, kind="stable")]
