@@ -124,3 +124,28 @@ def test_farkas_search_at_a_degenerate_vertex_is_guided(monkeypatch):
     assert K.is_empty
     assert rescon.check_certificate(K.certificate).valid
     assert len(calls) < 100
+
+
+def test_projection_of_a_target_inside_tries_no_guide(monkeypatch):
+    """F = 0: Ψ = conv X holds the mean, so the projection is the target itself. With
+    values at ±1.7e308 and 5e-324 in R^5 the float guides marked many facets tight and
+    the exact search tried up to 638 active sets per guide (7-11 s) before ()."""
+    from rescon.geometry import points
+
+    rng = np.random.default_rng(3)
+    X = rng.standard_normal((8, 5))
+    X[0] = [-1.7e308, -1.7e308, -1.7e308, -1.7e308, 1.7e308]
+    X[1] = -5e-324
+    calls = []
+    real = points._kkt
+
+    def counted(*args):
+        calls.append(1)
+        return real(*args)
+
+    monkeypatch.setattr(points, "_kkt", counted)
+    x, cert = rescon.kernel_point(X, 0)
+    assert rescon.check_certificate(cert).valid
+    assert [Fraction(v) for v in cert["x"]] == [sum(Fraction(float(p[j])) for p in X) / 8
+                                               for j in range(5)]
+    assert len(calls) == 1

@@ -220,7 +220,8 @@ def _near_active_sets(A: np.ndarray, b: np.ndarray, V: np.ndarray, dim: int,
 
 
 def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:
-    """Exact projection: active sets near each float guide first, then all of them."""
+    """Exact projection: the target if it lies in Ψ ("auto", "exact"), then active sets
+    near each float guide, then all of them."""
     ex = K._exact
     if K.dim == 0:
         return ex.vertices[0]
@@ -235,7 +236,10 @@ def _project(K: SafeKernel, m: Vec, backend: str) -> Vec:
                 yield from _near_active_sets(framed[0], framed[1], framed[4], K.dim, guess)
 
     tried = set()
-    for S in itertools.chain(near_sets(), _active_sets(len(facets), K.dim)):
+    # S = (): the target itself when it lies in Ψ (always for F = 0: the mean is in
+    # conv X), before any float guide — unless an explicit backend is to guide
+    first = [()] if backend in ("auto", "exact") else []
+    for S in itertools.chain(first, near_sets(), _active_sets(len(facets), K.dim)):
         if S in tried or len(S) > K.dim:
             continue
         tried.add(S)
