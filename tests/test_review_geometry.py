@@ -149,3 +149,20 @@ def test_projection_of_a_target_inside_tries_no_guide(monkeypatch):
     assert [Fraction(v) for v in cert["x"]] == [sum(Fraction(float(p[j])) for p in X) / 8
                                                for j in range(5)]
     assert len(calls) == 1
+
+
+@pytest.mark.parametrize("backend", ["cvxpy:OSQP", "cvxpy:SCS", "casadi:osqp"])
+def test_c_solver_errors_stay_off_stdout(backend, capfd):
+    """OSQP and SCS print their errors with C printf whatever their verbosity: on
+    stdout they preceded a --json object (a far target, 1e200 beside a 1e-100 box)."""
+    if backend not in qp_backends():
+        pytest.skip(f"{backend} not installed")
+    from rescon.models.kernel_models import project
+
+    A = np.vstack([np.eye(3), -np.eye(3)])
+    try:
+        project(A, np.full(6, 1e-100), np.zeros(3), np.eye(3), [1e200, -1e200, 1e200],
+                backend=backend)
+    except SolverError:
+        pass
+    assert capfd.readouterr().out == ""

@@ -635,12 +635,44 @@ _MATRIX = {"clarabel": _clarabel, "proxsuite": _proxsuite, "highs": _highs}
 # --------------------------------------------------------------------------- #
 
 
+@contextlib.contextmanager
+def _c_stdout_to_stderr():
+    """stdout (file descriptor 1 and sys.stdout) pointed at stderr: solvers print
+    errors whatever their verbosity (OSQP "ERROR in validate_data", SCS "could not determine
+    problem status"), which would precede a ``--json`` object on stdout."""
+    import os
+    import sys
+
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        with contextlib.redirect_stdout(sys.stderr):  # solvers printing through Python
+            yield
+    finally:
+        sys.stdout.flush()
+        _flush_c_stdio()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _flush_c_stdio() -> None:
+    """fflush(NULL): printf's buffer (full buffering off a terminal) is written
+    while fd 1 still points at stderr."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):  # no C library handle (Windows)
+        pass
+
+
 def _cvxpy_solve(problem, solver: str) -> None:
     import cvxpy as cp
 
     quiet = silent_highs_inside() if solver == "HIGHS" else contextlib.nullcontext()
     try:
-        with quiet:
+        with quiet, _c_stdout_to_stderr():
             problem.solve(solver=solver, **_CVXPY_SOLVERS[solver][1])
     except (cp.error.SolverError, ValueError) as exc:
         # ValueError: CVXPY's HiGHS interface cannot unpack a solution of status UNKNOWN
@@ -677,7 +709,7 @@ def _casadi_solve(opti, plugin: str):
     stays clean for ``--json`` output.
     """
     try:
-        with contextlib.redirect_stdout(io.StringIO()):
+        with contextlib.redirect_stdout(io.StringIO()), _c_stdout_to_stderr():
             opti.solver(plugin, {"print_time": False, "error_on_fail": False,
                                  **_CASADI_PLUGINS[plugin][1]})
             return opti.solve()
