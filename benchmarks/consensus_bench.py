@@ -159,16 +159,22 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
          "before issue 10); met = finished with max validity <= 1e-9.")], rows, out)
 
 
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def bench_main(name: str, doc: str, run, write, argv: list[str] | None) -> int:
+    """The command line of a benchmark script: ``--quick``, ``--out DIR``; runs, writes
+    ``DIR/name.{csv,md}`` and prints the markdown."""
+    p = argparse.ArgumentParser(description=doc.splitlines()[0])
     p.add_argument("--quick", action="store_true")
     p.add_argument("--out", default=str(Path(__file__).parent / "results"))
     args = p.parse_args(argv)
     t0 = time.perf_counter()
     rows = run(args.quick)
     write(rows, Path(args.out), time.perf_counter() - t0)
-    print((Path(args.out) / "consensus.md").read_text())
+    print((Path(args.out) / f"{name}.md").read_text())
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    return bench_main("consensus", __doc__, run, write, argv)
 
 
 if __name__ == "__main__":

@@ -17,9 +17,7 @@ Writes ``rmdo.csv`` and ``rmdo.md``.
 
 from __future__ import annotations
 
-import argparse
 import platform
-import time
 import warnings
 from pathlib import Path
 
@@ -27,7 +25,7 @@ import cvxpy as cp
 import numpy as np
 
 import rescon
-from benchmarks.consensus_bench import case, timed, write_results
+from benchmarks.consensus_bench import bench_main, case, timed, write_results
 from benchmarks.consensus_naive import run_naive
 from rescon.optim.cvxpy_adapter import CvxpyGradOracle
 from rescon.optim.steps import harmonic
@@ -194,15 +192,7 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true")
-    p.add_argument("--out", default=str(Path(__file__).parent / "results"))
-    args = p.parse_args(argv)
-    t0 = time.perf_counter()
-    rows = run(args.quick)
-    write(rows, Path(args.out), time.perf_counter() - t0)
-    print((Path(args.out) / "rmdo.md").read_text())
-    return 0
+    return bench_main("rmdo", __doc__, run, write, argv)
 
 
 if __name__ == "__main__":
