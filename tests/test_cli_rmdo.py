@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import rescon
-from rescon.cli import main
 from rescon.errors import InputError
 from rescon.optim.files import read_costs, read_rmdo
+from tests.test_cli import run
 
 ROOT = Path(__file__).parent.parent
 EXAMPLES = ROOT / "examples" / "scenarios"
@@ -41,15 +41,6 @@ undirected = true
 4 = [2.0, 1.0]
 """
 QUAD = "".join(f'{i} = "(x1 - 1)^2 + {i + 1}*(x2 - 2)^2"\n' for i in range(5))
-
-
-def run(argv, capsys) -> tuple[int, str, str]:
-    try:
-        code = main([str(a) for a in argv])
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def run_json(argv, capsys) -> dict:
