@@ -855,13 +855,19 @@ def test_one_dimensional_kernels_are_checked_for_large_n():
                 assert res.trusted == ()
 
 
-def test_polytope_enumeration_limit():
+def unit_cube_kernel() -> tuple[dict, list[dict]]:
+    """The safe kernel of the unit cube's corners with F = 0 (the cube) and its facets."""
     cube = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
     facets = [{"a": [s if j == i else 0 for j in range(3)], "b": max(s, 0)}
               for i in range(3) for s in (1, -1)]
     cert = {"rescon_certificate": 1, "kind": "safe_kernel", "points": [list(p) for p in cube],
             "F": 0, "dim": 3, "vertices": [list(p) for p in cube], "equalities": [],
             "facets": facets, "proof": {"method": "halfspaces"}}
+    return cert, facets
+
+
+def test_polytope_enumeration_limit():
+    cert, facets = unit_cube_kernel()
     assert check(cert).valid
     cert["facets"] = facets + [{"a": [1, 1, 1], "b": 3 + i} for i in range(400)]
     res = check(cert)  # too large is not invalid: the enumeration part is unchecked
@@ -870,12 +876,7 @@ def test_polytope_enumeration_limit():
 
 
 def test_vertex_test_beyond_its_limit_leaves_the_enumeration_unchecked(monkeypatch):
-    cube = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
-    facets = [{"a": [s if j == i else 0 for j in range(3)], "b": max(s, 0)}
-              for i in range(3) for s in (1, -1)]
-    cert = {"rescon_certificate": 1, "kind": "safe_kernel", "points": [list(p) for p in cube],
-            "F": 0, "dim": 3, "vertices": [list(p) for p in cube], "equalities": [],
-            "facets": facets, "proof": {"method": "halfspaces"}}
+    cert, facets = unit_cube_kernel()
     assert check(cert).verdict == "valid"
     monkeypatch.setattr(K, "MAX_EVAL_WORK", 100)  # 8 vertices x (6 + 9) = 120 > 100
     res = check(cert)
