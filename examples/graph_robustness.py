@@ -19,12 +19,19 @@ from __future__ import annotations
 import argparse
 import json
 import os
+from collections.abc import Hashable, Iterable
 from pathlib import Path
 
 import rescon
 from rescon.io import read_graph, write_json
 
 DEFAULT = Path(__file__).resolve().parent / "graphs" / "paper_example.edgelist"
+
+
+def labels(S: Iterable[Hashable]) -> list[str]:
+    """The node labels of a witness set as strings, integer labels in numeric order."""
+    numeric = all(isinstance(v, int) for v in S)
+    return [str(v) for v in sorted(S, key=None if numeric else str)]
 
 
 def main() -> None:
@@ -46,12 +53,11 @@ def main() -> None:
           f"(exact: {rep.exact}, proof: {rep.lower_proof}, {rep.seconds:.2f} s)")
     if rep.witness is not None:
         S1, S2 = rep.witness
-        print(f"not {rep.r_upper + 1}-robust: S1 = {sorted(S1, key=str)}, "
-              f"S2 = {sorted(S2, key=str)}")
+        print(f"not {rep.r_upper + 1}-robust: S1 = {labels(S1)}, S2 = {labels(S2)}")
     print(f"certificate {cert_path}: {check.verdict}")
     print(json.dumps({
         "graph": args.graph, "n": rep.n, "rho": rep.r_max, "s_star": rep.s_max,
-        "exact": rep.exact, "witness": [sorted(map(str, S)) for S in rep.witness]
+        "exact": rep.exact, "witness": [labels(S) for S in rep.witness]
         if rep.witness is not None else None,
         "certificate": str(cert_path), "verdict": check.verdict,
     }))
