@@ -515,6 +515,16 @@ def test_help_subprocess():
         assert "usage" in proc.stdout.lower() and proc.stderr == ""
 
 
+
+def test_version_and_python_m_rescon():
+    import rescon
+
+    proc = run_sub(["--version"])
+    assert proc.returncode == 0 and proc.stdout.strip() == f"rescon {rescon.__version__}"
+    proc = subprocess.run([sys.executable, "-m", "rescon", "--version"], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() == f"rescon {rescon.__version__}"
+
 # --------------------------------------------------------------------------- #
 # time-limited answers with --r (deterministic: the API's undecided answers are
 # simulated with monkeypatch, as a dense graph may or may not finish in time)

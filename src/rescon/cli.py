@@ -386,8 +386,15 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"rescon: error: {message}\n")
 
 
+def _version() -> str:
+    from . import __version__
+
+    return __version__
+
+
 def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="rescon", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"rescon {_version()}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     rob = sub.add_parser("robustness", help="rho(G), s*(r), (r,s)-robustness with certificates")
