@@ -581,16 +581,24 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
             adversaries[_label(k)] = behaviour_from_dict(v)
         except InputError as exc:
             raise InputError(f"{where} [adversaries.{k}]: {exc}") from None
-    return Scenario(graph=_graph(_table(data, "graph", where), base, f"{where} [graph]"),
-                    x0=_initial(_table(data, "initial", where), base, f"{where} [initial]"),
+    seed = integer(f"{where} [scenario] seed", sc.get("seed", 0), low=0)
+    G = _graph(_table(data, "graph", where), base, f"{where} [graph]", seed)
+    return Scenario(graph=G, x0=_initial(_table(data, "initial", where), base,
+                                         f"{where} [initial]", list(G), seed),
                     adversaries=adversaries, dos=_dos(data.get("dos", []), where), **sc)
 
 
-def _graph(g: Mapping, base: Path, where: str) -> nx.DiGraph:
+def _graph(g: Mapping, base: Path, where: str, seed: int) -> nx.DiGraph:
     """[graph]: ``edgelist`` (a graph file, any format of :func:`rescon.io.read_graph`)
     or ``edges`` (a list of [u, v], u → v, labels integers or strings); ``undirected``;
     ``nodes`` (with ``edges``, optional): every label in the order of the agents'
-    indices (the order of first appearance in ``edges`` otherwise)."""
+    indices (the order of first appearance in ``edges`` otherwise). Or ``generator``
+    and its parameters (:mod:`rescon.graphs.named`), random from ``seed`` (the
+    scenario's) unless the table gives its own ``seed``."""
+    if "generator" in g:
+        from ..graphs.named import generate
+
+        return generate(g, seed, where=where)
     _keys(g, _GRAPH, where)
     undirected = _flag(g, "undirected", where)
     if ("edgelist" in g) == ("edges" in g):
@@ -624,9 +632,15 @@ def _node_list(nodes: Any, where: str) -> list[Hashable]:
     return nodes
 
 
-def _initial(init: Mapping, base: Path, where: str) -> Any:
-    """[initial]: ``file`` (points, one row per node in graph order) or one key per
-    node holding its state (a number or a list of numbers)."""
+def _initial(init: Mapping, base: Path, where: str, nodes: list[Hashable],
+             seed: int) -> Any:
+    """[initial]: ``file`` (points, one row per node in graph order), ``random`` (a
+    seeded uniform box, :func:`_random_states`) or one key per node holding its state
+    (a number or a list of numbers)."""
+    if isinstance(init.get("random"), Mapping):
+        if len(init) > 1:
+            raise InputError(f"{where}: give either random or one state per node, not both")
+        return _random_states(init["random"], len(nodes), seed, f"{where} random")
     if "file" in init:
         if len(init) > 1:
             raise InputError(f"{where}: give either file or one state per node, not both")
@@ -634,6 +648,27 @@ def _initial(init: Mapping, base: Path, where: str) -> Any:
 
         return read_points(_path(init, "file", base, where))
     return {_label(k): _state(f"{where} {k}", v) for k, v in init.items()}
+
+
+def _random_states(box: Mapping, n: int, seed: int, where: str) -> np.ndarray:
+    """``random = {low, high, d, seed}``: n states drawn uniformly from the box
+    [low, high]^d (low, high: numbers, or lists of d numbers, then d may be omitted)
+    with ``numpy.random.default_rng([seed, 2])`` (stream 2 of the scenario seed unless
+    the table gives its own ``seed``), one row per node in graph order."""
+    _keys(box, {"low", "high", "d", "seed"}, where)
+    if "low" not in box or "high" not in box:
+        raise InputError(f"{where}: needs low and high (numbers or lists of d numbers)")
+    low, high = _reals(f"{where} low", box["low"]), _reals(f"{where} high", box["high"])
+    sizes = {a.size for a in (low, high) if a.ndim == 1}
+    d = integer(f"{where} d", box["d"], low=1) if "d" in box else max(sizes, default=1)
+    if max(low.ndim, high.ndim) > 1 or sizes - {d}:
+        raise InputError(f"{where}: low and high must be numbers or lists of the same "
+                         f"length d; got low = {box['low']!r}, high = {box['high']!r}")
+    if not (np.isfinite(low).all() and np.isfinite(high).all() and (low <= high).all()):
+        raise InputError(f"{where}: needs finite low <= high; got low = {box['low']!r}, "
+                         f"high = {box['high']!r}")
+    seed = integer(f"{where} seed", box.get("seed", seed), low=0)
+    return np.random.default_rng([seed, 2]).uniform(low, high, size=(n, d))
 
 
 def _dos(attacks: Any, where: str) -> tuple[DoSAttack, ...]:
