@@ -12,6 +12,7 @@ import pytest
 from rescon.consensus import scenario as scenario_module
 from rescon.consensus.dos import DoSAttack, Explicit, Periodic
 from rescon.consensus.scenario import Scenario
+from rescon.errors import InputError
 from rescon.graphs import robustness as robustness_module
 from rescon.graphs.generators import circulant
 from rescon.graphs.robustness import RobustnessCheck
@@ -117,3 +118,18 @@ def _fields(sc: Scenario) -> dict:
     keep = ("graph", "x0", "F", "adversaries", "T", "steps", "model", "policy",
             "algorithm", "centre", "c", "residual", "seed", "kernel_point")
     return {k: getattr(sc, k) for k in keep}
+
+
+def test_dataclasses_replace_rebuilds_a_constructed_scenario():
+    """A constructed Scenario holds normalised fields (alpha per node, a Residual);
+    ``dataclasses.replace`` must accept them back (it raised on alpha before)."""
+    from dataclasses import replace
+
+    sc = Scenario.paper_example()
+    again = replace(sc, residual="none")
+    assert again.residual(0.0) == 0.0
+    assert replace(sc).to_dict() == sc.to_dict()
+    per_node = replace(sc, alpha=[0.4] * len(sc.nodes))
+    assert (per_node.alpha == 0.4).all()
+    with pytest.raises(InputError, match="12 numbers in node order"):
+        replace(sc, alpha=[0.5, 0.5])

@@ -161,8 +161,9 @@ class Scenario:
         the paper's definition, exact, d ≤ 3; slower) or "box" ((min + max)/2 per
         coordinate, what the agreement proof computes; it can leave conv Λ and the
         benign hull).
-    alpha : α_i, a number or a mapping node → number; must satisfy α_i < c and
-        1 − α_i < c.
+    alpha : α_i, a number, a mapping node → number, or one number per node in node
+        order (what the field holds after construction, so ``dataclasses.replace``
+        works); must satisfy α_i < c and 1 − α_i < c.
     c : the constant 0.5 < c < 1 of the convergence theorem.
     residual : ε_i(t_k) added to every coordinate: "0.1^t" (the paper), "none", a
         number r (r^t) or a callable t → float.
@@ -292,6 +293,11 @@ class Scenario:
         a = self.alpha
         if isinstance(a, Mapping):
             arr = np.array([real(f"alpha[{v!r}]", a.get(v, 0.5)) for v in nodes])
+        elif not isinstance(a, str) and np.ndim(a) == 1:
+            if len(a) != len(nodes):
+                raise InputError(f"alpha must be a number, a mapping node -> number or "
+                                 f"{len(nodes)} numbers in node order; got {len(a)} numbers")
+            arr = np.array([real(f"alpha[{v!r}]", x) for v, x in zip(nodes, a, strict=True)])
         else:
             arr = np.full(len(nodes), real("alpha", a))
         bad = [v for v, x in zip(nodes, arr, strict=True) if not (x < c and 1 - x < c)]
