@@ -634,13 +634,15 @@ def _sizes_fit(g: Graph, S: int, X: int, B: int, r: int, meter: list[int]) -> st
 
 
 def _proof_implied(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
-    """(r', s')-robust implies (r, s)-robust when r' >= r and s' >= s (fewer reachable
-    nodes at a larger threshold), or when r' >= r + s - 1 (an (r, s)-violating pair
-    minus its reachable nodes is a pair of (r + s - 1)-closed sets)."""
+    """(r', s')-robust implies (r, s)-robust when r' >= r and s <= s' + r' - r: an
+    (r, s)-violating pair minus up to r' - r reachable members of each set violates
+    (r', s') (a remaining unreachable member gains at most r' - r outside neighbours,
+    and at least min(s - 1, r' - r) reachable members are gone). Special cases:
+    r' >= r and s' >= s; r' >= r + s - 1; (r', s') implies (r' - 1, s' + 1)."""
     _obj(p, where, ("method", "r", "s", "proof"))
     r2 = _int(p["r"], f"{where}.r", 0)
     s2 = _int(p["s"], f"{where}.s", 1, g.n)
-    if not ((r2 >= r and s2 >= s) or r2 >= r + s - 1):
+    if not (r2 >= r and s <= s2 + r2 - r):
         raise Invalid(f"{where}: ({r2}, {s2})-robustness does not imply ({r}, {s})-robustness")
     sub = _proof(p["proof"], f"{where}.proof", g, r2, s2, ctx)
     return f"implied({sub})"
