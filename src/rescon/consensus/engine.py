@@ -163,6 +163,8 @@ def run(scenario: Scenario, rule: UpdateRule, *, monitors: Sequence[Monitor] | N
     last = np.zeros((len(links.recv), d))
     has_last = np.zeros(len(links.recv), dtype=bool)
     states = np.empty((K + 1, n, d))
+    adv_rows = np.setdiff1d(np.arange(n), benign)
+    sent_range = np.full((K + 1, len(adv_rows), 2, d), np.nan)
     monitors = [ConsensusMonitor(sc)] if monitors is None else list(monitors)
     metrics: dict[str, np.ndarray] = {}
     for mon in monitors:
@@ -178,7 +180,8 @@ def run(scenario: Scenario, rule: UpdateRule, *, monitors: Sequence[Monitor] | N
                                         last, has_last, metrics, d)
         states[k] = x
         for a, msg in sent.items():
-            states[k, a] = msg
+            states[k, a] = msg[0]
+            sent_range[k, np.searchsorted(adv_rows, a)] = msg[1:]
         xb = x[benign]
         for mon in monitors:
             mon.record(k, t, xb)
@@ -199,12 +202,13 @@ def run(scenario: Scenario, rule: UpdateRule, *, monitors: Sequence[Monitor] | N
     base = {"algorithm": sc.algorithm, "policy": sc.policy, "centre": sc.centre, "F": sc.F,
             "T": sc.T, "steps": K, "kernel_point": sc.kernel_point, "seed": sc.seed}
     return Trajectory(np.arange(K + 1) * sc.T, states, tuple(nodes), benign, metrics,
-                      {**base, **(info or {})}, time.perf_counter() - t0)
+                      {**base, **(info or {})}, time.perf_counter() - t0, sent=sent_range)
 
 
 def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metrics, d):
     """Values on every link at step k and which are usable; updates the hold memory.
-    Returns (values (L, d), usable (L,), what each adversary sent (for the record))."""
+    Returns (values (L, d), usable (L,), what each adversary sent (for the record):
+    the mean, per-coordinate min and max of its finite messages, a (3, d) array)."""
     values = x[links.send].copy()
     sent: dict[int, np.ndarray] = {}
     if adv_idx:
@@ -220,7 +224,8 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
                 raise InputError(f"adversary {sc.nodes[a]!r}: {exc}") from None
             values[rows] = msgs
             finite = msgs[np.isfinite(msgs).all(axis=1)]
-            sent[a] = _scaled_mean(finite) if len(finite) else np.full(d, np.nan)
+            sent[a] = (np.vstack([_scaled_mean(finite), finite.min(axis=0),
+                                  finite.max(axis=0)]) if len(finite) else np.full((3, d), np.nan))
     finite = np.isfinite(values).all(axis=1)
     blocked = blocked_mask(sc.dos, links.index, t) if sc.dos else np.zeros(len(values), bool)
     metrics["blocked_links"][k] = int(blocked.sum())
@@ -367,12 +372,7 @@ def _wmsr(own: np.ndarray, X: np.ndarray, F: int) -> np.ndarray:
 
 
 def _bar(progress: bool | None, total: int, desc: str = "simulate") -> Any:
-    import sys
+    """A bar over the steps on stderr, or None (the rule of :mod:`rescon._progress`)."""
+    from .._progress import progress_bar
 
-    if progress is None:
-        progress = sys.stderr.isatty()
-    if not progress:
-        return None
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc=desc, unit="step", leave=False)
+    return progress_bar(progress, total, desc, unit="step")

@@ -32,6 +32,10 @@ class Trajectory:
         (:func:`rescon.rmdo`) adds ``cost`` (K+1, |B|), ``cost_at_mean``, ``cost_rate``
         and, when X* is known, ``distance_to_optimum`` and ``optimality_gap``.
     info : the scenario's settings and the assumptions it violates.
+    sent : (K+1, |A|, 2, d) or None; what each adversary (the non-benign rows, in row
+        order) sent at t_k: ``sent[k, j, 0]`` / ``sent[k, j, 1]`` the per-coordinate
+        min / max of its finite messages over its receivers (NaN when nothing finite
+        was sent or it has no receiver). A two-faced adversary's band; O(K·|A|·d).
     """
 
     times: np.ndarray
@@ -41,6 +45,7 @@ class Trajectory:
     metrics: dict[str, np.ndarray] = field(repr=False)
     info: dict[str, Any] = field(default_factory=dict, repr=False)
     seconds: float = 0.0
+    sent: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def max_validity(self) -> float:
@@ -50,6 +55,11 @@ class Trajectory:
     @property
     def final_diameter(self) -> float:
         return float(self.metrics["diameter"][-1])
+
+    @property
+    def adversary_rows(self) -> np.ndarray:
+        """Row indices of the adversaries (the rows not in ``benign``), in row order."""
+        return np.setdiff1d(np.arange(len(self.nodes)), self.benign)
 
     def to_json(self) -> dict[str, Any]:
         """JSON-ready dict (NaN written as null)."""
@@ -62,11 +72,16 @@ class Trajectory:
                 return [nan_to_none(v) for v in x]
             return None if isinstance(x, float) and math.isnan(x) else x
 
-        return {"nodes": list(self.nodes), "benign": [self.nodes[i] for i in self.benign],
-                "times": self.times.tolist(),
-                "states": nan_to_none(clean(self.states)),
-                "metrics": {k: nan_to_none(clean(v)) for k, v in self.metrics.items()},
-                "info": self.info, "seconds": self.seconds}
+        out = {"nodes": list(self.nodes), "benign": [self.nodes[i] for i in self.benign],
+               "times": self.times.tolist(),
+               "states": nan_to_none(clean(self.states)),
+               "metrics": {k: nan_to_none(clean(v)) for k, v in self.metrics.items()},
+               "info": self.info, "seconds": self.seconds}
+        if self.sent is not None:
+            out["sent"] = {"nodes": [self.nodes[i] for i in self.adversary_rows],
+                           "min": nan_to_none(clean(self.sent[:, :, 0])),
+                           "max": nan_to_none(clean(self.sent[:, :, 1]))}
+        return out
 
     def to_csv(self, path: str | Path) -> Path:
         """One row per (step, agent): k, t, node, benign, x_1..x_d (missing parent

@@ -1,72 +1,316 @@
 """Figures of a consensus run: each coordinate against time, and the diameter; for an
-RMDO run also the global cost and its change rate (the paper's Figs. 6–7)."""
+RMDO run also the global cost and its change rate (the paper's Figs. 6–7).
+
+Conventions (those of the paper's figures): benign agents are thin blue lines with one
+legend entry, initial states are marked × (benign) and ○ (adversarial), each adversary
+has its own colour, line style and marker. A two-faced adversary is drawn as what it
+sent: the band between the smallest and largest message of each step
+(``Trajectory.sent``), not as their mean. When the adversaries would squeeze the
+benign curves into less than half of a panel, the panel's y-limits follow the benign
+agents (adversaries off the scale marked ▲/▼ at the edge) and a second, shorter panel
+shows the full range. A log axis that would have to show an exact 0 stops one decade
+below the smallest positive value (:func:`log_floor`) and marks the zeros there.
+"""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 from . import figure_path, pyplot
 
-__all__ = ["plot_trajectory"]
+__all__ = ["log_floor", "plot_log_clipped", "plot_trajectory"]
+
+BENIGN = "tab:blue"
+#: (colour, line style, marker) of the j-th adversary, cycled.
+ADVERSARY_STYLES = (("tab:red", "--", "s"), ("tab:orange", "-.", "^"),
+                    ("tab:purple", ":", "D"), ("tab:brown", (0, (5, 1, 1, 1)), "v"),
+                    ("tab:pink", "--", "P"), ("tab:olive", "-.", "X"))
+#: a panel zooms on the benign agents when they would fill less than this share of it.
+ZOOM_SHARE = 0.5
+#: at most this many markers along one curve (line markers, off-scale marks).
+MARKS = 12
+LEGEND_COLUMNS = 3
 
 
 def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -> Any:
-    """One panel per coordinate (benign agents blue, adversaries red dashed, as in the
-    paper's Figs. 3–4) and one for the benign diameter; when the run has cost metrics
-    (:func:`rescon.rmdo`), two more: the global cost Σ_{i∈B} f_i at the benign mean
-    (with F* when known) and its change rate (the paper's Fig. 7). Saves to ``path``
-    if given (:func:`rescon.plot.figure_path`)."""
+    """One panel per coordinate x(p) (a second, shorter panel with the full range when
+    the adversaries would flatten the benign curves) and one for the benign diameter;
+    when the run has cost metrics (:func:`rescon.rmdo`), two more: the global cost
+    Σ_{i∈B} f_i at the benign mean (with F* when known) and its change rate (the
+    paper's Fig. 7). One legend for the figure. Saves to ``path`` if given
+    (:func:`rescon.plot.figure_path`); returns the matplotlib Figure."""
     path = None if path is None else figure_path(path)
     plt = pyplot(path)
-
-    t, X = traj.times, traj.states
-    d = X.shape[2]
-    benign = set(traj.benign.tolist())
-    panels = d + 1 + 2 * ("cost_at_mean" in traj.metrics)
-    fig, axes = plt.subplots(panels, 1, figsize=(7, 2.4 * panels), sharex=True)
+    d = traj.states.shape[2]
+    limits = [_benign_limits(traj, p) for p in range(d)]
+    rows: list[tuple[str, Any]] = []
     for p in range(d):
-        ax = axes[p]
-        for i, node in enumerate(traj.nodes):
-            if i in benign:
-                ax.plot(t, X[:, i, p], color="tab:blue", lw=0.9)
-            else:
-                ax.plot(t, X[:, i, p], color="tab:red", lw=0.9, ls="--", label=f"adversary {node}")
-        ax.set_ylabel(f"x({p + 1})")
-        if len(benign) < len(traj.nodes):
-            ax.legend(loc="best", fontsize=7)
-    ax = axes[d]
-    dia = np.maximum(traj.metrics["diameter"], np.finfo(float).tiny)
-    ax.plot(t, dia, color="k")
-    if log_diameter:
-        ax.set_yscale("log")
-    ax.set_ylabel("diameter (benign)")
-    if panels > d + 1:
-        _cost_panels(axes[d + 1], axes[d + 2], traj)
-    axes[-1].set_xlabel("t (s)")
-    info = traj.info
-    fig.suptitle(f"{info.get('algorithm', '')}, policy {info.get('policy', '')}, "
-                 f"F = {info.get('F', '')}", fontsize=9)
-    fig.tight_layout()
+        rows.append(("coord", p))
+        if limits[p] is not None:
+            rows.append(("full", p))
+    rows.append(("diameter", None))
+    if "cost_at_mean" in traj.metrics:
+        rows += [("cost", None), ("rate", None)]
+    heights = [0.6 if kind == "full" else 1.0 for kind, _ in rows]
+    fig, axes = plt.subplots(len(rows), 1, figsize=(7, 0.3 + 2.3 * sum(heights)),
+                             sharex=True, gridspec_kw={"height_ratios": heights},
+                             squeeze=False)
+    for ax, (kind, p) in zip(axes[:, 0], rows, strict=True):
+        if kind == "coord":
+            _coordinate_panel(ax, traj, p, limits[p])
+        elif kind == "full":
+            _coordinate_panel(ax, traj, p, None, zoom=limits[p])
+        elif kind == "diameter":
+            _diameter_panel(ax, traj, log_diameter)
+        elif kind == "cost":
+            _cost_panel(ax, traj)
+        else:
+            _rate_panel(ax, traj)
+    axes[-1, 0].set_xlabel("t (s)")
+    _figure_legend(fig, axes[:, 0])
+    fig.suptitle(_title(traj.info), fontsize=9)
+    fig.tight_layout(rect=(0, 0, 1, _legend_top(fig)))
     if path is not None:
         fig.savefig(path, dpi=120)
     return fig
 
 
-def _cost_panels(ax_cost: Any, ax_rate: Any, traj: Any) -> None:
-    """F(x̄(t_k)) (and the range of F(x_i) over benign agents, F* dashed when known)
-    and its change rate (F(x̄(t_k)) − F(x̄(t_{k−1})))/T on a symmetric log scale."""
+def _title(info: dict[str, Any]) -> str:
+    """Which algorithm, policy and F the run used."""
+    what = "Algorithm 2 (RMDO)" if info.get("update") == "rmdo" else "Algorithm 1"
+    algorithm = info.get("algorithm", "")
+    if algorithm and algorithm != "alg1":
+        what = f"{what}, filter {algorithm}"
+    return f"{what}, policy {info.get('policy', '')}, F = {info.get('F', '')}"
+
+
+# --------------------------------------------------------------------------- states
+
+
+def _adversary_style(j: int) -> tuple[Any, Any, str]:
+    """(colour, line style, marker) of the j-th adversary."""
+    return ADVERSARY_STYLES[j % len(ADVERSARY_STYLES)]
+
+
+def _sent_band(traj: Any, j: int, p: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """(min, max) over receivers of adversary j's messages in coordinate p per step, or
+    None when it sent one value to everyone at every step (then its row of
+    ``states`` is what it sent)."""
+    if traj.sent is None:
+        return None
+    lo, hi = traj.sent[:, j, 0, p], traj.sent[:, j, 1, p]
+    both = np.isfinite(lo) & np.isfinite(hi)
+    return (lo, hi) if np.any(lo[both] != hi[both]) else None
+
+
+def _finite_range(*arrays: np.ndarray) -> tuple[float, float] | None:
+    """(min, max) of the finite entries of ``arrays``, None when there are none."""
+    vals = np.concatenate([np.ravel(a) for a in arrays])
+    vals = vals[np.isfinite(vals)]
+    return (float(vals.min()), float(vals.max())) if vals.size else None
+
+
+def _padded(lo: float, hi: float) -> tuple[float, float]:
+    """[lo, hi] widened by 5 % of its span on each side (by 1 % of |lo| + 1 if flat)."""
+    pad = 0.05 * (hi - lo) if hi > lo else 0.01 * abs(lo) + 1.0
+    return lo - pad, hi + pad
+
+
+def _adversary_values(traj: Any, p: int) -> list[np.ndarray]:
+    """Every value the adversaries are drawn at in coordinate p."""
+    rows = traj.adversary_rows
+    out = [traj.states[:, rows, p]]
+    if traj.sent is not None:
+        out.append(traj.sent[:, :, :, p])
+    return out
+
+
+def _benign_limits(traj: Any, p: int) -> tuple[float, float] | None:
+    """y-limits from the benign agents in coordinate p when the adversaries would
+    squeeze the benign range into less than :data:`ZOOM_SHARE` of the axis, else None
+    (all agents fit)."""
+    benign = _finite_range(traj.states[:, traj.benign, p])
+    if benign is None or not len(traj.adversary_rows):
+        return None
+    every = _finite_range(np.asarray(benign), *_adversary_values(traj, p))
+    lo, hi = _padded(*benign)
+    with np.errstate(over="ignore"):
+        full = max(every[1], hi) - min(every[0], lo)
+    return (lo, hi) if not math.isfinite(full) or (hi - lo) < ZOOM_SHARE * full else None
+
+
+def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | None, *,
+                      zoom: tuple[float, float] | None = None) -> None:
+    """x_i(p) against t: benign agents, adversaries (lines or sent bands), initial
+    states; with ``limits`` the y-axis follows the benign agents and off-scale
+    adversary values are marked at the edge; ``zoom`` (on the full-range panel)
+    shades the zoomed window."""
+    t, X = traj.times, traj.states
+    step = max(1, len(t) // MARKS)
+    for n, i in enumerate(traj.benign):
+        ax.plot(t, X[:, i, p], color=BENIGN, lw=0.8, alpha=0.9,
+                label="benign agents" if n == 0 else None)
+    ax.scatter(np.full(len(traj.benign), t[0]), X[0, traj.benign, p], marker="x",
+               color=BENIGN, s=28, lw=1.2, zorder=4, label="x_i(0), benign")
+    for j, i in enumerate(traj.adversary_rows):
+        colour, ls, marker = _adversary_style(j)
+        band = _sent_band(traj, j, p)
+        name = f"adversary {traj.nodes[i]}"
+        if band is None:
+            ax.plot(t, X[:, i, p], color=colour, ls=ls, lw=1.1, marker=marker, ms=4,
+                    markevery=step, label=name)
+            start = [X[0, i, p]]
+        else:
+            ax.fill_between(t, band[0], band[1], color=colour, alpha=0.3, lw=0,
+                            label=f"{name}: range sent (two-faced)")
+            for edge in band:
+                ax.plot(t, edge, color=colour, ls=ls, lw=0.7, marker=marker, ms=3,
+                        markevery=step)
+            start = [band[0][0], band[1][0]]
+        ax.scatter(np.full(len(start), t[0]), start, marker="o", facecolors="none",
+                   edgecolors=colour, s=36, lw=1.2, zorder=4, label="x_i(0), adversary")
+        if limits is not None:
+            hi_vals = X[:, i, p] if band is None else band[1]
+            lo_vals = X[:, i, p] if band is None else band[0]
+            _mark_off_scale(ax, t, hi_vals, lo_vals, limits, colour)
+    suffix = (", benign range" if limits is not None
+              else ", full range" if zoom is not None else "")
+    ax.set_ylabel(f"x({p + 1}){suffix}")
+    if limits is not None:
+        ax.set_ylim(*limits)
+        ax.scatter([], [], marker="^", color="0.4", s=22,
+                   label="adversary off the scale (▲ above, ▼ below)")
+    if zoom is not None:
+        ax.axhspan(*zoom, color="0.5", alpha=0.15, lw=0, zorder=0)
+        _full_scale(ax, traj, p, zoom)
+
+
+def _mark_off_scale(ax: Any, t: np.ndarray, hi_vals: np.ndarray, lo_vals: np.ndarray,
+                    limits: tuple[float, float], colour: Any) -> None:
+    """▲ at the top edge where ``hi_vals`` > the upper limit, ▼ at the bottom edge where
+    ``lo_vals`` < the lower limit (at most :data:`MARKS` of each, evenly spread)."""
+    edge = ax.get_xaxis_transform()  # x in data, y in axes fraction
+    for vals, y, marker in ((hi_vals, 0.985, "^"), (lo_vals, 0.015, "v")):
+        with np.errstate(invalid="ignore"):
+            out = np.flatnonzero(vals > limits[1] if marker == "^" else vals < limits[0])
+        if out.size:
+            pick = out[np.linspace(0, out.size - 1, min(MARKS, out.size)).round().astype(int)]
+            ax.scatter(t[pick], np.full(pick.size, y), marker=marker, color=colour, s=22,
+                       transform=edge, clip_on=False, zorder=5)
+
+
+def _full_scale(ax: Any, traj: Any, p: int, zoom: tuple[float, float]) -> None:
+    """A symmetric log y-scale on the full-range panel when the adversaries reach
+    beyond 10³ times the benign scale (linear below it), so that values up to the float
+    limit still draw."""
+    every = _finite_range(*_adversary_values(traj, p))
+    scale = max(abs(zoom[0]), abs(zoom[1]), zoom[1] - zoom[0])
+    if every is not None and max(abs(every[0]), abs(every[1])) > 1e3 * scale:
+        ax.set_yscale("symlog", linthresh=scale)
+
+
+# --------------------------------------------------------------------------- log axes
+
+
+def log_floor(*series: Any) -> float | None:
+    """The lower limit of a log axis showing ``series`` when one of them reaches an
+    exact 0: a power of ten at least one decade below the smallest positive finite
+    value m (10^(⌊log₁₀ m⌋ − 1) ≤ m/10), or ε (2.2e-16) when no value is positive; None
+    when no value is 0 (the axis may autoscale)."""
+    vals = np.concatenate([np.ravel(np.asarray(s, dtype=float)) for s in series])
+    vals = vals[np.isfinite(vals)]
+    if not np.any(vals == 0.0):
+        return None
+    pos = vals[vals > 0.0]
+    if not pos.size:
+        return float(np.finfo(float).eps)
+    return 10.0 ** (math.floor(math.log10(float(pos.min()))) - 1)
+
+
+def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str | None = None,
+                     **style: Any) -> Any:
+    """Plot ``y`` ≥ 0 against ``t`` on ``ax``'s log scale, exact zeros drawn at
+    ``floor`` (:func:`log_floor` of everything on the axis) with a ▼ where each run of
+    zeros starts; the axis' lower limit is set just below the floor (floor / 2) so the
+    zeros stand off the frame. Returns the line."""
+    y = np.asarray(y, dtype=float)
+    ax.set_yscale("log")
+    if floor is None:
+        return ax.plot(t, y, label=label, **style)[0]
+    zero = y == 0.0
+    line = ax.plot(t, np.where(zero, floor, y), label=label, **style)[0]
+    starts = np.flatnonzero(zero & ~np.concatenate([[False], zero[:-1]]))
+    if starts.size:
+        ax.scatter(np.asarray(t)[starts], np.full(starts.size, floor), marker="v", s=40,
+                   color=line.get_color(), zorder=5, clip_on=False,
+                   label="exactly 0 (drawn at the axis floor)")
+    ax.set_ylim(bottom=floor / 2)
+    return line
+
+
+def _diameter_panel(ax: Any, traj: Any, log: bool) -> None:
+    """The benign diameter; on a log axis exact zeros sit at :func:`log_floor`."""
+    t, dia = traj.times, traj.metrics["diameter"]
+    if log:
+        plot_log_clipped(ax, t, dia, log_floor(dia), color="k", lw=1.2,
+                         label="benign diameter")
+        zero = np.flatnonzero(dia == 0.0)
+        if zero.size:
+            ax.text(0.99, 0.95, f"diameter exactly 0 at {zero.size} of {len(t)} steps, "
+                    f"first at t = {t[zero[0]]:g} s", transform=ax.transAxes, ha="right",
+                    va="top", fontsize=7)
+    else:
+        ax.plot(t, dia, color="k", lw=1.2, label="benign diameter")
+    ax.set_ylabel("diameter (benign)")
+
+
+# --------------------------------------------------------------------------- cost
+
+
+def _cost_panel(ax: Any, traj: Any) -> None:
+    """F(x̄(t_k)) and the range of F(x_i) over benign agents, F* dotted when known; a
+    log scale when every value is positive, else a symmetric log scale."""
     t, m = traj.times, traj.metrics
-    ax_cost.fill_between(t, m["cost"].min(axis=1), m["cost"].max(axis=1), color="tab:blue",
-                         alpha=0.2, lw=0, label="F(x_i), i benign")
-    ax_cost.plot(t, m["cost_at_mean"], color="tab:blue", label="F(mean)")
+    ax.fill_between(t, m["cost"].min(axis=1), m["cost"].max(axis=1), color=BENIGN,
+                    alpha=0.2, lw=0, label="F(x_i), i benign")
+    ax.plot(t, m["cost_at_mean"], color=BENIGN, label="F(benign mean)")
     value = traj.info.get("optimum", {}).get("value")
+    shown = [m["cost"], m["cost_at_mean"]]
     if value is not None and np.isfinite(value):
-        ax_cost.axhline(value, color="k", ls=":", lw=0.9, label="F*")
-    ax_cost.set_yscale("symlog")
-    ax_cost.set_ylabel("global cost")
-    ax_cost.legend(loc="best", fontsize=7)
-    ax_rate.plot(t, m["cost_rate"], color="tab:green")
-    ax_rate.set_yscale("symlog")
-    ax_rate.set_ylabel("change rate (1/s)")
+        ax.axhline(value, color="k", ls=":", lw=0.9, label="F*")
+        shown.append(np.asarray([value]))
+    finite = _finite_range(*shown)
+    ax.set_yscale("log" if finite is not None and finite[0] > 0 else "symlog")
+    ax.set_ylabel("global cost")
+
+
+def _rate_panel(ax: Any, traj: Any) -> None:
+    """(F(x̄(t_k)) − F(x̄(t_{k−1})))/T on a symmetric log scale."""
+    ax.plot(traj.times, traj.metrics["cost_rate"], color="tab:green", label="change rate")
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_yscale("symlog")
+    ax.set_ylabel("change rate (1/s)")
+
+
+# --------------------------------------------------------------------------- legend
+
+
+def _figure_legend(fig: Any, axes: Any) -> None:
+    """One legend above the panels: every distinct label once, in drawing order."""
+    seen: dict[str, Any] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            seen.setdefault(label, handle)
+    fig.legend(list(seen.values()), list(seen), loc="upper center", fontsize=7,
+               ncol=min(LEGEND_COLUMNS, len(seen)), bbox_to_anchor=(0.5, 0.965),
+               frameon=False)
+
+
+def _legend_top(fig: Any) -> float:
+    """The top of the panels' area: below the title and the legend's rows."""
+    rows = math.ceil(len(fig.legends[0].get_texts()) / LEGEND_COLUMNS) if fig.legends else 0
+    inches = 0.1 + 0.15 * rows
+    return 1.0 - inches / fig.get_figheight()
