@@ -134,8 +134,8 @@ def test_steps_to_consensus_definition():
 @pytest.mark.parametrize("grid, match", [
     ({"base": {}, "axes": {}, "runs": {}}, "unknown keys"),
     ({"axes": {"scenario.policy": []}}, "non-empty list"),
-    ({"axes": {"policy": ["hold"]}}, "dotted scenario key"),
-    ({"axes": {"nosuch.x": [1]}}, "dotted scenario key"),
+    ({"axes": {"policy": ["hold"]}}, "dotted key"),
+    ({"axes": {"nosuch.x": [1]}}, "dotted key"),
     ({"base": {"scenarios": {}}}, "unknown tables"),
     ({"run": {"repetitions": 0}}, "repetitions"),
     ({"run": {"seeds": 3}}, "unknown keys"),

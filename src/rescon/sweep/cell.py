@@ -1,5 +1,17 @@
 """One sweep cell: a pure function spec dict → row dict (no state but its argument), so
-any Dask worker can run it. Everything it returns is plain data."""
+any Dask worker can run it. Everything it returns is plain data.
+
+Every row has every column of :data:`METRICS`; the columns of the other kinds are null:
+
+* consensus: ``final_diameter``, ``max_validity``, ``steps_to_consensus``,
+  ``blocked_links``, ``final_gap`` (RMDO);
+* robustness: ``rho`` (ρ(G), null when a time limit left it open), ``s_star``
+  (s*(ρ)), ``exact``, ``method`` (the exact methods that ran), ``certificate_valid``
+  and ``certificate_verdict`` (the standalone checker's verdict on the certificate,
+  "valid" / "invalid" / "unchecked"; null with ``check = false``);
+* kernel: ``dim`` (−1 when empty), ``is_empty``, ``n_vertices``,
+  ``certificate_valid``, ``certificate_verdict``.
+"""
 
 from __future__ import annotations
 
@@ -11,11 +23,16 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
+
 __all__ = ["METRICS", "run_cell", "steps_to_consensus"]
 
 #: the result columns of a row, after the axes, ``repetition`` and ``seed``
 METRICS = ("status", "error", "final_diameter", "max_validity", "steps_to_consensus",
-           "blocked_links", "final_gap", "seconds", "rescon_version")
+           "blocked_links", "final_gap", "rho", "s_star", "exact", "method",
+           "certificate_valid", "certificate_verdict", "dim", "is_empty", "n_vertices",
+           "seconds", "rescon_version")
+_RESULTS = METRICS[2:-2]  # the columns a kind fills (null otherwise)
 
 
 def steps_to_consensus(diameter: np.ndarray, epsilon: float) -> int | None:
@@ -34,14 +51,14 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     row: dict[str, Any] = {**{k: cell["params"][k] for k in cell["params"]},
                            "repetition": cell["repetition"], "seed": cell["seed"]}
     t0 = time.perf_counter()
+    row.update(dict.fromkeys(_RESULTS))
     try:
-        metrics = _run(cell["spec"], Path(cell["path"]), cell["epsilon"])
+        run = _KIND_RUNS[cell.get("kind", "consensus")]
+        metrics = run(cell["spec"], Path(cell["path"]), cell["epsilon"])
         row.update(status="ok", error=None, **metrics)
     except Exception as exc:  # noqa: BLE001 (a failing cell is recorded, not raised)
         message = str(exc).splitlines()[0] if str(exc) else ""
-        row.update(status="failed", error=f"{type(exc).__name__}: {message}",
-                   final_diameter=None, max_validity=None, steps_to_consensus=None,
-                   blocked_links=None, final_gap=None)
+        row.update(status="failed", error=f"{type(exc).__name__}: {message}")
     row.update(seconds=time.perf_counter() - t0, rescon_version=__version__)
     return row
 
@@ -70,6 +87,52 @@ def _run(spec: dict[str, Any], path: Path, epsilon: float) -> dict[str, Any]:
             "steps_to_consensus": steps_to_consensus(m["diameter"], epsilon),
             "blocked_links": int(np.sum(m["blocked_links"])),
             "final_gap": None if gap is None else _num(float(gap[-1]))}
+
+
+def _robustness(spec: dict[str, Any], path: Path, epsilon: float) -> dict[str, Any]:
+    """ρ(G) and s*(ρ) of [graph] (a generator, a file or edges: the scenario parser's
+    [graph]) by :func:`rescon.robustness` ([robustness] method, time_limit), its
+    certificate checked by the standalone checker unless [robustness] check = false."""
+    from ..consensus.scenario import _graph
+    from ..graphs.robustness import robustness
+
+    opts = spec.get("robustness", {})
+    G = _graph(spec.get("graph", {}), path.parent, "[graph]", 0)
+    rep = robustness(G, method=opts.get("method", "auto"),
+                     time_limit=opts.get("time_limit"), progress=False)
+    return {"rho": rep.r_max, "s_star": rep.s_max, "exact": rep.exact,
+            "method": rep.method, **_verdict(rep.certificate, opts)}
+
+
+def _kernel(spec: dict[str, Any], path: Path, epsilon: float) -> dict[str, Any]:
+    """The safe kernel Ψ(X, F) of the [points] cloud (:func:`rescon.sweep.clouds.cloud`)
+    with [kernel] F, its certificate checked unless [kernel] check = false."""
+    from ..geometry.kernel import safe_kernel
+    from .clouds import cloud
+
+    opts = spec.get("kernel", {})
+    if "F" not in opts:
+        raise InputError("[kernel]: needs F (the number of points an adversary may move)")
+    K = safe_kernel(cloud(spec.get("points", {}), where="[points]"), opts["F"])
+    return {"dim": K.dim, "is_empty": K.is_empty, "n_vertices": len(K.vertices),
+            **_verdict(K.certificate, opts)}
+
+
+def _verdict(certificate: dict[str, Any], opts: dict[str, Any]) -> dict[str, Any]:
+    """certificate_valid / certificate_verdict of the standalone checker (both null
+    when ``opts["check"]`` is false)."""
+    check = opts.get("check", True)
+    if not isinstance(check, bool):
+        raise InputError(f"check must be true or false; got {check!r}")
+    if not check:
+        return {"certificate_valid": None, "certificate_verdict": None}
+    from ..certify import check_certificate
+
+    res = check_certificate(certificate)
+    return {"certificate_valid": res.valid, "certificate_verdict": res.verdict}
+
+
+_KIND_RUNS = {"consensus": _run, "robustness": _robustness, "kernel": _kernel}
 
 
 def _num(x: float) -> float | None:

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import json
 import os
-import sys
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+from .._progress import progress_bar
 from ..errors import InputError, MissingDependency
 from .cell import METRICS, run_cell
 from .grid import Grid, read_grid
@@ -56,9 +56,8 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     cells = g.cells()
     done = _finished(folder) if folder is not None else {}
     todo = [c for c in cells if c["cell"] not in done]
-    show = sys.stderr.isatty() if progress is None else progress
     as_text = {k for k, values in g.axes.items() if len({type(v) for v in values}) > 1}
-    for row in _bar(_execute(todo, scheduler, workers), len(cells), len(done), show):
+    for row in _bar(_execute(todo, scheduler, workers), len(cells), len(done), progress):
         cell = row.pop("cell")
         done[cell] = {k: _encode(v, k in as_text) for k, v in row.items()}
         if folder is not None:
@@ -66,7 +65,7 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     table = _frame(pd, g, [done[c["cell"]] for c in cells])
     if folder is not None:
         table.to_parquet(folder / "results.parquet", index=False)
-        _plot(table, g, folder)
+        _plot(table, g.axes, g.kind, folder)
     return table
 
 
@@ -195,30 +194,53 @@ def _frame(pd: Any, g: Grid, rows: list[dict[str, Any]]) -> Any:
     """The rows as a DataFrame with fixed columns and dtypes (nullable integers)."""
     columns = [*g.axes, "repetition", "seed", *METRICS]
     table = pd.DataFrame(rows, columns=columns)
-    for name in ("steps_to_consensus", "blocked_links", "repetition"):
-        table[name] = table[name].astype("Int64")
-    for name in ("final_diameter", "max_validity", "final_gap", "seconds"):
-        table[name] = table[name].astype("float64")
+    for names, dtype in _DTYPES:
+        for name in names:
+            table[name] = table[name].astype(dtype)
     return table
 
 
+#: column dtypes (nullable integers and booleans: null where a kind does not fill them)
+_DTYPES = ((("steps_to_consensus", "blocked_links", "repetition", "rho", "s_star", "dim",
+             "n_vertices"), "Int64"),
+           (("final_diameter", "max_validity", "final_gap", "seconds"), "float64"),
+           (("exact", "certificate_valid", "is_empty"), "boolean"))
+
+
 def _bar(rows: Iterator[dict[str, Any]], total: int, done: int,
-         show: bool) -> Iterator[dict[str, Any]]:
-    """``rows`` passed through, with a tqdm bar on stderr when ``show``."""
-    if not show:
+         progress: bool | None) -> Iterator[dict[str, Any]]:
+    """``rows`` passed through, with a bar on stderr (:mod:`rescon._progress`: None =
+    when stderr is a terminal) counting finished cells, resumed ones included."""
+    bar = progress_bar(progress, total, "sweep", unit="cell", initial=done)
+    if bar is None:
         yield from rows
         return
-    from tqdm import tqdm
-
-    with tqdm(total=total, initial=done, desc="sweep", unit="cell", file=sys.stderr) as bar:
+    with bar:
         for row in rows:
             bar.update(1)
             yield row
 
 
-def _plot(table: Any, g: Grid, folder: Path) -> None:
-    """summary.png: per axis, the success rate (status ok and ε-consensus reached) and
-    the mean steps to ε-consensus against the axis values (when matplotlib is there)."""
+def _panels(table: Any, kind: str) -> tuple[tuple[str, Any], tuple[str, Any]]:
+    """The two rows of summary.png for ``kind``: (label, 0/1 per row) whose mean per
+    axis value is a rate, and (label, numbers per row, null for failed cells) whose
+    mean is plotted."""
+    ok = table["status"] == "ok"
+    seconds = ("mean seconds (cells ok)", table["seconds"].where(ok))
+    if kind == "robustness":
+        good = ok & table["exact"].fillna(False) & table["certificate_valid"].fillna(False)
+        return ("exact, certificate valid", good), seconds
+    if kind == "kernel":
+        return ("kernel non-empty", ok & ~table["is_empty"].fillna(True)), seconds
+    return (("success rate (ε-consensus)", ok & table["steps_to_consensus"].notna()),
+            ("mean steps to ε-consensus", table["steps_to_consensus"]))
+
+
+def _plot(table: Any, axes: Mapping[str, list[Any]], kind: str, folder: Path) -> None:
+    """summary.png: per axis, a rate (consensus: status ok and ε-consensus reached;
+    robustness: exact with a valid certificate; kernel: non-empty) and a mean
+    (consensus: steps to ε-consensus; robustness, kernel: seconds) against the axis
+    values, averaged over the other axes and repetitions (when matplotlib is there)."""
     try:
         import matplotlib
     except ImportError:
@@ -226,19 +248,21 @@ def _plot(table: Any, g: Grid, folder: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    axes = list(g.axes) or ["repetition"]
-    fig, ax = plt.subplots(2, len(axes), figsize=(4 * len(axes), 6), squeeze=False)
-    reached = (table["status"] == "ok") & table["steps_to_consensus"].notna()
-    for j, key in enumerate(axes):
+    (rate_label, hits), (mean_label, values) = _panels(table, kind)
+    values = values.astype("float64")
+    keys = list(axes) or ["repetition"]
+    fig, ax = plt.subplots(2, len(keys), figsize=(4 * len(keys), 6), squeeze=False)
+    for j, key in enumerate(keys):
         labels = [str(v) for v in table[key]]
         order = list(dict.fromkeys(labels))
-        rate = [reached[[x == v for x in labels]].mean() for v in order]
-        steps = [table["steps_to_consensus"][[x == v for x in labels]].astype(
-            "float64").mean() for v in order]
-        ax[0, j].bar(order, rate)
-        ax[0, j].set(ylim=(0, 1), ylabel="success rate (ε-consensus)", title=key)
-        ax[1, j].plot(order, steps, "o-")
-        ax[1, j].set(xlabel=key, ylabel="mean steps to ε-consensus")
+        rows = [[x == v for x in labels] for v in order]
+        ax[0, j].bar(order, [hits[r].mean() for r in rows])
+        ax[0, j].set(ylim=(0, 1), ylabel=rate_label, title=key)
+        ax[1, j].plot(order, [values[r].mean() for r in rows], "o-")
+        ax[1, j].set(xlabel=key, ylabel=mean_label)
+        if sum(map(len, order)) > 24:  # long labels side by side would overlap
+            for a in ax[:, j]:
+                a.tick_params(axis="x", labelrotation=35)
     fig.tight_layout()
     fig.savefig(folder / "summary.png", dpi=120)
     plt.close(fig)
