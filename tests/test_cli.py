@@ -615,3 +615,15 @@ def test_kernel_command_empty_and_errors(capsys, tmp_path):
     with pytest.raises(SystemExit) as exc:
         main(["kernel", str(pts)])  # --F is required
     assert exc.value.code == 2
+
+
+def test_method_help_names_every_method(capsys):
+    """--method is checked lazily (the parser does not import graphs.robustness): its
+    help and its error still name every method of the library."""
+    from rescon.graphs.robustness import METHODS
+
+    _, out, _ = run(["robustness", "--help"], capsys)
+    code, _, err = run(["robustness", str(PAPER), "--method", "nope"], capsys)
+    assert code == 2
+    for m in METHODS:
+        assert m in " ".join(out.split()) and m in err

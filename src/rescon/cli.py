@@ -1,6 +1,8 @@
 """rescon command line: thin subcommands over the Python API.
 
-Every subcommand takes ``--json`` (one JSON object on stdout). Bad input exits 2
+Every subcommand takes ``--json`` (one JSON object on stdout) and ``--quiet`` (no
+progress bars; warnings, e.g. the assumptions a scenario violates, still go to stderr).
+Progress bars appear only when stderr is a terminal. Bad input exits 2
 with one line on stderr, never a traceback; ``rescon check`` exits 0 (valid),
 1 (invalid, reason on stderr), 2 (unreadable) or 3 (not fully checked: the parts taken
 on trust or beyond the checker's limits are named).
@@ -17,7 +19,6 @@ from pathlib import Path
 from typing import Any
 
 from .errors import RESCONError, TimeLimitReached
-from .graphs.robustness import METHODS
 
 __all__ = ["main"]
 
@@ -53,6 +54,12 @@ def _write_certificate(cert: dict[str, Any] | None, target: Path | None) -> None
     target.write_text(json.dumps(cert, separators=(",", ":")) + "\n", encoding="utf-8")
 
 
+def _progress(args: argparse.Namespace) -> bool | None:
+    """The library's ``progress``: False under ``--quiet``, else None (a bar only when
+    stderr is a terminal; see :mod:`rescon._progress`)."""
+    return False if args.quiet else None
+
+
 def _emit(result: dict[str, Any], as_json: bool, lines: list[str]) -> None:
     if as_json:
         print(json.dumps(result))
@@ -73,7 +80,7 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
     G = read_graph(args.graph, undirected=args.undirected)
     kw = {"time_limit": args.time_limit, "method": args.method}
     if args.r is None:
-        rep = robustness(G, **kw)
+        rep = robustness(G, progress=_progress(args), **kw)
         _write_certificate(rep.certificate, cert_path)
         out = {"n": rep.n, "r_max": rep.r_max, "s_max": rep.s_max, "exact": rep.exact,
                "witness": _pair_json(rep.witness), "method": rep.method,
@@ -213,7 +220,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
     out_dir, plot = _run_outputs(args)
     sc = Scenario.from_toml(args.scenario)
-    traj = _warned(lambda: simulate(sc))
+    traj = _warned(lambda: simulate(sc, progress=_progress(args)))
     out, lines = _run_summary(args, sc, traj, out_dir, plot)
     _emit(out, args.json, lines)
     return 0
@@ -230,7 +237,8 @@ def _cmd_rmdo(args: argparse.Namespace) -> int:
 
     out_dir, plot = _run_outputs(args)
     f = read_rmdo(args.scenario)
-    traj = _warned(lambda: rmdo(f.scenario, f.costs, step_size=f.step_size))
+    traj = _warned(lambda: rmdo(f.scenario, f.costs, step_size=f.step_size,
+                                progress=_progress(args)))
     out, lines = _run_summary(args, f.scenario, traj, out_dir, plot)
     m, opt = traj.metrics, dict(traj.info["optimum"])
     opt.setdefault("point", None)
@@ -305,7 +313,7 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     failures. ``--json``: the object of ``DIR/summary.json``."""
     from .paper import reproduce_paper
 
-    rep = reproduce_paper(args.out)
+    rep = reproduce_paper(args.out, progress=_progress(args))
     lines = [f"{c.verdict:>13}  {c.claim}" for c in rep.claims]
     verdicts = [c["verdict"] for c in rep.certificates]
     lines.append(f"certificates: {len(verdicts)} written, "
@@ -324,7 +332,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     from .sweep import sweep
 
     t0 = time.perf_counter()
-    table = sweep(args.grid, scheduler=args.scheduler, workers=args.workers, out=args.out)
+    table = sweep(args.grid, scheduler=args.scheduler, workers=args.workers, out=args.out,
+                  progress=_progress(args))
     ok = int((table["status"] == "ok").sum())
     out = {"cells": len(table), "ok": ok, "failed": len(table) - ok,
            "out": str(Path(args.out) / "results.parquet"),
@@ -379,6 +388,15 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _robustness_method(text: str) -> str:
+    """A name of :data:`rescon.graphs.robustness.METHODS` (imported only when given)."""
+    from .graphs.robustness import METHODS
+
+    if text not in METHODS:
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(METHODS)}; got {text!r}")
+    return text
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
 
@@ -404,8 +422,9 @@ def _parser() -> argparse.ArgumentParser:
     rob.add_argument("--undirected", action="store_true", help="treat edges as undirected")
     rob.add_argument("--time-limit", type=_positive_float, metavar="SEC",
                      help="stop and report proven bounds after SEC seconds")
-    rob.add_argument("--method", default="auto", choices=METHODS,
-                     help="exact method when the bounds do not meet")
+    rob.add_argument("--method", default="auto", type=_robustness_method,
+                     help="exact method when the bounds do not meet: auto (default), "
+                          "search, milp or dp")
     rob.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
     rob.add_argument("--json", action="store_true", help="one JSON object on stdout")
     rob.set_defaults(func=_cmd_robustness)
@@ -463,6 +482,9 @@ def _parser() -> argparse.ArgumentParser:
     chk.add_argument("--json", action="store_true",
                      help="one JSON object: valid, readable, reason, trusted")
     chk.set_defaults(func=_cmd_check)
+    for command in sub.choices.values():
+        command.add_argument("--quiet", "-q", action="store_true",
+                             help="no progress bars (warnings still go to stderr)")
     return p
 
 

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 import time
 import warnings
 from collections.abc import Callable, Hashable
@@ -29,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from ._progress import progress_bar, wanted
 from .certify import check_certificate
 from .consensus.dos import PAPER_MU_D, PAPER_T_D, check_assumption3
 from .consensus.engine import simulate
@@ -140,16 +140,12 @@ def reproduce_paper(out: Any = "out/paper", *, progress: bool | None = None) -> 
 
 
 class _Phases:
-    """One tqdm bar over the phases, on stderr, only on a terminal unless forced."""
+    """One bar over the phases on stderr (the rule of :mod:`rescon._progress`)."""
 
     def __init__(self, enabled: bool | None, names: list[str]) -> None:
-        self.enabled = sys.stderr.isatty() if enabled is None else bool(enabled)
-        self.bar = None
-        if self.enabled:
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=len(names), unit="part", file=sys.stderr, position=0,
-                            desc="rescon paper")
+        self.enabled = wanted(enabled)
+        self.bar = progress_bar(self.enabled, len(names), "rescon paper", unit="part",
+                                leave=True, position=0)
 
     def run(self, name: str, part: Callable[[], None]) -> None:
         self.note(name)
