@@ -3,8 +3,12 @@
 * spread_p(t) = max_{i∈B} x_{i,p}(t) − min_{i∈B} x_{i,p}(t) per coordinate p, and the
   diameter max_{i,j∈B} ‖x_i(t) − x_j(t)‖₂ (consensus: both → 0);
 * δ-validity: dist(x_i(t), conv{x_j(0) : j ∈ B}) for every benign i (validity: it stays
-  ≤ δ). The hull is computed exactly once (the safe kernel with F = 0); a state inside
-  it (decided exactly) is at distance 0, one outside is projected onto it exactly.
+  ≤ δ). The hull is computed exactly once: Qhull proposes its vertices V, the exact
+  polytope conv V (the safe kernel of V with F = 0) is built and every initial state is
+  proven in it (:func:`certified_hull`); a state inside it (decided exactly) is at
+  distance 0, one outside gets a certified float distance or the exact projection.
+
+:data:`MONITORS` names the metrics a run can record (``simulate(..., metrics=...)``).
 """
 
 from __future__ import annotations
@@ -17,7 +21,14 @@ import numpy as np
 from .._rounding import MIN_SUBNORMAL, UNIT_ROUNDOFF
 from ..geometry.kernel import safe_kernel
 
-__all__ = ["ValidityMonitor", "diameter", "spread"]
+__all__ = ["MONITORS", "ValidityMonitor", "certified_hull", "diameter", "spread"]
+
+#: the metrics a consensus run can record: "spread" (K+1, d), "diameter" (K+1,),
+#: "validity" (the max (K+1,) and "validity_per_agent" (K+1, |B|))
+MONITORS = ("spread", "diameter", "validity")
+
+#: up to this many initial states the hull is built from all of them (no proposal)
+PROPOSE_MIN = 64
 
 
 def spread(states: np.ndarray) -> np.ndarray:
@@ -68,7 +79,7 @@ class ValidityMonitor:
     onto H, rounded once (~1.5 ms per state)."""
 
     def __init__(self, initial: np.ndarray) -> None:
-        self.hull = safe_kernel(initial, 0)
+        self.hull = certified_hull(initial)
         full = self.hull.dim == initial.shape[1] and bool(self.hull._exact.facets)
         self._rows = _filter_rows(self.hull._exact.facets) if full else None
         self._edges = _polygon_edges(self.hull) if full and initial.shape[1] == 2 else None
@@ -98,13 +109,7 @@ class ValidityMonitor:
 
     def _slacks(self, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """fl(Â x − b̂) per row and facet, and its error bound (:meth:`surely_inside`)."""
-        A, b = self._rows
-        d = states.shape[1]
-        with np.errstate(over="ignore", invalid="ignore"):
-            S = states @ A.T - b
-            bound = (2 * (d + 2) * UNIT_ROUNDOFF * (np.abs(states) @ np.abs(A).T + np.abs(b))
-                     + (d + 2) * MIN_SUBNORMAL * (np.abs(states).max(axis=1) + 1)[:, None])
-        return S, bound
+        return _slacks(*self._rows, states)
 
     def distances(self, states: np.ndarray) -> np.ndarray:
         """Distances of the rows of ``states``: rows :meth:`surely_inside` the hull are 0,
@@ -147,6 +152,71 @@ class ValidityMonitor:
         P, Q = self._edges
         M = np.maximum(np.abs(X).max(axis=1), max(np.abs(P).max(), np.abs(Q).max()))
         return np.where((M > 1e-100) & (M < 1e100), 64 * UNIT_ROUNDOFF * M, np.inf)
+
+
+def certified_hull(X: np.ndarray):
+    """conv X (rows of X, (n, d)) as the exact polytope safe_kernel(X[V], 0) for rows V
+    with conv X[V] = conv X. V is proposed by Qhull (:func:`_proposed_rows`) and then
+    certified: every other row is proven in conv X[V] (the float filter of its exact
+    facets, :meth:`ValidityMonitor.surely_inside`, and the exact test where the filter
+    is unsure); rows that are not are added to V and conv X[V] is rebuilt. The hull of
+    n points costs one Qhull call, the exact kernel of its h vertices and O(n·facets)
+    float work, instead of the O(n^d) candidates of safe_kernel(X, 0)."""
+    X = np.asarray(X, dtype=np.float64)
+    rows = _proposed_rows(X)
+    while True:
+        hull = safe_kernel(X[rows], 0)
+        outside = _rows_outside(hull, X, rows)
+        if not outside.size:
+            return hull
+        rows = np.union1d(rows, outside)
+
+
+def _rows_outside(hull, X: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Rows of X (other than ``rows``, the hull's own points) not in ``hull`` (exact)."""
+    rest = np.setdiff1d(np.arange(len(X)), rows)
+    if hull.dim == X.shape[1] and hull._exact.facets:
+        A, b = _filter_rows(hull._exact.facets)
+        S, bound = _slacks(A, b, X[rest])
+        rest = rest[~(S < -bound).all(axis=1)]
+    return np.array([i for i in rest if not hull.contains(X[i])], dtype=np.int64)
+
+
+def _proposed_rows(X: np.ndarray) -> np.ndarray:
+    """Row indices that Qhull finds to be the vertices of conv X (a proposal: rounding
+    may add or miss some; :func:`certified_hull` decides). All rows for small n or
+    d > 3. X is first put on its principal axes, each scaled to unit width (an affine
+    map keeps the vertices): a thin or flat X (an axis of width ~0) becomes a fat one,
+    axes of width exactly 0 are dropped; Qhull's own degeneracy failure is retried
+    joggled ("QJ")."""
+    n, d = X.shape
+    if n <= PROPOSE_MIN or d > 3:
+        return np.arange(n)
+    top = np.abs(X).max()
+    Y = np.ldexp(X, -int(np.frexp(top)[1])) if top > 0 else X
+    Y = Y - Y.mean(axis=0)
+    Z = Y @ np.linalg.svd(Y, full_matrices=False)[2].T
+    width = Z.max(axis=0) - Z.min(axis=0)
+    Z = Z[:, width > 0] / width[width > 0]
+    if Z.shape[1] <= 1:
+        return np.unique([0, *(np.argmin(Z, axis=0)), *(np.argmax(Z, axis=0))])
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        return np.sort(ConvexHull(Z).vertices)
+    except QhullError:
+        return np.sort(ConvexHull(Z, qhull_options="QJ").vertices)
+
+
+def _slacks(A: np.ndarray, b: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """fl(Â x − b̂) per row of ``states`` and facet (Â, b̂), and its error bound
+    (:meth:`ValidityMonitor.surely_inside`)."""
+    d = states.shape[1]
+    with np.errstate(over="ignore", invalid="ignore"):
+        S = states @ A.T - b
+        bound = (2 * (d + 2) * UNIT_ROUNDOFF * (np.abs(states) @ np.abs(A).T + np.abs(b))
+                 + (d + 2) * MIN_SUBNORMAL * (np.abs(states).max(axis=1) + 1)[:, None])
+    return S, bound
 
 
 def _polygon_edges(hull) -> tuple[np.ndarray, np.ndarray] | None:
