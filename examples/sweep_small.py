@@ -4,7 +4,8 @@ Shows: a TOML grid (the paper's example under three blocked-link policies × two
 centres × 2 repetitions = 12 cells) run serially (``workers=0``, no Dask needed) or on
 a local Dask cluster (``--workers N``) or an existing one (``--scheduler ADDRESS``);
 one row per cell in ``OUT/results.parquet`` (resumable: rerunning skips finished
-cells). Prints the table's main columns and one JSON line.
+cells). Prints the table's main columns and one JSON line. Any grid works, e.g.
+``examples/sweeps/robustness.toml`` (ρ and s* of generated graphs, certificates checked).
 
 Run::
 
@@ -24,8 +25,8 @@ from pathlib import Path
 import rescon
 
 DEFAULT = Path(__file__).resolve().parent / "sweeps" / "small.toml"
-COLUMNS = ["scenario.policy", "scenario.centre", "seed", "status", "final_diameter",
-           "max_validity", "steps_to_consensus"]
+#: columns never printed (the rest is printed when some row has a value)
+HIDDEN = {"repetition", "error", "rescon_version", "seconds"}
 
 
 def main() -> None:
@@ -42,13 +43,13 @@ def main() -> None:
     workers = 0 if args.workers is None and args.scheduler is None else args.workers
     df = rescon.sweep(args.grid, workers=workers, scheduler=args.scheduler, out=args.out,
                       progress=False)
-    shown = [c for c in COLUMNS if c in df.columns]
+    shown = [c for c in df.columns if c not in HIDDEN and df[c].notna().any()]
     print(df[shown].to_string(index=False))
-    print(json.dumps({
-        "cells": len(df), "ok": int((df["status"] == "ok").sum()),
-        "max_final_diameter": float(df["final_diameter"].max()),
-        "results": str(Path(args.out) / "results.parquet"),
-    }))
+    summary = {"cells": len(df), "ok": int((df["status"] == "ok").sum()),
+               "results": str(Path(args.out) / "results.parquet")}
+    if df["final_diameter"].notna().any():
+        summary["max_final_diameter"] = float(df["final_diameter"].max())
+    print(json.dumps(summary))
 
 
 if __name__ == "__main__":
