@@ -562,17 +562,18 @@ def _witness_text(rep: Any, cert: dict[str, Any]) -> str:
 
 def _plot_centres(trajs: dict[str, Any], path: Path) -> Any:
     """Benign diameter and distance to the initial benign hull over time, one line per
-    Cen(Λ) choice (hold-last). The diameter's log axis stops at the rounding floor
-    ε · (initial diameter): an exact 0 is drawn there."""
+    Cen(Λ) choice (hold-last). The diameter's log axis stops a decade below the
+    smallest positive diameter (:func:`rescon.plot.consensus.log_floor`): exact zeros
+    are drawn there, ▼ where they start."""
     from .plot import pyplot
+    from .plot.consensus import log_floor, plot_log_clipped
 
     plt = pyplot(path)
     fig, (ax_d, ax_v) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
-    floor = np.finfo(float).eps * max(t.metrics["diameter"][0] for t in trajs.values())
+    floor = log_floor(*(t.metrics["diameter"] for t in trajs.values()))
     for (centre, t), style in zip(trajs.items(), ("-", "--", ":"), strict=False):
-        ax_d.plot(t.times, np.maximum(t.metrics["diameter"], floor), ls=style, label=centre)
+        plot_log_clipped(ax_d, t.times, t.metrics["diameter"], floor, ls=style, label=centre)
         ax_v.plot(t.times, t.metrics["validity"], ls=style, label=centre)
-    ax_d.set_yscale("log")
     ax_d.set_ylabel("diameter (benign)")
     ax_v.set_ylabel("distance to conv(benign x(0))")
     ax_v.set_xlabel("t (s)")
@@ -584,17 +585,20 @@ def _plot_centres(trajs: dict[str, Any], path: Path) -> Any:
 
 
 def _plot_distance(tr: Any, long: Any, path: Path) -> Any:
-    """max_i dist(x_i, X*) over time for the paper's horizon and the long run."""
+    """max_i dist(x_i, X*) over time for the paper's horizon and the long run (log
+    axes; an exact 0 at :func:`rescon.plot.consensus.log_floor`)."""
     from .plot import pyplot
+    from .plot.consensus import log_floor, plot_log_clipped
 
     plt = pyplot(path)
     fig, ax = plt.subplots(figsize=(7, 3))
-    ax.plot(long.times, long.metrics["distance_to_optimum"], color="tab:gray",
-            label=f"{len(long.times) - 1} steps")
-    ax.plot(tr.times, tr.metrics["distance_to_optimum"], color="tab:blue",
-            label=f"{len(tr.times) - 1} steps (the paper's horizon)")
+    dist = long.metrics["distance_to_optimum"], tr.metrics["distance_to_optimum"]
+    floor = log_floor(*dist)
+    plot_log_clipped(ax, long.times, dist[0], floor, color="tab:gray",
+                     label=f"{len(long.times) - 1} steps")
+    plot_log_clipped(ax, tr.times, dist[1], floor, color="tab:blue",
+                     label=f"{len(tr.times) - 1} steps (the paper's horizon)")
     ax.set_xscale("log")
-    ax.set_yscale("log")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("max_i dist(x_i, X*)")
     ax.legend(fontsize=7)

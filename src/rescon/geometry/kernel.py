@@ -152,11 +152,14 @@ class SafeKernel:
         :func:`rescon.kernel_point`."""
         return kernel_point_of(self, method=method, backend=backend, target=target)
 
-    def plot(self, ax: Any = None, *, point: Any = None, path: Any = None) -> Any:
-        """Points, kernel and (optionally) a chosen point; d = 2 or 3 (matplotlib)."""
+    def plot(self, ax: Any = None, *, point: Any = None, path: Any = None,
+             view: tuple[float, float] | None = None) -> Any:
+        """Points, kernel and (optionally) a chosen point; d = 2 or 3 (matplotlib), axes
+        x₁, x₂ (, x₃) at equal scale, a 3-D kernel seen from ``view`` = (elevation,
+        azimuth) in degrees (:func:`rescon.plot.kernel.plot_kernel`)."""
         from ..plot.kernel import plot_kernel
 
-        return plot_kernel(self, ax=ax, point=point, path=path)
+        return plot_kernel(self, ax=ax, point=point, path=path, view=view)
 
 
 def _ambient(hull: AffineHull, d: int, a: tuple[int, ...], b: int, scale: int

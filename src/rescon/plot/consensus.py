@@ -72,7 +72,6 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
     axes[-1, 0].set_xlabel("t (s)")
     _figure_legend(fig, axes[:, 0])
     fig.suptitle(_title(traj.info), fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, _legend_top(fig)))
     if path is not None:
         fig.savefig(path, dpi=120)
     return fig
@@ -164,8 +163,8 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
                     markevery=step, label=name)
             start = [X[0, i, p]]
         else:
-            ax.fill_between(t, band[0], band[1], color=colour, alpha=0.3, lw=0,
-                            label=f"{name}: range sent (two-faced)")
+            ax.fill_between(t, band[0], band[1], color=colour, alpha=0.15, lw=0,
+                            label=f"{name}: range sent")
             for edge in band:
                 ax.plot(t, edge, color=colour, ls=ls, lw=0.7, marker=marker, ms=3,
                         markevery=step)
@@ -244,9 +243,11 @@ def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str
     line = ax.plot(t, np.where(zero, floor, y), label=label, **style)[0]
     starts = np.flatnonzero(zero & ~np.concatenate([[False], zero[:-1]]))
     if starts.size:
+        zero_label = "exactly 0 (drawn at the axis floor)"
         ax.scatter(np.asarray(t)[starts], np.full(starts.size, floor), marker="v", s=40,
                    color=line.get_color(), zorder=5, clip_on=False,
-                   label="exactly 0 (drawn at the axis floor)")
+                   label=None if zero_label in ax.get_legend_handles_labels()[1]
+                   else zero_label)
     ax.set_ylim(bottom=floor / 2)
     return line
 
@@ -299,18 +300,14 @@ def _rate_panel(ax: Any, traj: Any) -> None:
 
 
 def _figure_legend(fig: Any, axes: Any) -> None:
-    """One legend above the panels: every distinct label once, in drawing order."""
+    """One legend under the title's place, above the panels (laid out below it; the
+    title comes after the layout): every distinct label once, in drawing order."""
     seen: dict[str, Any] = {}
     for ax in axes:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             seen.setdefault(label, handle)
-    fig.legend(list(seen.values()), list(seen), loc="upper center", fontsize=7,
-               ncol=min(LEGEND_COLUMNS, len(seen)), bbox_to_anchor=(0.5, 0.965),
-               frameon=False)
-
-
-def _legend_top(fig: Any) -> float:
-    """The top of the panels' area: below the title and the legend's rows."""
-    rows = math.ceil(len(fig.legends[0].get_texts()) / LEGEND_COLUMNS) if fig.legends else 0
-    inches = 0.1 + 0.15 * rows
-    return 1.0 - inches / fig.get_figheight()
+    legend = fig.legend(list(seen.values()), list(seen), loc="upper center", fontsize=7,
+                        ncol=min(LEGEND_COLUMNS, len(seen)), frameon=False,
+                        bbox_to_anchor=(0.5, 1.0 - 0.3 / fig.get_figheight()))
+    box = legend.get_window_extent(fig.canvas.get_renderer())
+    fig.tight_layout(rect=(0, 0, 1, fig.transFigure.inverted().transform(box.p0)[1]))
