@@ -38,7 +38,7 @@ from ..geometry.centroid import hull_centroid
 from ..geometry.kernel import safe_kernel
 from .adversaries import StepView, adversary_messages
 from .dos import blocked_mask
-from .metrics import ValidityMonitor, diameter, spread
+from .metrics import ValidityMonitor, diameter, monitor_names, spread
 from .scenario import Scenario
 from .trajectory import Trajectory
 
@@ -60,17 +60,25 @@ class _Links:
         self.in_nbrs = [self.send[self.start[i]:self.start[i + 1]] for i in range(n)]
 
 
-def simulate(scenario: Scenario, *, progress: bool | None = None) -> Trajectory:
+def simulate(scenario: Scenario, *, metrics: Sequence[str] | None = None,
+             progress: bool | None = None) -> Trajectory:
     """Run the scenario (Algorithm 1 or a baseline); see the module docstring for one step.
+
+    Parameters
+    ----------
+    metrics : the monitors to run, names from :data:`rescon.consensus.metrics.MONITORS`
+        ("spread", "diameter", "validity"; default: every one). ``blocked_links`` and
+        ``starved`` are always recorded.
 
     Returns
     -------
     Trajectory (states, metrics per step, the violated assumptions in ``info``).
     """
     t0 = time.perf_counter()
+    monitor = ConsensusMonitor(scenario, metrics)
     problems = scenario.warn()
-    return run(scenario, ConvexStep(scenario.residual), progress=progress, started=t0,
-               info={"assumptions_violated": problems})
+    return run(scenario, ConvexStep(scenario.residual), monitors=[monitor],
+               progress=progress, started=t0, info={"assumptions_violated": problems})
 
 
 class UpdateRule(Protocol):
@@ -107,23 +115,31 @@ class ConvexStep:
 
 class ConsensusMonitor:
     """``spread`` (K+1, d), ``diameter`` (K+1,), ``validity`` (K+1,) and
-    ``validity_per_agent`` (K+1, |B|) of the benign states (:mod:`.metrics`)."""
+    ``validity_per_agent`` (K+1, |B|) of the benign states (:mod:`.metrics`), or those
+    of the ``metrics`` named (:func:`~rescon.consensus.metrics.monitor_names`)."""
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, metrics: Sequence[str] | None = None) -> None:
+        self.names = monitor_names(metrics)
         benign = _benign_rows(scenario)
         K, d = scenario.steps, scenario.d
-        self.validity = ValidityMonitor(scenario.x0[benign])
-        self.metrics = {"spread": np.empty((K + 1, d)), "diameter": np.empty(K + 1),
-                        "validity": np.empty(K + 1),
-                        "validity_per_agent": np.empty((K + 1, len(benign)))}
+        shapes = {"spread": [("spread", (K + 1, d))], "diameter": [("diameter", K + 1)],
+                  "validity": [("validity", K + 1),
+                               ("validity_per_agent", (K + 1, len(benign)))]}
+        self.metrics = {key: np.empty(shape) for name in self.names
+                        for key, shape in shapes[name]}
+        self.validity = (ValidityMonitor(scenario.x0[benign]) if "validity" in self.names
+                         else None)
 
     def record(self, k: int, t: float, xb: np.ndarray) -> None:
         m = self.metrics
-        m["spread"][k] = spread(xb)
-        m["diameter"][k] = diameter(xb)
-        dist = self.validity.distances(xb)
-        m["validity_per_agent"][k] = dist
-        m["validity"][k] = dist.max()
+        if "spread" in m:
+            m["spread"][k] = spread(xb)
+        if "diameter" in m:
+            m["diameter"][k] = diameter(xb)
+        if self.validity is not None:
+            dist = self.validity.distances(xb)
+            m["validity_per_agent"][k] = dist
+            m["validity"][k] = dist.max()
 
 
 def _benign_rows(sc: Scenario) -> np.ndarray:
@@ -255,6 +271,8 @@ def _scaled_mean(a: np.ndarray, axis: int = 0) -> np.ndarray:
 def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     """x̃_i for every benign agent (rows in ``benign`` order) and the rows (positions in
     ``benign``) that must hold their state."""
+    if sc.algorithm == "alg1":
+        return _alg1_auxiliary(sc, links, x, values, usable, benign, d, cache)
     m = (d + 1) * sc.F + 1
     aux = np.empty((len(benign), d))
     starved: list[int] = []
@@ -263,18 +281,11 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     for r, i in enumerate(benign):
         sl = slice(links.start[i], links.start[i + 1])
         X = values[sl][usable[sl]]
-        if sc.algorithm in ("alg1", "kernel") and len(X) < m:
+        if sc.algorithm == "kernel" and len(X) < m:
             starved.append(r)
             aux[r] = x[i]
             continue
-        if sc.algorithm == "alg1":
-            for p in range(d):
-                order = np.argsort(X[:, p], kind="stable")
-                problems.append(X[order[:m]])
-                where.append((r, p, 0))
-                problems.append(X[order[-m:]])
-                where.append((r, p, 1))
-        elif sc.algorithm == "kernel":
+        if sc.algorithm == "kernel":
             problems.append(X)
             where.append((r, 0, 0))
         elif sc.algorithm == "wmsr":
@@ -282,13 +293,51 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
         else:
             aux[r] = _scaled_mean(np.vstack([X, x[i]]))
     points = _kernel_points(problems, sc.F, sc.kernel_point, cache)
-    if sc.algorithm == "kernel":
-        for (r, _, _), pt in zip(where, points, strict=True):
-            aux[r] = pt
-    elif sc.algorithm == "alg1" and points:
-        rows = [r for r, _, _ in where[::2 * d]]  # each row has its 2d points in turn
-        aux[rows] = _centre(np.reshape(points, (len(rows), 2 * d, d)), sc.centre)
+    for (r, _, _), pt in zip(where, points, strict=True):
+        aux[r] = pt
     return aux, starved
+
+
+def _alg1_auxiliary(sc, links, x, values, usable, benign, d, cache):
+    """:func:`_auxiliary` for Algorithm 1, one array operation per group of agents with
+    the same number c of usable values: their values (R, c, d) are sorted per
+    coordinate (stable: ties by sender order) and Y_p, Z_p are the first and last m
+    rows in that order; the 2d kernel problems of an agent come in turn (p = 1..d, Y
+    then Z)."""
+    m = (d + 1) * sc.F + 1
+    aux = np.empty((len(benign), d))
+    starved: list[np.ndarray] = []
+    problems: list[np.ndarray] = []
+    moved: list[np.ndarray] = []
+    for c, rows, idx in _usable_groups(links, usable, benign):
+        if c < m:
+            starved.append(rows)
+            aux[rows] = x[benign[rows]]
+            continue
+        V = values[idx]  # (R, c, d)
+        order = np.argsort(V, axis=1, kind="stable").transpose(0, 2, 1)  # (R, d, c)
+        ends = np.concatenate([order[:, :, None, :m], order[:, :, None, -m:]], axis=2)
+        picked = np.take_along_axis(V[:, None, None], ends[..., None], axis=3)
+        problems.append(picked.reshape(-1, m, d))  # (R, d, 2, m, d): Y_p, Z_p in turn
+        moved.append(rows)
+    if moved:
+        points = _kernel_points(np.concatenate(problems), sc.F, sc.kernel_point, cache)
+        rows = np.concatenate(moved)
+        aux[rows] = _centre(np.reshape(points, (len(rows), 2 * d, d)), sc.centre)
+    return aux, np.sort(np.concatenate(starved)) if starved else starved
+
+
+def _usable_groups(links, usable, benign):
+    """(c, rows, idx) for each count c of usable received values among the benign
+    agents: ``rows`` their positions in ``benign``, ``idx`` (len(rows), c) their usable
+    links (in link order: by sender)."""
+    ulinks = np.flatnonzero(usable)  # links are sorted by receiver
+    count = np.bincount(links.recv[ulinks], minlength=len(links.start) - 1)
+    first = np.concatenate([[0], np.cumsum(count)])
+    per_agent = count[benign]
+    for c in np.unique(per_agent):
+        rows = np.flatnonzero(per_agent == c)
+        yield int(c), rows, ulinks[first[benign[rows]][:, None] + np.arange(c)]
 
 
 def _centre(lam: np.ndarray, centre: str) -> np.ndarray:
@@ -310,9 +359,10 @@ def _centre(lam: np.ndarray, centre: str) -> np.ndarray:
 SMALL_BATCH_MAX = {2: 64, 3: 24}
 
 
-def _kernel_points(problems: list[np.ndarray], F: int, method: str,
-                   cache: dict) -> list[np.ndarray]:
-    """A point of Ψ(X, F) for every X (Ψ is nonempty for |X| ≥ (d+1)F+1).
+def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
+                   cache: dict) -> np.ndarray:
+    """A point of Ψ(X, F) for every X (Ψ is nonempty for |X| ≥ (d+1)F+1), as rows
+    (P, d); ``problems`` is a list of sets or one array (P, m, d) of sets of one size.
 
     "project" in the plane goes through the numba batch path
     (:mod:`rescon.geometry._small2d`: exact decisions, float geometry, certified error
@@ -326,14 +376,17 @@ def _kernel_points(problems: list[np.ndarray], F: int, method: str,
     from ..geometry._small2d import ACCEPT_REL, OK, project_small_2d
     from ..geometry._small3d import project_small_3d
 
-    out: list[np.ndarray | None] = [None] * len(problems)
+    if not len(problems):
+        return np.empty((0, 0))
+    out = np.empty((len(problems), problems[0].shape[1]))
+    done = np.zeros(len(problems), dtype=bool)
     if method == "project":
-        groups: dict[tuple[int, int], list[int]] = {}
-        for k, X in enumerate(problems):
-            if len(X) <= SMALL_BATCH_MAX.get(X.shape[1], 0):
-                groups.setdefault(X.shape, []).append(k)
-        for (_, d), idx in groups.items():
-            Ys = np.ascontiguousarray(np.stack([problems[k] for k in idx]), dtype=np.float64)
+        for (m, d), idx in _same_shape(problems).items():
+            if m > SMALL_BATCH_MAX.get(d, 0):
+                continue
+            Ys = np.ascontiguousarray(problems[idx] if isinstance(problems, np.ndarray)
+                                      else np.stack([problems[k] for k in idx]),
+                                      dtype=np.float64)
             if d == 2:
                 pts = np.empty((len(idx), 2))
                 err = np.empty(len(idx))
@@ -342,17 +395,26 @@ def _kernel_points(problems: list[np.ndarray], F: int, method: str,
                 found = (status == OK) & (err <= ACCEPT_REL * np.abs(pts).max(axis=1))
             else:
                 pts, _, found = project_small_3d(Ys, F)
-            for k, p, ok in zip(idx, pts, found, strict=True):
-                if ok:
-                    out[k] = p
+            out[idx[found]] = pts[found]
+            done[idx[found]] = True
     exact = "project" if method == "project-exact" else method
-    for k, X in enumerate(problems):
-        if out[k] is None:
-            key = (X.shape, X[np.lexsort(X.T[::-1])].tobytes())  # Ψ ignores the order
-            if key not in cache:
-                cache[key] = safe_kernel(X, F).point(exact)[0]
-            out[k] = cache[key]
+    for k in np.flatnonzero(~done):
+        X = problems[k]
+        key = (X.shape, X[np.lexsort(X.T[::-1])].tobytes())  # Ψ ignores the order
+        if key not in cache:
+            cache[key] = safe_kernel(X, F).point(exact)[0]
+        out[k] = cache[key]
     return out
+
+
+def _same_shape(problems: list[np.ndarray] | np.ndarray) -> dict[tuple[int, ...], np.ndarray]:
+    """Indices of the problems by shape (one group for an array of problems)."""
+    if isinstance(problems, np.ndarray):
+        return {problems.shape[1:]: np.arange(len(problems))}
+    groups: dict[tuple[int, ...], list[int]] = {}
+    for k, X in enumerate(problems):
+        groups.setdefault(X.shape, []).append(k)
+    return {shape: np.array(idx) for shape, idx in groups.items()}
 
 
 def _wmsr(own: np.ndarray, X: np.ndarray, F: int) -> np.ndarray:

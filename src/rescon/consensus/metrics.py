@@ -15,13 +15,16 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 
 from .._rounding import MIN_SUBNORMAL, UNIT_ROUNDOFF
+from ..errors import InputError
 from ..geometry.kernel import safe_kernel
 
-__all__ = ["MONITORS", "ValidityMonitor", "certified_hull", "diameter", "spread"]
+__all__ = ["MONITORS", "ValidityMonitor", "certified_hull", "diameter", "monitor_names",
+           "spread"]
 
 #: the metrics a consensus run can record: "spread" (K+1, d), "diameter" (K+1,),
 #: "validity" (the max (K+1,) and "validity_per_agent" (K+1, |B|))
@@ -29,6 +32,24 @@ MONITORS = ("spread", "diameter", "validity")
 
 #: up to this many initial states the hull is built from all of them (no proposal)
 PROPOSE_MIN = 64
+
+
+def monitor_names(metrics: Any) -> tuple[str, ...]:
+    """The :data:`MONITORS` a run records: every one for None, else the names given
+    (a string or a sequence of strings; duplicates ignored, order of MONITORS)."""
+    if metrics is None:
+        return MONITORS
+    names = [metrics] if isinstance(metrics, str) else metrics
+    try:
+        chosen = set(names)
+    except TypeError:
+        raise InputError(f"metrics must be a list of names from {MONITORS}; got {metrics!r}"
+                         ) from None
+    unknown = sorted(map(repr, chosen - set(MONITORS)))
+    if unknown:
+        raise InputError(f"metrics: unknown name(s) {', '.join(unknown)}; "
+                         f"choose from {', '.join(MONITORS)}")
+    return tuple(m for m in MONITORS if m in chosen)
 
 
 def spread(states: np.ndarray) -> np.ndarray:
