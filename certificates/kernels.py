@@ -600,6 +600,67 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
     return "halfspaces"
 
 
+def _polygon_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[int]]],
+                       names: list[str], ctx: Any) -> str:
+    """P = conv(V) ⊆ Psi for a polygon P (d = dim = 2, vert(P) = V already proved;
+    ``tight[i]``: the integer normals of the facets tight at V[i]), by the normal fan:
+
+        P ⊆ Psi  iff  for every vertex v and every w ≠ 0 in the normal cone N_v of P
+                      at v, the closed halfspace {y : w·(y − v) >= 0} holds >= F + 1 points.
+
+    (If x ∈ P has depth <= F, a closed halfspace {a·y >= a·x} holds <= F points; a vertex
+    v maximising a over P has a ∈ N_v and {a·y >= a·v} is inside it.  Conversely a
+    vertex failing the test has depth <= F.)  N_v is the cone of w1 ⊥ y1, w2 ⊥ y2 (the
+    two edge directions y of P at v, w_k·y_other < 0); on w = (1 − t) w1 + t w2,
+    t ∈ [0, 1], a point p with s_k = w_k·(p − v) is counted for all t (s1, s2 >= 0), for
+    none (both < 0), for t <= t_p or for t >= t_p (t_p = s1 / (s1 − s2)), so the count is
+    constant between consecutive t_p and its minimum is taken on one of these open
+    intervals (at a breakpoint it is at least that of a neighbouring interval).  Work:
+    2 n products per vertex and a sort of the breakpoints, bit-weighted; beyond
+    MAX_EVAL_WORK the part is unchecked."""
+    part = "vertices in the safe kernel (proof 'halfspaces', normal fan of the polygon)"
+    sp = _scaled_points(pts, ctx, part)
+    if sp is None:
+        return "halfspaces: not checked"
+    P, D = sp  # the points scaled by D; T: the vertices scaled by D (X / e)
+    T = [_scaled_test(v, D) for v in V]
+    bits = max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
+    work = _cost(2 * len(P) * len(V), 2 * bits)
+    if work > MAX_EVAL_WORK:
+        ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
+                  f"({bits}-bit numbers) need work {work} > {MAX_EVAL_WORK}")
+        return "halfspaces: not checked"
+    for (X, e), rows, name in zip(T, tight, names):
+        y1, y2 = _edge_directions([], rows, 2)
+        w1, w2 = [-y1[1], y1[0]], [-y2[1], y2[0]]
+        if _dot(w1, y2) > 0:
+            w1 = [-t for t in w1]
+        if _dot(w2, y1) > 0:
+            w2 = [-t for t in w2]
+        c1, c2 = _dot(w1, X), _dot(w2, X)
+        base, down, up = 0, [], []  # always counted; counted for t <= t_p; for t >= t_p
+        for p in P:
+            s1, s2 = e * _dot(w1, p) - c1, e * _dot(w2, p) - c2
+            if s1 >= 0 and s2 >= 0:
+                base += 1
+            elif s1 >= 0:
+                down.append(Fraction(s1, s1 - s2))
+            elif s2 >= 0:
+                up.append(Fraction(s1, s1 - s2))
+        down.sort()
+        up.sort()
+        cuts = sorted({Fraction(0), Fraction(1), *down, *up})
+        for lo, hi in zip(cuts, cuts[1:]):
+            count = base + len(down) - bisect_left(down, hi) + bisect_right(up, lo)
+            if count <= F:
+                t = (lo + hi) / 2
+                w = tuple((1 - t) * a + t * b for a, b in zip(w1, w2))
+                raise Invalid(f"{name} is not in the safe kernel: the closed halfspace "
+                              f"w·(y - {name}) >= 0 with w = {_fmtv(w)} holds only "
+                              f"{count} <= F = {F} points")
+    return "halfspaces (normal fan)"
+
+
 # --------------------------------------------------------------------------- #
 # (c): Tverberg partitions
 # --------------------------------------------------------------------------- #
@@ -768,7 +829,7 @@ def kind_kernel_empty(c: dict, ctx: Any) -> str:
 
 
 def _poly_enumeration(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]],
-                      d: int, V: set[Vec], ctx: Any) -> None:
+                      d: int, V: set[Vec], ctx: Any) -> bool:
     """P = {E·x = f, Fc·x <= g} (integer rows) is bounded and every vertex of P is in V.
 
     Assumes P is pointed (rank of all normals = d, which a listed vertex shows).
@@ -776,7 +837,7 @@ def _poly_enumeration(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], 
     the 1-dimensional null space of rank-(d-1) tight rows: a basis of E plus d-1-r_E
     facet normals.  Vertices: unique solutions of a basis of E plus d-r_E facets that
     satisfy every constraint.  Beyond MAX_POLY_WORK (weighted by bit size) the part is
-    recorded as unchecked."""
+    recorded as unchecked and False returned; True when verified."""
     BE = _basis_with_rhs(E, d)
     rE = len(BE)
     m = len(Fc)
@@ -791,7 +852,7 @@ def _poly_enumeration(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], 
         ctx.trust("vertex enumeration", f"facets: P bounded with every vertex listed: "
                   f"enumerating {subsets} subsets of the {m} facets ({bits}-bit rows) needs "
                   f"work {work} > {MAX_POLY_WORK}")
-        return
+        return False
     if r1 >= 0:
         for sub in combinations(range(m), r1):
             y = _normal([a for a, _ in BE] + [Fc[i][0] for i in sub], d)
@@ -816,6 +877,81 @@ def _poly_enumeration(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], 
         if v not in V:
             raise Invalid(f"P has the vertex {_fmtv(v)} (tight: facets {_fmti(list(sub))} and "
                           f"the equalities), which is not listed in vertices")
+    return True
+
+
+def _primitive(v: list[int]) -> tuple[int, ...]:
+    """The integer vector v divided by the gcd of its entries (same direction)."""
+    g = math.gcd(*v)
+    return tuple(t // g for t in v) if g > 1 else tuple(v)
+
+
+def _edge_directions(BE: list[list[int]], tight: list[list[int]], d: int) -> set[tuple[int, ...]]:
+    """The extreme rays of the tangent cone T = {y : E·y = 0, a·y <= 0 for a in
+    ``tight``} (pointed: the rows have rank d), as primitive integer vectors: the null
+    directions ±y of the basis BE of E plus d − 1 − |BE| tight rows, of rank d − 1, that
+    lie in T (a nonzero y of a pointed cone is extreme iff the rows tight at it have
+    rank d − 1)."""
+    rays: set[tuple[int, ...]] = set()
+    r1 = d - 1 - len(BE)
+    if r1 < 0:
+        return rays
+    for sub in combinations(tight, r1):
+        y = _normal(BE + list(sub), d)
+        if not any(y):
+            continue
+        for ys in (y, [-t for t in y]):
+            if all(_dot(a, ys) <= 0 for a in tight):
+                rays.add(_primitive(ys))
+    return rays
+
+
+def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d: int,
+              V: list[Vec], incidence: list[list[int]], adj: Any, ctx: Any) -> bool:
+    """P = conv(V) from the vertex adjacency (``adjacency[i]``: the vertices joined to
+    V[i] by an edge of P), given V ⊆ P with rank-d tight rows at each v (so the tangent
+    cone T_v = {y : E·y = 0, a·y <= 0 for the facets tight at v} is pointed and generated
+    by its extreme rays, and P ⊆ v + T_v).
+
+    Checked: for every v and every extreme ray y of T_v exactly one listed neighbour w
+    with w − v a positive multiple of y, and no other listed neighbour.  Then for any
+    linear c, walking from v to such a w whenever c·y < 0 strictly decreases c on the
+    finite V and stops at a v* with c >= 0 on T_{v*}, so min_P c = c·v* is attained in
+    V: P is bounded and P = conv(V) (a point of P outside conv(V) would be separated by
+    some c).  Work: the local ray enumeration, sum over v of C(t_v, d − 1 − r_E) ×
+    (c_d + t_v) for t_v tight facets, bit-weighted; beyond MAX_POLY_WORK unchecked
+    (returns False); True when verified."""
+    _array(adj, "adjacency")
+    if len(adj) != len(V):
+        raise Invalid(f"adjacency has {len(adj)} entries, expected one per vertex ({len(V)})")
+    BE = [a for a, _ in _basis_with_rhs(E, d)]
+    r1 = d - 1 - len(BE)
+    bits = _bit_size([a + [b] for a, b in E + Fc])
+    steps = sum(math.comb(len(on), r1) * (_normal_steps(d) + len(on)) if r1 >= 0 else 0
+                for on in incidence)
+    work = _cost(steps, d * bits)
+    if work > MAX_POLY_WORK:
+        ctx.trust("vertex enumeration", f"adjacency: the edges at the {len(V)} vertices "
+                  f"({bits}-bit rows) need work {work} > {MAX_POLY_WORK}")
+        return False
+    for i, (v, on) in enumerate(zip(V, incidence)):
+        rays = _edge_directions(BE, [Fc[j][0] for j in on], d)
+        seen: dict[tuple[int, ...], int] = {}
+        for t, j in enumerate(_array(adj[i], f"adjacency[{i}]")):
+            j = _int(j, f"adjacency[{i}][{t}]", 0, len(V) - 1)
+            u = _primitive(_int_vector(tuple(a - b for a, b in zip(V[j], v))))
+            if u not in rays:
+                raise Invalid(f"adjacency[{i}] lists vertices[{j}], which is not joined to "
+                              f"vertices[{i}] by an edge of P")
+            if u in seen:
+                raise Invalid(f"adjacency[{i}] lists vertices[{seen[u]}] and vertices[{j}] "
+                              "along the same edge of P")
+            seen[u] = j
+        missing = rays - seen.keys()
+        if missing:
+            raise Invalid(f"adjacency[{i}]: no vertex listed along the edge of P at "
+                          f"vertices[{i}] in direction {_fmtv(min(missing))}")
+    return True
 
 
 def _basis_with_rhs(E: list[tuple[list[int], int]], d: int) -> list[tuple[list[int], int]]:
@@ -847,11 +983,12 @@ def _int_vector(v: Vec) -> list[int]:
 
 
 def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], int]],
-                   V: list[Vec], d: int, ctx: Any) -> bool:
+                   V: list[Vec], d: int, ctx: Any) -> list[list[int]] | None:
     """Every v ∈ V satisfies the equalities and facets exactly and the constraints tight
-    at it have rank d (v is a vertex of P).  Costs #V x #constraints products, weighted
-    by bit size; beyond MAX_EVAL_WORK the part is recorded as unchecked and False is
-    returned (the vertex enumeration assumes it)."""
+    at it have rank d (v is a vertex of P); returns, per vertex, the indices of the
+    facets tight at it (the vertex–facet incidence).  Costs #V x #constraints products,
+    weighted by bit size; beyond MAX_EVAL_WORK the part is recorded as unchecked and None
+    is returned (the vertex enumeration and the skeleton rely on it)."""
     SV = [(_int_vector(v), _den_lcm([v])) for v in V]
     bits = max(_bit_size([a + [b] for a, b in Ei + Fi]),
                _bit_size([X + [e] for X, e in SV]))
@@ -860,23 +997,25 @@ def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], in
         ctx.trust("vertex test", f"vertices: each a vertex of P ({len(V)} vertices, "
                   f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work {work} > "
                   f"{MAX_EVAL_WORK}")
-        return False
+        return None
+    incidence: list[list[int]] = []
     for i, ((X, Dv), v) in enumerate(zip(SV, V)):
         for j, (a, f) in enumerate(Ei):
             if _dot(a, X) != f * Dv:
                 raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
-        tight = [a for a, _ in Ei]
+        on: list[int] = []
         for j, (a, g) in enumerate(Fi):
             s = _dot(a, X) - g * Dv
             if s > 0:
                 raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates facets[{j}]")
             if s == 0:
-                tight.append(a)
-        r = _rank(tight)
+                on.append(j)
+        r = _rank([a for a, _ in Ei] + [Fi[j][0] for j in on])
         if r < d:
             raise Invalid(f"vertices[{i}] = {_fmtv(v)} is not a vertex of P: the constraints "
                           f"tight at it have rank {r} < d = {d}")
-    return True
+        incidence.append(on)
+    return incidence
 
 
 def kind_safe_kernel(c: dict, ctx: Any) -> str:
@@ -886,7 +1025,7 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
     vertex of P (tight rows of rank d); P is bounded and all its vertices are in V, so
     P = conv(V); V ⊆ Psi by (b) or (c).  Hence Psi ⊆ P = conv(V) ⊆ Psi."""
     _obj(c, "certificate", _HEAD + ("points", "F", "dim", "vertices", "equalities", "facets",
-                                    "proof"))
+                                    "proof"), ("adjacency",))
     pts, d, F = _problem(c)
     n = len(pts)
     dim = _int(c["dim"], "dim", 0, d)
@@ -913,11 +1052,15 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
     # every vertex lies in P and is a vertex of P; P bounded, vert(P) ⊆ V
     Ei = [_int_constraint(a, b) for a, b in E]
     Fi = [_int_constraint(a, b) for a, b in Fc]
-    if _vertices_of_p(Ei, Fi, V, d, ctx):
-        _poly_enumeration(Ei, Fi, d, set(V), ctx)
-    else:
+    incidence = _vertices_of_p(Ei, Fi, V, d, ctx)
+    if incidence is None:
         ctx.trust("vertex enumeration", "facets: P bounded with every vertex listed: not "
                   "checked (the enumeration relies on the vertex test)")
+        spanned = False
+    elif "adjacency" in c:
+        spanned = _skeleton(Ei, Fi, d, V, incidence, c["adjacency"], ctx)
+    else:
+        spanned = _poly_enumeration(Ei, Fi, d, set(V), ctx)
     _check_dim(V, dim)
     # V ⊆ Psi
     if m == "tverberg":
@@ -928,6 +1071,9 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
         for i, parts in enumerate(vp):
             _tverberg(parts, f"proof.vertex_parts[{i}]", pts, F, V[i], names[i], ctx)
         how = "tverberg"
+    elif spanned and d == dim == 2:
+        how = _polygon_in_kernel(pts, F, V, [[Fi[j][0] for j in on] for on in incidence],
+                                 names, ctx)
     else:
         how = _in_kernel_halfspaces(pts, F, V, names, ctx, "vertices")
     nv = f"{len(V)} vertex" if len(V) == 1 else f"{len(V)} vertices"
