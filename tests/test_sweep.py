@@ -139,6 +139,16 @@ def test_steps_to_consensus_definition():
     ({"base": {"scenarios": {}}}, "unknown tables"),
     ({"run": {"repetitions": 0}}, "repetitions"),
     ({"run": {"seeds": 3}}, "unknown keys"),
+    ({"axes": {"scenario.polcy": ["hold"]}}, r"unknown keys \['polcy'\] in scenario"),
+    ({"base": {"graph": {"generator": "circulant", "degree": 3}}}, "unknown keys"),
+    ({"axes": {"graph.generator": ["circulant", "nosuch"]}},
+     r"unknown generators \['nosuch'\] \(available: ba_robust, directed_growth"),
+    ({"run": {"kind": "robustnes"}}, "kind must be one of consensus, robustness, kernel"),
+    ({"run": {"kind": "robustness"}, "base": {"scenario": {}}}, "unknown tables"),
+    ({"run": {"kind": "robustness"}, "axes": {"scenario.F": [1]}}, "dotted key"),
+    ({"run": {"kind": "kernel"}, "axes": {"kernel.f": [1]}}, r"unknown keys \['f'\]"),
+    ({"run": {"kind": "kernel"}, "axes": {"points.generator": ["cube"]}},
+     "available: gaussian, uniform, sphere"),
 ])
 def test_bad_grid_is_one_line_input_error(grid, match):
     with pytest.raises(InputError, match=match) as exc:
@@ -307,3 +317,213 @@ def test_unreachable_scheduler_is_a_clear_error_within_seconds():
     with pytest.raises(InputError, match="cannot connect"):
         rescon.sweep(GRID8, scheduler=f"tcp://127.0.0.1:{_free_port()}")
     assert time.monotonic() - t0 < 20
+
+
+# ---------------------------------------------------------- generated graphs and states
+
+#: a scenario on a generated graph with seeded uniform initial states
+GENERATED = {"scenario": {"F": 1, "steps": 20, "check_robustness": False, "seed": 5},
+             "graph": {"generator": "ba_robust", "n": 12, "m": 4},
+             "initial": {"random": {"low": [0.0, -1.0], "high": [10.0, 1.0]}},
+             "adversaries": {"0": {"kind": "constant", "value": [50.0, 50.0]}}}
+
+
+def _with(table: str, **changes) -> dict:
+    return {**GENERATED, table: {**GENERATED[table], **changes}}
+
+
+def test_generated_graph_and_random_states_follow_the_seed():
+    from rescon.graphs.generators import ba_robust
+
+    s = Scenario.from_dict(GENERATED)
+    G = ba_robust(12, 4, seed=np.random.default_rng([5, 1]))
+    assert set(s.graph.edges) == set(G.to_directed().edges)
+    assert s.x0.shape == (12, 2)
+    assert (s.x0 >= [0.0, -1.0]).all() and (s.x0 <= [10.0, 1.0]).all()
+    again = Scenario.from_dict(GENERATED)
+    assert again.to_dict() == s.to_dict()
+    other = Scenario.from_dict(_with("scenario", seed=6))
+    assert set(other.graph.edges) != set(s.graph.edges)
+    assert not np.array_equal(other.x0, s.x0)
+    pinned = Scenario.from_dict(_with("graph", seed=5) | {"scenario": {
+        **GENERATED["scenario"], "seed": 6}})
+    assert set(pinned.graph.edges) == set(s.graph.edges)  # graph.seed wins
+    assert Scenario.from_dict(s.to_dict()).to_dict() == s.to_dict()
+    assert rescon.simulate(s, progress=False).final_diameter < 1.0
+
+
+@pytest.mark.parametrize("generator, n, extra, rho", [
+    ("circulant", 12, {"k": 3}, 3), ("two_cliques", 10, {"b": 2}, 2),
+    ("directed_growth", 9, {"k": 2}, 2), ("complete", 6, {}, 3),
+    ("erdos_renyi", 8, {"p": 1.0, "directed": True}, 4),
+    ("random_geometric", 8, {"radius": 2.0, "dim": 3}, 4),
+])
+def test_every_generator_builds_its_graph(generator, n, extra, rho):
+    s = Scenario.from_dict(_with("graph", generator=generator, n=n, **extra) | {
+        "graph": {"generator": generator, "n": n, **extra}})
+    assert s.graph.number_of_nodes() == n
+    assert rescon.robustness(s.graph, progress=False).r_max == rho
+
+
+@pytest.mark.parametrize("graph, match", [
+    ({"generator": "barabasi"}, r"\[graph\]: generator must be one of ba_robust, "
+                                "directed_growth, circulant, two_cliques, erdos_renyi"),
+    ({"generator": "circulant", "n": 10}, "generator 'circulant' needs k"),
+    ({"generator": "circulant", "n": 10, "k": 2, "m": 2},
+     r"\['m'\] are not parameters of generator 'circulant' \(it takes n, k, directed\)"),
+    ({"generator": "erdos_renyi", "n": 10, "p": 1.5}, "p must be a probability"),
+    ({"generator": "two_cliques", "n": 9, "b": 2}, "n must be even"),
+    ({"generator": "ba_robust", "n": 3, "m": 3}, "ba_robust: n must be an integer >= 5"),
+    ({"generator": "circulant", "n": 10, "k": 2, "directed": "yes"}, "directed must be true"),
+    ({"generator": "circulant", "n": 10, "circulant": 2}, "circulant must be a table"),
+    ({"generator": "complete", "n": 5, "undirected": True}, "not parameters"),
+])
+def test_bad_generator_is_one_line_error_naming_the_key(graph, match):
+    with pytest.raises(InputError, match=match) as exc:
+        Scenario.from_dict({**GENERATED, "graph": graph})
+    assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("random, match", [
+    ({"low": 0.0}, "needs low and high"),
+    ({"low": [0.0, 0.0], "high": [1.0, 1.0, 1.0]}, "same length d"),
+    ({"low": 1.0, "high": 0.0}, "finite low <= high"),
+    ({"low": 0.0, "high": 1.0, "d": 0}, "d must be an integer >= 1"),
+    ({"low": 0.0, "high": 1.0, "size": 3}, r"unknown keys \['size'\]"),
+])
+def test_bad_random_states_are_one_line_errors(random, match):
+    with pytest.raises(InputError, match=match) as exc:
+        Scenario.from_dict({**GENERATED, "initial": {"random": random}})
+    assert "\n" not in str(exc.value)
+
+
+# -------------------------------------------------- generator, robustness and kernel grids
+
+#: consensus cells over graph generators (each with its own parameters) and sizes
+GEN = {"base": {"scenario": {"F": 1, "steps": 20, "check_robustness": False},
+                "graph": {"generator": "ba_robust", "n": 12, "ba_robust": {"m": 4},
+                          "circulant": {"k": 4}, "erdos_renyi": {"p": 0.8}},
+                "initial": {"random": {"low": 0.0, "high": 10.0, "d": 2}},
+                "adversaries": {"0": {"kind": "constant", "value": [50.0, 50.0]}}},
+       "axes": {"graph.generator": ["ba_robust", "circulant", "erdos_renyi"],
+                "graph.n": [10, 14]},
+       "run": {"epsilon": 0.01}}
+#: robustness cells: no graph twice (a rho cached by an earlier cell in the same process
+#: makes the method "bounds"), the search forced (the auto race's winner is timing)
+ROB = {"run": {"kind": "robustness"},
+       "base": {"graph": {"generator": "ba_robust", "n": 12, "ba_robust": {"m": 3},
+                          "circulant": {"k": 3}, "erdos_renyi": {"p": 0.5, "directed": True},
+                          "seed": 7},
+                "robustness": {"method": "search"}},
+       "axes": {"graph.generator": ["ba_robust", "circulant", "erdos_renyi"],
+                "graph.n": [9, 13]}}
+#: kernel cells over the three clouds, sizes, dimensions and F (F = 13 >= n fails)
+KER = {"run": {"kind": "kernel"},
+       "base": {"points": {"generator": "gaussian", "n": 12, "d": 2}, "kernel": {"F": 1}},
+       "axes": {"points.generator": ["gaussian", "sphere", "uniform"],
+                "points.n": [8, 13], "points.d": [2, 3], "kernel.F": [1, 2, 13]}}
+ROB_COLUMNS = ("rho", "s_star", "exact", "method", "certificate_valid", "certificate_verdict")
+KER_COLUMNS = ("dim", "is_empty", "n_vertices", "certificate_valid", "certificate_verdict")
+CON_COLUMNS = ("final_diameter", "max_validity", "steps_to_consensus", "blocked_links")
+
+
+@pytest.fixture(scope="module")
+def kinds_out(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("kinds")
+
+
+@pytest.fixture(scope="module")
+def serial_kinds(kinds_out) -> dict[str, pd.DataFrame]:
+    return {name: rescon.sweep(g, workers=0, out=kinds_out / name)
+            for name, g in (("gen", GEN), ("rob", ROB), ("ker", KER))}
+
+
+def test_generator_axes_give_consensus_rows(serial_kinds):
+    t = serial_kinds["gen"]
+    assert len(t) == 6 and (t["status"] == "ok").all(), list(t["error"])
+    assert list(t["graph.n"]) == [10, 14] * 3
+    assert t[list(CON_COLUMNS)].notna().all().all()
+    assert t[[*ROB_COLUMNS, "dim", "is_empty", "n_vertices"]].isna().all().all()
+
+
+def test_robustness_rows_are_exact_and_certified(serial_kinds):
+    from rescon.graphs.named import generate
+
+    t = serial_kinds["rob"]
+    assert (t["status"] == "ok").all(), list(t["error"])
+    assert t["exact"].all() and t["certificate_valid"].all()
+    assert (t["certificate_verdict"] == "valid").all()
+    for _, row in t.iterrows():
+        G = generate({**ROB["base"]["graph"], "generator": row["graph.generator"],
+                      "n": int(row["graph.n"])}, 0)
+        if "rho" in G.graph:  # the structured generators know their rho
+            assert row["rho"] == G.graph["rho"]
+        assert row["rho"] == rescon.robustness(G, progress=False).r_max
+    assert t[list(CON_COLUMNS)].isna().all().all()
+
+
+def test_kernel_rows_and_a_failing_cell(serial_kinds):
+    t = serial_kinds["ker"]
+    bad = t["kernel.F"] == 13
+    assert (t["status"][~bad] == "ok").all(), list(t["error"][~bad])
+    assert (t["status"][bad] == "failed").all()
+    assert t["error"][bad].str.startswith("InputError: F").all()
+    ok = t[~bad]
+    assert (ok["is_empty"] == (ok["dim"] == -1)).all()
+    assert (ok["is_empty"] == (ok["n_vertices"] == 0)).all()
+    helly = ok["points.n"] >= (ok["points.d"] + 1) * ok["kernel.F"] + 1
+    assert not ok["is_empty"][helly].any()  # Helly: non-empty from (d+1)F+1 points on
+    assert (ok["certificate_verdict"] == "valid").all()
+    assert t[list(ROB_COLUMNS[:4])].isna().all().all()
+
+
+def test_every_kind_writes_its_summary_plot(serial_kinds, kinds_out):
+    for name in serial_kinds:
+        assert (kinds_out / name / "summary.png").stat().st_size > 10_000
+
+
+def test_robustness_example_grid():
+    t = rescon.sweep(ROOT / "examples" / "sweeps" / "robustness.toml", workers=0)
+    assert len(t) == 24 and (t["status"] == "ok").all(), list(t["error"])
+    assert t["exact"].all() and (t["certificate_verdict"] == "valid").all()
+
+
+@pytest.fixture(scope="module")
+def local2():
+    """A LocalCluster of 2 worker processes, shared by the tests of this module."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        yield cluster.scheduler_address
+
+
+@pytest.mark.slow
+def test_every_kind_on_two_workers_gives_the_serial_rows(serial_kinds, local2):
+    for name, g in (("gen", GEN), ("rob", ROB), ("ker", KER)):
+        _same_rows(rescon.sweep(g, scheduler=local2), serial_kinds[name])
+
+
+# ---------------------------------------------------------------- progress and bad input
+
+
+def test_progress_bar_on_stderr_only_when_asked(capsys):
+    grid = {"base": GRID8["base"], "axes": {"scenario.policy": ["hold", "zero"]}}
+    rescon.sweep(grid, workers=0, progress=True)
+    out, err = capsys.readouterr()
+    assert out == "" and "sweep" in err and "2/2" in err and "cell" in err
+    rescon.sweep(grid, workers=0, progress=False)
+    assert capsys.readouterr() == ("", "")
+
+
+def test_cli_bad_inputs_are_one_line(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["sweep", str(SMALL), "--workers", "0", "--out", str(f)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "out" in err and "not a directory" in err and "\n" not in err
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[axes]\n"graph.generator" = ["ba"]\n')
+    assert main(["sweep", str(bad), "--workers", "0", "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "unknown generators ['ba']" in err and "\n" not in err
