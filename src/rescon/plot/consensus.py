@@ -149,6 +149,8 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
     shades the zoomed window."""
     t, X = traj.times, traj.states
     step = max(1, len(t) // MARKS)
+    if zoom is not None:
+        _full_scale(ax, traj, p, zoom)
     for n, i in enumerate(traj.benign):
         ax.plot(t, X[:, i, p], color=BENIGN, lw=0.8, alpha=0.9,
                 label="benign agents" if n == 0 else None)
@@ -184,7 +186,6 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
                    label="adversary off the scale (▲ above, ▼ below)")
     if zoom is not None:
         ax.axhspan(*zoom, color="0.5", alpha=0.15, lw=0, zorder=0)
-        _full_scale(ax, traj, p, zoom)
 
 
 def _mark_off_scale(ax: Any, t: np.ndarray, hi_vals: np.ndarray, lo_vals: np.ndarray,
@@ -202,13 +203,15 @@ def _mark_off_scale(ax: Any, t: np.ndarray, hi_vals: np.ndarray, lo_vals: np.nda
 
 
 def _full_scale(ax: Any, traj: Any, p: int, zoom: tuple[float, float]) -> None:
-    """A symmetric log y-scale on the full-range panel when the adversaries reach
-    beyond 10³ times the benign scale (linear below it), so that values up to the float
-    limit still draw."""
-    every = _finite_range(*_adversary_values(traj, p))
+    """Before anything is drawn on the full-range panel: when the adversaries reach
+    beyond 10³ times the benign scale, a symmetric log y-scale (linear up to the benign
+    scale) with fixed limits at the extreme finite values, so that values up to the
+    float limit draw (a linear autoscale would overflow); else the linear autoscale."""
+    every = _finite_range(np.asarray(zoom), *_adversary_values(traj, p))
     scale = max(abs(zoom[0]), abs(zoom[1]), zoom[1] - zoom[0])
-    if every is not None and max(abs(every[0]), abs(every[1])) > 1e3 * scale:
+    if max(abs(every[0]), abs(every[1])) > 1e3 * scale:
         ax.set_yscale("symlog", linthresh=scale)
+        ax.set_ylim(*every)
 
 
 # --------------------------------------------------------------------------- log axes
