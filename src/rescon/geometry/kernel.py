@@ -20,6 +20,7 @@ import numpy as np
 
 from .._validate import check_F, check_points
 from ..errors import EmptyKernel, InputError
+from ._skeleton import vertex_adjacency
 from .emptiness import empty_certificate, empty_from_halfspaces
 from .exact import (
     AffineHull,
@@ -291,6 +292,7 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         return {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(),
                 "F": F, "dim": dim, "vertices": [[fraction_str(v) for v in x] for x in verts],
                 "equalities": halfspaces_json(eqs), "facets": halfspaces_json(constraints),
+                "adjacency": vertex_adjacency(verts, constraints),
                 "proof": {"method": "halfspaces"}}
 
     V = np.array([[float(v) for v in x] for x in verts])
