@@ -359,8 +359,7 @@ def test_generated_graph_and_random_states_follow_the_seed():
     ("random_geometric", 8, {"radius": 2.0, "dim": 3}, 4),
 ])
 def test_every_generator_builds_its_graph(generator, n, extra, rho):
-    s = Scenario.from_dict(_with("graph", generator=generator, n=n, **extra) | {
-        "graph": {"generator": generator, "n": n, **extra}})
+    s = Scenario.from_dict({**GENERATED, "graph": {"generator": generator, "n": n, **extra}})
     assert s.graph.number_of_nodes() == n
     assert rescon.robustness(s.graph, progress=False).r_max == rho
 

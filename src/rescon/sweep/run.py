@@ -36,8 +36,11 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     distance to conv(benign x0)), ``steps_to_consensus`` (first k with diameter(t_k) ≤
     ε·diameter(t_0), ε = [run] epsilon, default 1e-6; null if never),
     ``blocked_links`` (Σ over steps of the links under DoS), ``final_gap`` (RMDO: the
-    optimality gap at the last step), ``seconds`` (wall time of the cell),
-    ``rescon_version``.
+    optimality gap at the last step), then the columns of robustness and kernel cells
+    (``[run] kind``; :mod:`rescon.sweep.cell`: ``rho``, ``s_star``, ``exact``,
+    ``method``, ``certificate_valid``, ``certificate_verdict``, ``dim``, ``is_empty``,
+    ``n_vertices``; null in the rows of another kind), ``seconds`` (wall time of the
+    cell), ``rescon_version``.
 
     scheduler : address of a running Dask scheduler ("tcp://host:8786"); default an
         embedded ``distributed.LocalCluster`` of ``workers`` processes (default: the
