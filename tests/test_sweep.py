@@ -526,3 +526,15 @@ def test_cli_bad_inputs_are_one_line(tmp_path, capsys):
     assert main(["sweep", str(bad), "--workers", "0", "--out", str(tmp_path / "b")]) == 2
     err = capsys.readouterr().err.strip()
     assert "unknown generators ['ba']" in err and "\n" not in err
+
+
+def test_dotted_axis_keys_reach_nested_tables():
+    """As TOML reads a.b.c = v: "graph.circulant.k" sets [graph.circulant] k."""
+    g = read_grid({"base": {"graph": {"generator": "circulant", "n": 10,
+                                      "circulant": {"k": 4, "directed": True}},
+                            "initial": {"random": {"low": 0.0, "high": 1.0}}},
+                   "axes": {"graph.circulant.k": [2, 3], "initial.random.d": [3]}})
+    specs = [c["spec"] for c in g.cells()]
+    assert [s["graph"]["circulant"] for s in specs] == [{"k": 2, "directed": True},
+                                                        {"k": 3, "directed": True}]
+    assert specs[0]["initial"]["random"] == {"low": 0.0, "high": 1.0, "d": 3}
