@@ -116,8 +116,8 @@ def test_one_legend_entry_for_benign_agents_and_one_style_per_adversary():
     assert set(styles) == {"adversary a", "adversary b"}
     a, b = styles.values()
     assert a[0] != b[0] and a[1] != b[1]
-    benign = [ln for ln in ax.get_lines() if ln.get_color() == "tab:blue"]
-    assert len(benign) == 4 and sum(ln.get_label() == "benign agents" for ln in benign) == 1
+    benign = [c for c in ax.collections if c.get_label() == "benign agents"]
+    assert len(benign) == 1 and len(benign[0].get_segments()) == 4  # one artist, N curves
 
 
 def test_initial_states_marked_x_benign_and_o_adversarial():

@@ -100,9 +100,13 @@ class Trajectory:
         return p
 
     def plot(self, path: str | Path | None = None, *, log_diameter: bool = True) -> Any:
-        """x(1), x(2), ... against t (benign blue, adversaries red, as the paper's
-        Figs. 3–4) and the diameter (log scale); for an RMDO run also the global cost
-        and its change rate (Figs. 6–7). Returns the matplotlib Figure."""
+        """x(1), x(2), ... against t (benign agents blue, one legend entry; initial
+        states × benign, ○ adversarial; each adversary its own style; a two-faced one
+        as the band of what it sent, from ``sent``; a panel whose adversaries would
+        flatten the benign curves zooms on them, with a full-range panel below) and the
+        diameter (log scale, exact zeros marked at a floor); for an RMDO run also the
+        global cost and its change rate (the paper's Figs. 3–4, 6–7; see
+        :func:`rescon.plot.consensus.plot_trajectory`). Returns the matplotlib Figure."""
         from ..plot.consensus import plot_trajectory
 
         return plot_trajectory(self, path=path, log_diameter=log_diameter)

@@ -151,9 +151,11 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
     step = max(1, len(t) // MARKS)
     if zoom is not None:
         _full_scale(ax, traj, p, zoom)
-    for n, i in enumerate(traj.benign):
-        ax.plot(t, X[:, i, p], color=BENIGN, lw=0.8, alpha=0.9,
-                label="benign agents" if n == 0 else None)
+    from matplotlib.collections import LineCollection
+
+    curves = np.stack(np.broadcast_arrays(t[:, None], X[:, traj.benign, p]), axis=-1)
+    ax.add_collection(LineCollection(curves.transpose(1, 0, 2), colors=BENIGN, lw=0.8,
+                                     alpha=0.9, label="benign agents"))
     ax.scatter(np.full(len(traj.benign), t[0]), X[0, traj.benign, p], marker="x",
                color=BENIGN, s=28, lw=1.2, zorder=4, label="x_i(0), benign")
     for j, i in enumerate(traj.adversary_rows):
@@ -209,9 +211,17 @@ def _full_scale(ax: Any, traj: Any, p: int, zoom: tuple[float, float]) -> None:
     float limit draw (a linear autoscale would overflow); else the linear autoscale."""
     every = _finite_range(np.asarray(zoom), *_adversary_values(traj, p))
     scale = max(abs(zoom[0]), abs(zoom[1]), zoom[1] - zoom[0])
-    if max(abs(every[0]), abs(every[1])) > 1e3 * scale:
+    top = max(abs(every[0]), abs(every[1]))
+    if top > 1e3 * scale:
+        from matplotlib.ticker import FixedLocator
+
         ax.set_yscale("symlog", linthresh=scale)
         ax.set_ylim(*every)
+        exps = np.unique(np.linspace(math.ceil(math.log10(scale)), math.floor(math.log10(top)),
+                                     4).round())
+        ticks = [s * 10.0 ** e for s in (-1, 1) for e in exps if every[0] <= s * 10.0 ** e
+                 <= every[1]]
+        ax.yaxis.set_major_locator(FixedLocator(ticks))
 
 
 # --------------------------------------------------------------------------- log axes
