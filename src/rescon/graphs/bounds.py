@@ -16,6 +16,8 @@ format of certificates/FORMAT.md:
 
 from __future__ import annotations
 
+import random
+import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import lru_cache
@@ -30,6 +32,8 @@ __all__ = [
     "Pair",
     "pair_value",
     "pair_cost",
+    "descend_pair",
+    "descended_pairs",
     "violates",
     "upper_witness",
     "source_components_witness",
@@ -191,6 +195,70 @@ def s_candidates(ig: IndexedGraph, r: int, *, starts: int | None = None) -> list
             if cost is not None:
                 found[pair] = cost
     return sorted(found, key=lambda p: (found[p], len(p.S1)))
+
+
+def _mask_cost(inmask: list[int], S: int, r: int) -> int | None:
+    """|reach_r(S)| for a bitmask S, or None when S is empty or fully r-reachable."""
+    reach = size = 0
+    rest = S
+    while rest:
+        low = rest & -rest
+        rest ^= low
+        size += 1
+        reach += (inmask[low.bit_length() - 1] & ~S).bit_count() >= r
+    return reach if reach < size else None
+
+
+def _masks_cost(inmask: list[int], A: int, B: int, r: int) -> int | None:
+    """The pair cost (as :func:`pair_cost`) of bitmasks A, B (None if not a valid pair)."""
+    a = _mask_cost(inmask, A, r)
+    b = None if a is None else _mask_cost(inmask, B, r)
+    return None if b is None else a + b
+
+
+def descend_pair(ig: IndexedGraph, r: int, A: int, B: int) -> tuple[int, int, int] | None:
+    """Steepest descent on the pair cost from bitmasks (A, B): each step moves one node
+    into A, into B or out of both, taking the cheapest strictly improving move.
+    Returns (cost, A, B) at a local minimum, or None when (A, B) is not a valid pair."""
+    inmask = ig.in_masks()
+    cur = _masks_cost(inmask, A, B, r)
+    if cur is None:
+        return None
+    while True:
+        best = (cur, A, B)
+        for v in range(ig.n):
+            bit = 1 << v
+            a0, b0 = A & ~bit, B & ~bit
+            for a, b in ((a0 | bit, b0), (a0, b0 | bit), (a0, b0)):
+                c = _masks_cost(inmask, a, b, r)
+                if c is not None and c < best[0]:
+                    best = (c, a, b)
+        if best[0] == cur:
+            return cur, A, B
+        cur, A, B = best
+
+
+def descended_pairs(ig: IndexedGraph, r: int, *, starts: int = 40, seed: int = 0,
+                    deadline: float | None = None) -> list[Pair]:
+    """Local minima of the pair cost (:func:`descend_pair`) from ``starts`` random
+    bisections that are valid pairs (seeded, so reproducible; at most 50·``starts``
+    draws), stopping at ``deadline`` (perf_counter); every returned pair's cost bounds
+    s*(r) from above."""
+    rng = random.Random(seed)
+    full = (1 << ig.n) - 1
+    found: list[Pair] = []
+    for _ in range(50 * starts):
+        if len(found) == starts or (deadline is not None and time.perf_counter() > deadline):
+            break
+        A = rng.getrandbits(ig.n) & full
+        out = descend_pair(ig, r, A, full ^ A)
+        if out is not None:
+            found.append(Pair(_set(out[1]), _set(out[2])))
+    return found
+
+
+def _set(mask: int) -> frozenset[int]:
+    return frozenset(i for i in range(mask.bit_length()) if (mask >> i) & 1)
 
 
 def upper_witness(ig: IndexedGraph, *, starts: int | None = None) -> tuple[int, Pair]:

@@ -51,7 +51,11 @@ def implied_s(n: int, r: int, r2: int, s2: int) -> int:
 
 
 def implied_proof(r: int, s: int, r2: int, s2: int, proof: Proof) -> Proof:
-    """``proof`` of (r2, s2)-robustness as a proof of (r, s) (wrapped unless equal)."""
+    """``proof`` of (r2, s2)-robustness as a proof of (r, s) (wrapped unless equal; an
+    implied proof is unwrapped first: the implication is transitive, since
+    s ≤ s2 + r2 − r ≤ s3 + r3 − r2 + r2 − r)."""
+    if proof.get("method") == "implied":
+        r2, s2, proof = proof["r"], proof["s"], proof["proof"]
     if (r, s) == (r2, s2):
         return proof
     return {"method": "implied", "r": r2, "s": s2, "proof": proof}

@@ -11,20 +11,27 @@ construction proofs below); only when they do not meet, an exact method: the
 bitmask branch and bound (n ≤ 64, its search tree is the certificate) raced against
 the improved MILP for ρ; for s*, the subset DP (n ≤ 22), else the charged-set branch
 and bound raced against the MILP (n ≤ 64), else the MILP.
+
+Before any search, every fact already proven about the same graph in this process
+(facts.py: a bounded cache keyed by node labels and edges) is used through the
+implication (r', s')-robust ⇒ (r, s)-robust for r ≤ r', s ≤ s' + r' − r (so
+s*(r) ≥ s*(ρ) + ρ − r), and every known violating pair refutes (r'', s'') above it.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Hashable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from .._progress import progress_bar
 from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
+from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
 from .milp import MilpOutcome, RobustnessMilp, milp_min_cost
 from .search import (
@@ -212,11 +219,42 @@ def _decide_r(
     deadline: float | None,
     seeds: list[list[int]],
     known_pair: tuple[int, bd.Pair] | None = None,
-    on_progress: Callable[[float], None] | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
 ) -> _Decision:
-    """Is ig r-robust? Bounds first, then the exact ``method``."""
+    """Is ig r-robust? The cached facts first (an implied proof, or a known pair of
+    cost 0 at threshold r), then :func:`_decide_r_fresh`; the answer is cached."""
     if r > (ig.n + 1) // 2:
         return _Decision(False, pair=_half_pair(ig))
+    facts = facts_for(ig)
+    known = facts.lower(r)
+    if known is not None:
+        return _Decision(True, proof=implied_proof(r, 1, r, known[0], known[1]))
+    refuted = facts.upper(r)
+    if refuted is not None and refuted[0] == 0:
+        return _Decision(False, pair=refuted[1])
+    dec = _decide_r_fresh(ig, r, method, deadline, seeds, known_pair, on_progress)
+    _remember(facts, r, 1, dec)
+    return dec
+
+
+def _remember(facts: Facts, r: int, s: int, dec: _Decision) -> None:
+    """Cache a decision of (r, s)-robustness (nothing when the time limit cut it)."""
+    if dec.holds and dec.proof is not None:
+        facts.add_proof(r, s, dec.proof)
+    elif dec.holds is False:
+        facts.add_pair(dec.pair)
+
+
+def _decide_r_fresh(
+    ig: IndexedGraph,
+    r: int,
+    method: str,
+    deadline: float | None,
+    seeds: list[list[int]],
+    known_pair: tuple[int, bd.Pair] | None,
+    on_progress: Callable[[float, int], None] | None,
+) -> _Decision:
+    """Is ig r-robust (r ≤ ⌈n/2⌉)? Bounds first, then the exact ``method``."""
     _check_method_size(method, ig.n)
     proof = _cheap_proof(ig, r, 1, seeds, seed_search=True, deadline=deadline)
     if proof is not None:
@@ -265,7 +303,7 @@ def _milp_decision(ig: IndexedGraph, r: int, out: MilpOutcome) -> _Decision:
 
 
 def _race(ig: IndexedGraph, r: int, deadline: float | None,
-          on_progress: Callable[[float], None] | None) -> _Decision:
+          on_progress: Callable[[float, int], None] | None) -> _Decision:
     """The search and the MILP race, one core each; the first answer wins.
 
     The search wins on sparse and mid-density graphs (and its tree is a checkable
@@ -326,8 +364,35 @@ def _s_star(
     seeds: list[list[int]],
     r_proof: Proof,
     candidates: list[bd.Pair],
+    *,
+    cap: int | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
 ) -> _SStar:
-    """s*(r) for an r-robust graph (r ≥ 1), ``r_proof`` proving (r, 1)-robustness."""
+    """s*(r) for an r-robust graph (r ≥ 1), ``r_proof`` proving (r, 1)-robustness; with
+    ``cap``, min(s*(r), cap) (enough to decide (r, cap)-robustness). The result's proof
+    and pair are added to the cached facts."""
+    facts = facts_for(ig)
+    ss = _s_star_fresh(ig, r, method, deadline, seeds, r_proof, candidates + facts.pairs,
+                       facts.lower(r), cap, on_progress)
+    if ss.proof is not None:
+        facts.add_proof(r, ss.lower, ss.proof)
+    facts.add_pair(ss.pair)
+    return ss
+
+
+def _s_star_fresh(
+    ig: IndexedGraph,
+    r: int,
+    method: str,
+    deadline: float | None,
+    seeds: list[list[int]],
+    r_proof: Proof,
+    candidates: list[bd.Pair],
+    known: tuple[int, Proof] | None,
+    cap: int | None,
+    on_progress: Callable[[float, int], None] | None,
+) -> _SStar:
+    """:func:`_s_star` given the facts: ``known`` = (s, proof of (r, s)-robustness)."""
     n = ig.n
     all_s = _cheap_proof(ig, r, n, seeds)
     if all_s is not None:
@@ -338,13 +403,22 @@ def _s_star(
         cost = bd.pair_cost(ig, cand, r)
         if cost is not None and cost < upper:
             upper, pair = cost, cand
-    # lower: the r-robustness proof itself (s = 1), or a construction with r + s − 1
+    # lower: the r-robustness proof itself (s = 1), a construction with r + s − 1,
+    # or what the facts imply
     lower, proof = 1, r_proof
     for s in range(upper, 1, -1):
         con = bd.construction_proof(ig, r, s, seeds=seeds)
         if con is not None:
             lower, proof = s, con
             break
+    if known is not None and known[0] > lower:
+        lower, proof = min(known[0], upper), implied_proof(r, min(known[0], upper), r, *known)
+    if lower < upper and (cap is None or cap > lower):
+        upper, pair = _descended_upper(ig, r, upper, pair, deadline)
+    if cap is not None and cap < upper:
+        if lower >= cap:
+            return _SStar(cap, cap, cap, implied_proof(r, cap, r, lower, proof), None, "bounds")
+        upper, pair = cap, None
     if lower >= upper:
         return _SStar(upper, upper, upper, proof, pair, "bounds")
     _check_method_size(method, n)
@@ -352,7 +426,7 @@ def _s_star(
         if n <= DP_AUTO_NODES and (deadline is None or _remaining(deadline) > 1.0):
             method = "dp"
         elif n <= MAX_SEARCH_NODES:
-            return _race_s(ig, r, lower, upper, proof, pair, deadline)
+            return _race_s(ig, r, lower, upper, proof, pair, deadline, on_progress)
         else:
             method = "milp"
     if method == "dp":
@@ -361,10 +435,26 @@ def _s_star(
             return _SStar(n, n, n, {"method": "dp"}, None, "dp")
         return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
     if method == "search":
-        found = min_cost_pair(ig, r, upper, lower=lower, deadline=deadline)
+        found = _deepening_search(ig, r, lower, upper, deadline, on_progress=on_progress)
         return _cost_search_result(ig, r, found, lower, upper, proof, pair)
     return _milp_s_result(ig, r, _milp_s(ig, r, lower, upper, deadline).outcome(), lower, upper,
                           proof, pair)
+
+
+DESCENT_SECONDS = 0.25  # budget of the local search for cheap pairs (bounds.descended_pairs)
+
+
+def _descended_upper(ig: IndexedGraph, r: int, upper: int, pair: bd.Pair | None,
+                     deadline: float | None) -> tuple[int, bd.Pair | None]:
+    """The cheapest of (upper, pair) and the local-search pairs: a tight upper bound
+    makes every exact s* search prune from its first node."""
+    stop = time.perf_counter() + DESCENT_SECONDS
+    stop = stop if deadline is None else min(stop, deadline)
+    for cand in bd.descended_pairs(ig, r, deadline=stop):
+        cost = bd.pair_cost(ig, cand, r)
+        if cost is not None and cost < upper:
+            upper, pair = cost, cand
+    return upper, pair
 
 
 def _milp_s(ig: IndexedGraph, r: int, lower: int, upper: int,
@@ -407,14 +497,41 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
     return _SStar(upper, upper, upper, search_proof, pair, "search")
 
 
+DEEPEN_CHEAP_SECONDS = 0.1
+
+
+def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
+                      deadline: float | None, *, should_stop: Callable[[], bool] | None = None,
+                      on_progress: Callable[[float, int], None] | None = None) -> CostOutcome:
+    """The charged-set branch and bound below growing caps (at most ``upper``): a search
+    below a small cap prunes hard, and one that finds no pair proves s*(r) ≥ cap, so the
+    search below a weak heuristic ``upper`` runs only when nothing cheaper exists. The
+    step from lower to cap doubles while rounds are cheap (< ``DEEPEN_CHEAP_SECONDS``)
+    and falls back to 1 after an expensive one: the search cost grows steeply with the
+    cap, and a pair of cost = lower ends a search early. Exact: the last search is exact
+    below its cap, and every earlier one proved that nothing is cheaper than its cap."""
+    step, nodes = 1, 0
+    while True:
+        cap = min(lower + step, upper)
+        t0 = time.perf_counter()
+        out = min_cost_pair(ig, r, cap, lower=lower, deadline=deadline, should_stop=should_stop,
+                            on_progress=on_progress)
+        nodes += out.nodes
+        if out.status == "stopped" or out.pair is not None or cap == upper:
+            return replace(out, nodes=nodes, best=out.best if out.pair is not None else upper)
+        cheap = time.perf_counter() - t0 < DEEPEN_CHEAP_SECONDS
+        lower, step = cap, 2 * step if cheap else 1
+
+
 def _race_s(ig: IndexedGraph, r: int, lower: int, upper: int, proof: Proof,
-            pair: bd.Pair | None, deadline: float | None) -> _SStar:
-    """The s*(r) branch and bound and the MILP race, one core each."""
+            pair: bd.Pair | None, deadline: float | None,
+            on_progress: Callable[[float, int], None] | None = None) -> _SStar:
+    """The s*(r) branch and bound (deepening) and the MILP race, one core each."""
     milp = _milp_s(ig, r, lower, upper, deadline)
     milp.start()
     try:
-        out = min_cost_pair(ig, r, upper, lower=lower, deadline=deadline,
-                            should_stop=lambda: not milp.running())
+        out = _deepening_search(ig, r, lower, upper, deadline,
+                                should_stop=lambda: not milp.running(), on_progress=on_progress)
     except BaseException:
         milp.cancel()
         raise
@@ -500,20 +617,27 @@ def robustness(
     else:
         seeds = bd.greedy_cliques(ig)
         up_value, up_pair = bd.upper_witness(ig)
+    facts = facts_for(ig)
+    for known_pair in facts.pairs:
+        if bd.pair_value(ig, known_pair) < up_value:
+            up_value, up_pair = bd.pair_value(ig, known_pair), known_pair
     r_upper, r_upper_pair = (half, None) if up_value >= half else (up_value, up_pair)
-    # lower bound: the best cheap proof at or below r_upper
+    # lower bound: the best cached or cheap proof at or below r_upper
     r_lower, lower = 0, {"method": "trivial"}
     for r in range(r_upper, 0, -1):
-        proof = _cheap_proof(ig, r, 1, seeds)
+        known = facts.lower(r)
+        proof = implied_proof(r, 1, r, *known) if known else _cheap_proof(ig, r, 1, seeds)
         if proof is not None:
             r_lower, lower = r, proof
+            facts.add_proof(r, 1, proof)
             break
     used = "bounds"
-    bar = _progress_bar(progress, n)
+    bar = _Phases(progress, n)
     candidates = [up_pair]
     while r_lower < r_upper:
+        bar.phase(f"ρ search (r={r_upper})")
         dec = _decide_r(ig, r_upper, method, deadline, seeds,
-                        known_pair=(up_value, up_pair), on_progress=bar)
+                        known_pair=(up_value, up_pair), on_progress=bar.update)
         used = dec.method
         if dec.holds is None:
             break
@@ -526,10 +650,10 @@ def robustness(
             r_upper_pair = dec.pair
             r_upper = bd.pair_value(ig, dec.pair)
             up_value, up_pair = r_upper, dec.pair
-    if bar is not None:
-        bar(None)
+    facts.add_pair(r_upper_pair)
     exact = r_lower == r_upper
     if not exact:
+        bar.close()
         cert = {**_head("robustness", ig), "exact": False, "r_lower": r_lower,
                 "r_upper": r_upper, "lower": lower, "upper_r": _upper_json(r_upper_pair)}
         return RobustnessReport(n, None, None, _labels(ig, r_upper_pair), None,
@@ -539,7 +663,10 @@ def robustness(
     if rho == 0:
         ss = _SStar(n, n, n, {"method": "trivial"}, None, "bounds")
     else:
-        ss = _s_star(ig, rho, method, deadline, seeds, lower, candidates)
+        bar.phase(f"s* search (r={rho})")
+        ss = _s_star(ig, rho, method, deadline, seeds, lower, candidates,
+                     on_progress=bar.update)
+    bar.close()
     if ss.method != "bounds":
         used = ss.method if used == "bounds" else f"{used}+{ss.method}"
     if ss.value is None:
@@ -593,16 +720,41 @@ def is_rs_robust(
             dec = _Decision(True, proof={"method": "trivial"})
         else:
             assert dec.proof is not None
-            ss = _s_star_of_robust(ig, r, method, deadline, seeds, dec.proof)
-            if ss.value is None and ss.lower < s <= ss.upper:
-                dec = _Decision(None, method=ss.method)
-            elif ss.lower >= s:
-                proof = ss.proof if ss.lower == s else {
-                    "method": "implied", "r": r, "s": ss.lower, "proof": ss.proof}
-                dec = _Decision(True, proof=proof, method=ss.method)
-            else:
-                dec = _Decision(False, pair=ss.pair, method=ss.method)
+            dec = _decide_rs(ig, r, s, method, deadline, seeds, dec.proof)
     return _check_result(ig, r, s, dec, time.perf_counter() - t0)
+
+
+IMPLIED_SEARCH_SECONDS = 1.0  # budget for proving (r + s − 1)-robustness first
+
+
+def _decide_rs(ig: IndexedGraph, r: int, s: int, method: str, deadline: float | None,
+               seeds: list[list[int]], r_proof: Proof) -> _Decision:
+    """(r, s)-robust, for r-robust ig (r ≥ 1, s ≥ 2)? In this order: the cached facts
+    (implications, known pairs), (r + s − 1)-robustness (⇒ (r, s), facts.py; decided
+    within ``IMPLIED_SEARCH_SECONDS``), then the exact min(s*(r), s)."""
+    facts = facts_for(ig)
+    known = facts.lower(r)
+    if known is not None and known[0] >= s:
+        return _Decision(True, proof=implied_proof(r, s, r, *known))
+    refuted = facts.upper(r)
+    if refuted is not None and refuted[0] < s:
+        return _Decision(False, pair=refuted[1])
+    if r + s - 1 <= (ig.n + 1) // 2:
+        stop = time.perf_counter() + IMPLIED_SEARCH_SECONDS
+        strong = _decide_r(ig, r + s - 1, method, stop if deadline is None else
+                           min(stop, deadline), seeds)
+        if strong.holds:
+            assert strong.proof is not None
+            return _Decision(True, proof=implied_proof(r, s, r + s - 1, 1, strong.proof),
+                             method=strong.method)
+    ss = _s_star(ig, r, method, deadline, seeds, r_proof, [bd.upper_witness(ig)[1]], cap=s)
+    if ss.lower >= s:
+        assert ss.proof is not None
+        return _Decision(True, proof=implied_proof(r, s, r, ss.lower, ss.proof),
+                         method=ss.method)
+    if ss.value is None and ss.upper >= s:
+        return _Decision(None, method=ss.method)
+    return _Decision(False, pair=ss.pair, method=ss.method)
 
 
 def _check_result(ig: IndexedGraph, r: int, s: int, dec: _Decision,
@@ -675,23 +827,29 @@ def _s_star_of_robust(ig: IndexedGraph, r: int, method: str, deadline: float | N
     return _s_star(ig, r, method, deadline, seeds, r_proof, [up_pair])
 
 
-def _progress_bar(enabled: bool | None, n: int) -> Callable[[float | None], None] | None:
-    """A tqdm bar over the refuted share of the search space (TTY only by default)."""
-    import sys
+class _Phases:
+    """One progress bar (stderr; see rescon._progress) over the phases of
+    :func:`robustness`: its description names the phase (bounds → ρ search (r = …) →
+    s* search (r = …)), its count the refuted share of the current search space in ‰,
+    and its postfix the search nodes explored so far in that phase."""
 
-    if enabled is None:
-        enabled = sys.stderr.isatty()
-    if not enabled:
-        return None
-    from tqdm import tqdm
+    def __init__(self, enabled: bool | None, n: int) -> None:
+        self.n = n
+        self.bar = progress_bar(enabled, 1000, f"robustness (n={n}): bounds", unit="‰")
 
-    bar = tqdm(total=1000, desc=f"robustness search (n={n})", leave=False, unit="‰")
+    def phase(self, name: str) -> None:
+        """Start phase ``name`` (the count restarts at 0)."""
+        if self.bar is not None:
+            self.bar.set_description_str(f"robustness (n={self.n}): {name}", refresh=False)
+            self.bar.n = 0
+            self.bar.set_postfix_str("", refresh=True)
 
-    def update(fraction: float | None) -> None:
-        if fraction is None:
-            bar.close()
-            return
-        bar.n = min(int(fraction * 1000), 1000)
-        bar.refresh()
+    def update(self, fraction: float, nodes: int) -> None:
+        """The current search has refuted ``fraction`` of its space in ``nodes`` nodes."""
+        if self.bar is not None:
+            self.bar.n = min(int(fraction * 1000), 1000)
+            self.bar.set_postfix_str(f"{nodes:,} nodes", refresh=True)
 
-    return update
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()

@@ -98,7 +98,7 @@ def decide_r_robust(
     *,
     record: bool = True,
     deadline: float | None = None,
-    on_progress: Callable[[float], None] | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> SearchOutcome:
     """Decide whether ``ig`` is r-robust, exactly.
@@ -110,7 +110,8 @@ def decide_r_robust(
     record : keep the search tree as a certificate (dropped if it exceeds
         ``MAX_TREE_TOKENS`` tokens; the answer stays exact).
     deadline : ``time.perf_counter()`` value after which the search stops.
-    on_progress : called with the refuted share of the search space.
+    on_progress : called with the refuted share of the search space and the number
+        of search nodes so far.
     should_stop : polled between slices; True abandons the search ("stopped"),
         e.g. when a racing MILP has answered.
     """
@@ -137,7 +138,7 @@ def decide_r_robust(
                 tokens = grown
             continue
         if on_progress is not None:
-            on_progress(float(progress[0]))
+            on_progress(float(progress[0]), int(state[K.ST_NODES]))
         if status != K.RUNNING:
             break
         if (deadline is not None and time.perf_counter() > deadline) or (
@@ -174,13 +175,14 @@ def min_cost_pair(
     lower: int = 0,
     deadline: float | None = None,
     should_stop: Callable[[], bool] | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
 ) -> CostOutcome:
     """s*(r) = min |reach_r(S1)| + |reach_r(S2)| over pairs whose sets both keep an
     r-closed member, searched below ``upper`` (a known pair's cost, or n); the search
     ends early when it finds a pair of cost ``lower`` (a proven lower bound).
 
     Exact branch and bound over S1 with charged members (see
-    ``_kernels.min_cost_step``); n ≤ 64.
+    ``_kernels.min_cost_step``); n ≤ 64. ``on_progress`` as in :func:`decide_r_robust`.
     """
     K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
@@ -194,6 +196,8 @@ def min_cost_pair(
     while True:
         K.min_cost_step(inmask, outmask, order, r, lower, stack, depth, state, ubuf, _SLICE,
                         progress)
+        if on_progress is not None:
+            on_progress(float(progress[0]), int(state[K.CS_NODES]))
         if state[K.CS_STATUS] != K.RUNNING:
             break
         if (deadline is not None and time.perf_counter() > deadline) or (
