@@ -487,6 +487,25 @@ def test_robustness_example_grid():
     assert t["exact"].all() and (t["certificate_verdict"] == "valid").all()
 
 
+def test_generated_example_grid():
+    t = rescon.sweep(ROOT / "examples" / "sweeps" / "generated.toml", workers=0)
+    assert len(t) == 18 and (t["status"] == "ok").all(), list(t["error"])
+    assert (t["max_validity"] == 0).all()  # no residual: the benign hull is kept
+    assert set(t["graph.generator"]) == {"ba_robust", "circulant", "random_geometric"}
+
+
+def test_cli_simulates_a_scenario_file_with_a_generated_graph(tmp_path, capsys):
+    import json
+
+    p = tmp_path / "gen.toml"
+    p.write_text('[scenario]\nF = 1\nsteps = 10\nseed = 4\n\n[graph]\n'
+                 'generator = "circulant"\nn = 10\n\n[graph.circulant]\nk = 3\n\n'
+                 '[initial.random]\nlow = [0.0, 0.0]\nhigh = [10.0, 10.0]\n')
+    assert main(["simulate", str(p), "--json", "--quiet"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["N"] == 10 and res["d"] == 2 and res["final_diameter"] < 1
+
+
 @pytest.fixture(scope="module")
 def local2():
     """A LocalCluster of 2 worker processes, shared by the tests of this module."""
