@@ -321,6 +321,6 @@ def _figure_legend(fig: Any, axes: Any) -> None:
             seen.setdefault(label, handle)
     legend = fig.legend(list(seen.values()), list(seen), loc="upper center", fontsize=7,
                         ncol=min(LEGEND_COLUMNS, len(seen)), frameon=False,
-                        bbox_to_anchor=(0.5, 1.0 - 0.3 / fig.get_figheight()))
+                        bbox_to_anchor=(0.5, 1.0 - 0.36 / fig.get_figheight()))
     box = legend.get_window_extent(fig.canvas.get_renderer())
     fig.tight_layout(rect=(0, 0, 1, fig.transFigure.inverted().transform(box.p0)[1]))
