@@ -622,11 +622,13 @@ def robustness(
         if bd.pair_value(ig, known_pair) < up_value:
             up_value, up_pair = bd.pair_value(ig, known_pair), known_pair
     r_upper, r_upper_pair = (half, None) if up_value >= half else (up_value, up_pair)
-    # lower bound: the best cached or cheap proof at or below r_upper
+    # lower bound: the best cheap or cached proof at or below r_upper
     r_lower, lower = 0, {"method": "trivial"}
     for r in range(r_upper, 0, -1):
         known = facts.lower(r)
-        proof = implied_proof(r, 1, r, *known) if known else _cheap_proof(ig, r, 1, seeds)
+        proof = _cheap_proof(ig, r, 1, seeds)
+        if proof is None and known is not None:
+            proof = implied_proof(r, 1, r, *known)
         if proof is not None:
             r_lower, lower = r, proof
             facts.add_proof(r, 1, proof)
