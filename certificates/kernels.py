@@ -600,65 +600,148 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
     return "halfspaces"
 
 
-def _polygon_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[int]]],
-                       names: list[str], ctx: Any) -> str:
-    """P = conv(V) ⊆ Psi for a polygon P (d = dim = 2, vert(P) = V already proved;
-    ``tight[i]``: the integer normals of the facets tight at V[i]), by the normal fan:
+def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[int]]],
+                   names: list[str], ctx: Any) -> str:
+    """P = conv(V) ⊆ Psi for a full-dimensional polytope P in d = 2 or 3 (vert(P) = V
+    already proved; ``tight[i]``: the integer normals of the facets tight at V[i]), by
+    the normal fan:
 
         P ⊆ Psi  iff  for every vertex v and every w ≠ 0 in the normal cone N_v of P
                       at v, the closed halfspace {y : w·(y − v) >= 0} holds >= F + 1 points.
 
     (If x ∈ P has depth <= F, a closed halfspace {a·y >= a·x} holds <= F points; a vertex
     v maximising a over P has a ∈ N_v and {a·y >= a·v} is inside it.  Conversely a
-    vertex failing the test has depth <= F.)  N_v is the cone of w1 ⊥ y1, w2 ⊥ y2 (the
-    two edge directions y of P at v, w_k·y_other < 0); on w = (1 − t) w1 + t w2,
-    t ∈ [0, 1], a point p with s_k = w_k·(p − v) is counted for all t (s1, s2 >= 0), for
-    none (both < 0), for t <= t_p or for t >= t_p (t_p = s1 / (s1 − s2)), so the count is
-    constant between consecutive t_p and its minimum is taken on one of these open
-    intervals (at a breakpoint it is at least that of a neighbouring interval).  Work:
-    2 n products per vertex and a sort of the breakpoints, bit-weighted; beyond
-    MAX_EVAL_WORK the part is unchecked."""
-    part = "vertices in the safe kernel (proof 'halfspaces', normal fan of the polygon)"
+    vertex failing the test has depth <= F.)  N_v = cone(tight normals) is pointed and
+    full-dimensional, and the count is smallest on an open cell of int N_v cut by the
+    planes (p − v)^⊥ (at a boundary point it is at least that of a nearby cell).
+    d = 2: N_v is the arc between w1 ⊥ y1 and w2 ⊥ y2 (the edge directions y of P at v),
+    one sweep (:func:`_arc_min`).  d = 3: a point p with a·(p − v) >= 0 for every tight
+    normal a is counted on every cell, one with all < 0 on none; the circles (p − v)^⊥
+    of the others ("crossing" points) cut int N_v, and every cell has a side on one of
+    them: for each crossing p, sweep the arc (p − v)^⊥ ∩ N_v; the cell beside a piece of
+    it holds the points positive there, and of the points q with q − v ∥ p − v those on
+    the side chosen (min over the two sides).  Work: n·d products per vertex plus K²
+    per vertex with K crossing points, bit-weighted; beyond MAX_EVAL_WORK unchecked."""
+    part = "vertices in the safe kernel (proof 'halfspaces', normal fan)"
     sp = _scaled_points(pts, ctx, part)
     if sp is None:
         return "halfspaces: not checked"
     P, D = sp  # the points scaled by D; T: the vertices scaled by D (X / e)
+    d = len(P[0])
     T = [_scaled_test(v, D) for v in V]
-    bits = max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
-    work = _cost(2 * len(P) * len(V), 2 * bits)
-    if work > MAX_EVAL_WORK:
-        ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
-                  f"({bits}-bit numbers) need work {work} > {MAX_EVAL_WORK}")
-        return "halfspaces: not checked"
+    bits = 2 * max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
+    spent = 0
     for (X, e), rows, name in zip(T, tight, names):
-        y1, y2 = _edge_directions([], rows, 2)
-        w1, w2 = [-y1[1], y1[0]], [-y2[1], y2[0]]
-        if _dot(w1, y2) > 0:
-            w1 = [-t for t in w1]
-        if _dot(w2, y1) > 0:
-            w2 = [-t for t in w2]
-        c1, c2 = _dot(w1, X), _dot(w2, X)
-        base, down, up = 0, [], []  # always counted; counted for t <= t_p; for t >= t_p
-        for p in P:
-            s1, s2 = e * _dot(w1, p) - c1, e * _dot(w2, p) - c2
-            if s1 >= 0 and s2 >= 0:
-                base += 1
-            elif s1 >= 0:
-                down.append(Fraction(s1, s1 - s2))
-            elif s2 >= 0:
-                up.append(Fraction(s1, s1 - s2))
-        down.sort()
-        up.sort()
-        cuts = sorted({Fraction(0), Fraction(1), *down, *up})
-        for lo, hi in zip(cuts, cuts[1:]):
-            count = base + len(down) - bisect_left(down, hi) + bisect_right(up, lo)
-            if count <= F:
-                t = (lo + hi) / 2
-                w = tuple((1 - t) * a + t * b for a, b in zip(w1, w2))
-                raise Invalid(f"{name} is not in the safe kernel: the closed halfspace "
-                              f"w·(y - {name}) >= 0 with w = {_fmtv(w)} holds only "
-                              f"{count} <= F = {F} points")
+        dv = [[e * t - x for t, x in zip(p, X)] for p in P]  # e·D·(p − v)
+        if d == 2:
+            y1, y2 = _edge_directions([], rows, 2)
+            w1, w2 = _inward_normal(y1, y2), _inward_normal(y2, y1)
+            pairs = [(_dot(w1, u), _dot(w2, u)) for u in dv if any(u)]
+            count, tau = _arc_min(pairs)
+            count += len(dv) - len(pairs)  # points at v
+            w = tuple((1 - tau) * a + tau * b for a, b in zip(w1, w2))
+            spent += _cost(2 * len(P), bits)
+        else:
+            count, w, work = _cone3_min(dv, rows)
+            spent += _cost(work, 2 * bits)
+        if spent > MAX_EVAL_WORK:
+            ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
+                      f"({bits // 2}-bit numbers) need work > {MAX_EVAL_WORK}")
+            return "halfspaces: not checked"
+        if count <= F:
+            raise Invalid(f"{name} is not in the safe kernel: its Tukey depth is at most "
+                          f"{count} <= F = {F} (the closed halfspaces w·(y - {name}) >= 0 "
+                          f"for w near {_fmtv(w)}, in the normal cone of P there, hold "
+                          f"{count} points)")
     return "halfspaces (normal fan)"
+
+
+def _inward_normal(y: tuple[int, ...], other: tuple[int, ...]) -> list[int]:
+    """The w ⊥ y (in R^2) with w·other < 0: an extreme ray of the normal cone of the
+    tangent cone cone(y, other)."""
+    w = [-y[1], y[0]]
+    return [-t for t in w] if _dot(w, other) > 0 else w
+
+
+def _arc_min(pairs: list[tuple[int, int]]) -> tuple[int, Fraction]:
+    """(min count, a tau of it) over the open intervals of (0, 1) between breakpoints of
+    #{(s1, s2) : (1 − tau)·s1 + tau·s2 > 0}, for pairs not both 0: counted on all of
+    (0, 1) when s1, s2 >= 0, on none when both <= 0, else for tau below (s1 > 0 > s2)
+    or above (s1 < 0 < s2) t = s1 / (s1 − s2)."""
+    base, down, up = 0, [], []
+    for s1, s2 in pairs:
+        if s1 >= 0 and s2 >= 0:
+            base += 1
+        elif s1 > 0 > s2:
+            down.append(Fraction(s1, s1 - s2))
+        elif s1 < 0 < s2:
+            up.append(Fraction(s1, s1 - s2))
+    down.sort()
+    up.sort()
+    cuts = sorted({Fraction(0), Fraction(1), *down, *up})
+    best = None
+    for lo, hi in zip(cuts, cuts[1:]):
+        count = base + len(down) - bisect_left(down, hi) + bisect_right(up, lo)
+        if best is None or count < best[0]:
+            best = (count, (lo + hi) / 2)
+    assert best is not None
+    return best
+
+
+def _cone3_min(dv: list[list[int]], normals: list[list[int]]
+               ) -> tuple[int, tuple[Fraction, ...], int]:
+    """(min count over the open cells of int N_v, a direction near the smallest cell,
+    work) for d = 3, N_v = cone(normals), dv = the points minus v (scaled): see
+    :func:`_fan_in_kernel`."""
+    base = 0
+    crossing: list[list[int]] = []
+    for u in dv:
+        s = [_dot(a, u) for a in normals]
+        if min(s) >= 0:
+            base += 1
+        elif max(s) > 0:
+            crossing.append(u)
+    work = len(dv) * len(normals)
+    if not crossing:
+        return base, tuple(Fraction(sum(col)) for col in zip(*normals)), work
+    best: tuple[int, tuple[Fraction, ...]] | None = None
+    for u in crossing:
+        e1, e2 = _arc_ends(u, normals)
+        pairs, same, opposite = [], 0, 0
+        for q in crossing:
+            s1, s2 = _dot(e1, q), _dot(e2, q)
+            if s1 or s2:
+                pairs.append((s1, s2))
+            elif _dot(u, q) > 0:
+                same += 1
+            else:
+                opposite += 1
+        count, tau = _arc_min(pairs)
+        count += base + min(same, opposite)
+        if best is None or count < best[0]:
+            best = (count, tuple((1 - tau) * a + tau * b for a, b in zip(e1, e2)))
+        work += 2 * len(crossing) + len(normals) ** 2
+    assert best is not None
+    return best[0], best[1], work
+
+
+def _arc_ends(u: list[int], normals: list[list[int]]) -> tuple[list[int], list[int]]:
+    """The two extreme rays of the 2-dimensional cone N ∩ u^⊥, N = cone(normals) pointed
+    and u^⊥ through its interior: N ∩ u^⊥ is generated by the normals a with a·u = 0 and
+    (−a_j·u)·a_i + (a_i·u)·a_j for a_i·u > 0 > a_j·u; its extreme rays e1, e2 are the
+    generators with every other one on the side of e1 where the orientation
+    u·(e1 × g) >= 0, resp. u·(g × e2) >= 0."""
+    s = [_dot(a, u) for a in normals]
+    gens = [a for a, t in zip(normals, s) if t == 0]
+    gens += [[-sj * x + si * y for x, y in zip(ai, aj)]
+             for ai, si in zip(normals, s) if si > 0 for aj, sj in zip(normals, s) if sj < 0]
+
+    def orient(g: list[int], h: list[int]) -> int:
+        return _det([u, g, h])
+
+    e1 = next(g for g in gens if all(orient(g, h) >= 0 for h in gens))
+    e2 = next(g for g in gens if all(orient(h, g) >= 0 for h in gens))
+    return e1, e2
 
 
 # --------------------------------------------------------------------------- #
@@ -1071,9 +1154,9 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
         for i, parts in enumerate(vp):
             _tverberg(parts, f"proof.vertex_parts[{i}]", pts, F, V[i], names[i], ctx)
         how = "tverberg"
-    elif spanned and d == dim == 2:
-        how = _polygon_in_kernel(pts, F, V, [[Fi[j][0] for j in on] for on in incidence],
-                                 names, ctx)
+    elif spanned and d == dim and d in (2, 3):
+        how = _fan_in_kernel(pts, F, V, [[Fi[j][0] for j in on] for on in incidence],
+                             names, ctx)
     else:
         how = _in_kernel_halfspaces(pts, F, V, names, ctx, "vertices")
     nv = f"{len(V)} vertex" if len(V) == 1 else f"{len(V)} vertices"

@@ -719,8 +719,7 @@ TAMPER = {
         square_kernel, _do(_set(["vertices"], copy.deepcopy(SQUARE)), _set(["dim"], 2),
                            _set(["facets"], [{"a": [-1, 0], "b": 0}, {"a": [0, -1], "b": 0},
                                              {"a": [1, 0], "b": 1}, {"a": [0, 1], "b": 1}])),
-        "is not in the safe kernel: the closed halfspace w·(y - vertices[0]) >= 0 with "
-        "w = (-1/2, -1/2) holds only 1 <= F = 1 points"),
+        "vertices[0] is not in the safe kernel: its Tukey depth is at most 1 <= F = 1"),
     "kernel: missing vertex": (triangle_hull, _del(["vertices", 2]), "not listed in vertices"),
     "kernel: non-vertex listed": (
         triangle_hull, _append(["vertices"], [1, 0]), "is not a vertex of P"),
