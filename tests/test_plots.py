@@ -7,6 +7,8 @@ from __future__ import annotations
 import networkx as nx
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("matplotlib")
 
@@ -99,7 +101,8 @@ def test_log_floor_is_a_decade_below_the_smallest_positive_value():
     assert log_floor([5.0, 2e-15, 0.0]) == pytest.approx(1e-16)
     assert log_floor([5.0, 1e-3], [0.0, 7e-300]) == pytest.approx(1e-301)
     assert log_floor([5.0, 1e-3]) is None  # no zero: the axis autoscales
-    assert log_floor([0.0, 0.0]) == np.finfo(float).eps
+    assert log_floor([0.0, 0.0]) == pytest.approx(1e-16)
+    assert log_floor([0.0, 5e-324]) == 5e-324  # no power of ten below it
 
 
 # --------------------------------------------------------------------------- states
@@ -244,3 +247,22 @@ def test_kernel_plot_3d_of_a_planar_kernel_is_one_polygon():
     faces = [c for c in ax.collections if c.get_label().startswith("safe kernel")]
     assert len(faces) == 1 and len(faces[0].get_paths()) == 1
     assert ax.get_zlabel() == "x₃"
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(min_value=0.0, max_value=1e300, allow_subnormal=True)
+                | st.sampled_from([0.0, 5e-324, 1e-310]), min_size=1, max_size=20))
+def test_log_floor_property(values):
+    """With a zero shown, the floor is > 0 and a power of ten at least a decade below
+    every positive value (unless that is deep in the subnormals); without one, None."""
+    from rescon.plot.consensus import log_floor
+
+    floor = log_floor(values)
+    positive = [v for v in values if v > 0]
+    if 0.0 not in values:
+        assert floor is None
+        return
+    assert floor > 0
+    if all(v > 1e-300 for v in positive):
+        assert all(floor <= v / 10 for v in positive)
+        assert np.isclose(np.log10(floor), round(np.log10(floor)))

@@ -230,16 +230,16 @@ def _full_scale(ax: Any, traj: Any, p: int, zoom: tuple[float, float]) -> None:
 def log_floor(*series: Any) -> float | None:
     """The lower limit of a log axis showing ``series`` when one of them reaches an
     exact 0: a power of ten at least one decade below the smallest positive finite
-    value m (10^(⌊log₁₀ m⌋ − 1) ≤ m/10), or ε (2.2e-16) when no value is positive; None
-    when no value is 0 (the axis may autoscale)."""
+    value m (10^(⌊log₁₀ m⌋ − 1) ≤ m/10), or 1e-16 (the power of ten below the machine
+    ε) when no value is positive; never below the smallest positive float (m deep in
+    the subnormals); None when no value is 0 (the axis may autoscale)."""
     vals = np.concatenate([np.ravel(np.asarray(s, dtype=float)) for s in series])
     vals = vals[np.isfinite(vals)]
     if not np.any(vals == 0.0):
         return None
     pos = vals[vals > 0.0]
-    if not pos.size:
-        return float(np.finfo(float).eps)
-    return 10.0 ** (math.floor(math.log10(float(pos.min()))) - 1)
+    m = float(pos.min()) if pos.size else 10.0 * np.finfo(float).eps
+    return max(10.0 ** (math.floor(math.log10(m)) - 1), float(np.nextafter(0.0, 1.0)))
 
 
 def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str | None = None,
@@ -261,7 +261,7 @@ def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str
                    color=line.get_color(), zorder=5, clip_on=False,
                    label=None if zero_label in ax.get_legend_handles_labels()[1]
                    else zero_label)
-    ax.set_ylim(bottom=floor / 2)
+    ax.set_ylim(bottom=floor / 2 or floor)
     return line
 
 

@@ -43,17 +43,18 @@ def _faces(K: Any) -> list[np.ndarray]:
 
 def _equal_aspect(ax: Any, X: np.ndarray) -> None:
     """One unit is as long on every axis (3-D: the box aspect follows the data's extents,
-    every extent at least 1 % of the largest so a flat cloud stays visible)."""
+    every extent at least 1 % of the largest so a flat cloud stays visible, and 5 %
+    margins on each side)."""
     if X.shape[1] == 2:
         ax.set_aspect("equal", adjustable="datalim")
         return
     lo, hi = X.min(axis=0), X.max(axis=0)
     span = hi - lo
     span = np.maximum(span, 0.01 * span.max()) if span.max() > 0 else np.ones(3)
-    mid = (lo + hi) / 2
-    ax.set_xlim(mid[0] - span[0] / 2, mid[0] + span[0] / 2)
-    ax.set_ylim(mid[1] - span[1] / 2, mid[1] + span[1] / 2)
-    ax.set_zlim(mid[2] - span[2] / 2, mid[2] + span[2] / 2)
+    mid, half = (lo + hi) / 2, 0.55 * span
+    ax.set_xlim(mid[0] - half[0], mid[0] + half[0])
+    ax.set_ylim(mid[1] - half[1], mid[1] + half[1])
+    ax.set_zlim(mid[2] - half[2], mid[2] + half[2])
     ax.set_box_aspect(tuple(span / span.max()))
     from matplotlib.ticker import MaxNLocator
 
