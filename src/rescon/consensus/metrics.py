@@ -60,23 +60,38 @@ def spread(states: np.ndarray) -> np.ndarray:
 def diameter(states: np.ndarray) -> float:
     """Largest Euclidean distance between two rows of ``states`` (n, d).
 
+    The rows are first scaled by a power of two 2^-e so that max |x| ∈ [1/2, 1) (when
+    that is exact: no entry becomes subnormal), which changes no rounding: the answer is
+    2^e times the plain n² formula on the scaled rows, and that formula neither
+    overflows (rows at 1e300) nor underflows (rows at 1e-300); each distance is then
+    within (d + 2)u of its exact value.
+
     Only rows that can end a diameter are compared with every row: for any point c
     (here the float mean) and R = max_j ‖x_j − c‖, a row p has max_j ‖p − x_j‖ ≤
     ‖p − c‖ + R, so p ends no diameter when ‖p − c‖ + R < L for a lower bound L (the
     distances from the row farthest from c). Both ends of a diameter pass that test;
     the float test gets a relative slack 4(d + 2)u, far above the rounding of its
-    norms, and is skipped (every row kept) when squares could overflow or underflow.
-    The kept pairs are computed as the plain n² formula would, so the answer is the
-    same float, in O(n·kept) instead of O(n²)."""
+    norms (each ‖x − c‖ is computed from exact-rounded differences). When R ≤ 1e-100
+    after scaling (the rows agree to 100 digits: converged states) or a row is not
+    finite, the distinct rows are compared pairwise. Memory O(n·d) (pairs in blocks);
+    time O(n·kept)."""
     X = np.asarray(states, dtype=float)
-    keep = np.ones(len(X), dtype=bool)
-    if len(X) > 2 and np.isfinite(X).all():
+    if len(X) < 2:
+        return _pairwise_max(X, X)
+    scale = 0
+    if np.isfinite(X).all():
+        scale = int(np.frexp(np.abs(X).max())[1])
+        if not np.array_equal(np.ldexp(np.ldexp(X, -scale), scale), X):
+            scale = 0  # subnormal entries would lose bits
+        X = np.ldexp(X, -scale)
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             r = np.sqrt(((X - X.mean(axis=0)) ** 2).sum(axis=1))
             if 1e-100 < r.max() < 1e100:
                 far = np.sqrt(((X - X[np.argmax(r)]) ** 2).sum(axis=1)).max()
                 keep = r + r.max() >= far * (1 - 4 * (X.shape[1] + 2) * UNIT_ROUNDOFF)
-    return _pairwise_max(X[keep], X)
+                return math.ldexp(_pairwise_max(X[keep], X), scale)
+    distinct = np.unique(X, axis=0)
+    return math.ldexp(_pairwise_max(distinct, distinct), scale)
 
 
 def _pairwise_max(P: np.ndarray, X: np.ndarray, chunk: int = 256) -> float:
@@ -110,9 +125,9 @@ class ValidityMonitor:
             return 0.0
         y, _ = self.hull.point("project", target=x)
         v = x - y
-        with np.errstate(over="ignore"):
-            dist = float(np.linalg.norm(v))
-        return dist if math.isfinite(dist) else math.hypot(*v)  # squares overflowed
+        if 1e-150 <= np.abs(v).max() <= 1e150:  # no square over- or underflows
+            return float(np.linalg.norm(v))
+        return math.hypot(*v)  # scaled: 1e-162 no longer gives 0, 1e300 no longer inf
 
     def surely_inside(self, states: np.ndarray) -> np.ndarray:
         """Rows of ``states`` (n, d) that a float filter proves inside the hull (False:
@@ -209,7 +224,7 @@ def _proposed_rows(X: np.ndarray) -> np.ndarray:
     d > 3. X is first put on its principal axes, each scaled to unit width (an affine
     map keeps the vertices): a thin or flat X (an axis of width ~0) becomes a fat one,
     axes of width exactly 0 are dropped; Qhull's own degeneracy failure is retried
-    joggled ("QJ")."""
+    joggled ("QJ"), then every row is proposed."""
     n, d = X.shape
     if n <= PROPOSE_MIN or d > 3:
         return np.arange(n)
@@ -223,10 +238,12 @@ def _proposed_rows(X: np.ndarray) -> np.ndarray:
         return np.unique([0, *(np.argmin(Z, axis=0)), *(np.argmax(Z, axis=0))])
     from scipy.spatial import ConvexHull, QhullError
 
-    try:
-        return np.sort(ConvexHull(Z).vertices)
-    except QhullError:
-        return np.sort(ConvexHull(Z, qhull_options="QJ").vertices)
+    for options in (None, "QJ"):
+        try:
+            return np.sort(ConvexHull(Z, qhull_options=options).vertices)
+        except QhullError:
+            continue
+    return np.arange(n)  # too few points for Qhull
 
 
 def _slacks(A: np.ndarray, b: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
