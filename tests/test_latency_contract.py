@@ -8,10 +8,15 @@ import added anywhere on the path fails it.
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
+from math import comb
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import rescon
 
@@ -72,3 +77,79 @@ def test_submodules_stay_reachable_as_attributes():
     out = subprocess.run([sys.executable, "-c", "import rescon; print(rescon.__version__)"],
                          capture_output=True, text=True, timeout=60, check=True).stdout
     assert json.dumps(out.strip()) == json.dumps(rescon.__version__)
+
+
+# --------------------------------------------------------------- small inputs, no numba
+
+def test_small_kernel_from_the_cli_loads_no_numba(tmp_path):
+    """``rescon kernel`` on 12 points: nothing compiled, nothing of numba imported."""
+    pts = tmp_path / "p.csv"
+    pts.write_text("\n".join(f"{math.cos(t):.6f},{math.sin(2 * t):.6f}"
+                             for t in range(12)) + "\n")
+    mods = _loaded("from rescon.cli import main\nimport contextlib, io\n"
+                   f"with contextlib.redirect_stdout(io.StringIO()):\n"
+                   f"    assert main(['kernel', {str(pts)!r}, '--F', '2']) == 0")
+    assert [m for m in _heavy(mods) if m.split(".")[0] in ("numba", "llvmlite")
+            or m in COMPILED] == []
+
+
+def _scan_inputs(k, m, kind, seed):
+    rng = np.random.default_rng(seed)
+    Y = rng.normal(size=(m, k))
+    if kind == 1:  # ties: many points exactly on candidate hyperplanes
+        Y = np.round(Y * 2) / 2
+    elif kind == 2:  # tiny magnitudes: the underflow term decides
+        Y = Y * 1e-300
+    elif kind == 3:  # repeated points and a degenerate coordinate
+        if k > 1:
+            Y[:, 0] = Y[:, 1]
+        Y[1] = Y[0]
+    return Y, rng.integers(1, 3, size=m)
+
+
+@settings(max_examples=60, deadline=None)
+@given(k=st.integers(1, 5), extra=st.integers(1, 8), kind=st.integers(0, 3),
+       seed=st.integers(0, 2**32 - 1), F=st.integers(0, 8), exact=st.booleans())
+def test_numpy_scan_decides_as_the_numba_scan(k, extra, kind, seed, F, exact):
+    """Same cofactors, same degenerate flags, and every count compared with F the same
+    (the numba scan stops a subset early, so only counts ≤ F must be equal)."""
+    from rescon.geometry import _candidates, _scan_np
+    from rescon.geometry.halfspaces import _permutations
+
+    m = k + extra
+    Y, W = _scan_inputs(k, m, kind, seed)
+    subsets = _scan_np.k_subsets(m, k)
+    assert np.array_equal(subsets, _candidates.k_subsets(m, k, comb(m, k)))
+    perms, signs = _permutations(k - 1)
+    c_err, floor = (0.0, 0.0) if exact else (1e-15, 1e-300)
+    a = _candidates.classify(Y, W.astype(np.int64), subsets, perms, signs, c_err, F, floor)
+    b = _scan_np.classify(Y, W, subsets, perms, signs, c_err, F, floor)
+    assert np.array_equal(a[3], b[3])
+    assert np.array_equal(a[4], b[4]) and np.array_equal(a[5], b[5])
+    plus_a, minus_a, unc_a = a[:3]
+    plus_b, minus_b, unc_b = b[:3]
+    for x, y in ((plus_a, plus_b), (minus_a, minus_b), (plus_a + unc_a, plus_b + unc_b),
+                 (minus_a + unc_a, minus_b + unc_b)):
+        assert np.array_equal(x <= F, y <= F)
+        assert np.array_equal(x[x <= F], y[x <= F])
+
+
+@pytest.mark.parametrize("d, n, F, scale", [(2, 12, 2, 1.0), (2, 9, 1, 1e-200),
+                                            (3, 10, 1, 1.0), (3, 9, 1, 1e150),
+                                            (4, 8, 1, 1.0)])
+def test_small_kernels_equal_the_numba_path(monkeypatch, d, n, F, scale):
+    """The small path (numpy scan, integer side counts) gives the very same kernel as
+    the numba path: the same facets, vertices and certificate."""
+    from rescon.geometry import halfspaces
+    from rescon.geometry.kernel import safe_kernel
+
+    X = np.random.default_rng(n + d).normal(size=(n, d)) * scale
+    X[-1] = X[0] + (X[1] - X[0]) * 0.5  # a point on a segment: exact ties
+    small = safe_kernel(X, F)
+    monkeypatch.setattr(halfspaces, "SMALL_SCAN", -1)
+    big = safe_kernel(X, F)
+    assert small.is_empty == big.is_empty and small.dim == big.dim
+    assert np.array_equal(small.A, big.A) and np.array_equal(small.b, big.b)
+    assert np.array_equal(small.vertices, big.vertices)
+    assert json.dumps(small.certificate, sort_keys=True) == json.dumps(big.certificate,
+                                                                       sort_keys=True)

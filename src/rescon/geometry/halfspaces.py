@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
+from fractions import Fraction
 from math import comb, factorial, gcd
 from typing import Any
 
@@ -36,6 +37,11 @@ SWEEP_MIN_POINTS = 150
 #: float cofactors with |C|₁ below this fraction of their permanent are replaced by the
 #: rounded exact normal (their relative error would exceed ~1e-12)
 ILL_CONDITIONED = 1e-3
+#: up to this many point tests (:func:`candidate_cost`) the candidates are classified
+#: by numpy (:mod:`._scan_np`, the same decisions) and the undecided ones in Python
+#: integers: numba's start-up — ~0.5 s warm, ~10 s compiling on a cold cache — would
+#: dominate such inputs (a 12-point kernel in the plane needs 660 tests)
+SMALL_SCAN = 20_000
 
 
 @dataclass
@@ -208,11 +214,14 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
 
     Raises InputError when the enumeration would exceed MAX_CANDIDATE_COST.
     """
-    from ._candidates import ANGLE_ERR, classify, k_subsets, sweep_pairs_2d
-    from ._expansions import in_range, normals3
-
     m, k = Y.shape
     count = comb(m, k)
+    small = candidate_cost(m, k) <= SMALL_SCAN  # no numba (the same sets, see SMALL_SCAN)
+    if small:
+        from ._scan_np import classify, in_range, k_subsets
+    else:
+        from ._candidates import ANGLE_ERR, classify, k_subsets
+        from ._expansions import in_range
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     # k = 1: the sign of a float difference is exact — of exact floats
     exact_floats = exact_view and (k == 1 or bits <= _exact_float_bits(k))
@@ -220,7 +229,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
     # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
     # window is exactly on the line
-    sweep = k == 2 and m >= SWEEP_MIN_POINTS and exact_view
+    sweep = k == 2 and m >= SWEEP_MIN_POINTS and exact_view and not small
     separated = sweep and exact_floats and 16 * ANGLE_ERR * 2 * max(
         max(col) - min(col) for col in zip(*Yi)) ** 2 < 1
     sweep = sweep and (separated or not exact_floats)  # else the direct scan decides
@@ -233,8 +242,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     # k + 1 of them underflows either
     floor = 0.0 if exact_floats else underflow_floor(k, float(np.abs(Y).max()))
     expansions = exact_view and in_range(Y)
-    subsets = k_subsets(m, k, count)
+    subsets = k_subsets(m, k) if small else k_subsets(m, k, count)
     if sweep:
+        from ._candidates import sweep_pairs_2d
+
         plus, minus, unc, degenerate, cof, cof_abs = sweep_pairs_2d(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
         if separated:
@@ -253,7 +264,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     sure_p, sure_m = np.flatnonzero(sure_plus), np.flatnonzero(sure_minus)
     maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
     n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F,
-                                                    expansions)  # exactly
+                                                    expansions and not small)  # exactly
     add_p = ~dependent & (n_plus <= F) & ~sure_plus[maybe]
     add_m = ~dependent & (n_minus <= F) & ~sure_minus[maybe]
     idx = np.concatenate([sure_p, sure_m, maybe[add_p], maybe[add_m]])
@@ -274,9 +285,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         af_abs = af_abs * (1.1 * c_err / c_new)
         c_err = c_new
         if len(ill):
-            exact = np.empty((len(ill), 3))
-            normals3(np.ascontiguousarray(Y, dtype=np.float64), through[ill], exact)
-            af[ill] = exact * sign[ill, None]
+            af[ill] = _exact_normals3(Y, through[ill], small) * sign[ill, None]
             af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
     if exact_only:
         af, af_abs, c_err = _rounded_normals(Yi, through, sign)
@@ -296,6 +305,27 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
                         b_abs[keep], out[keep], c_err, box)
     return hs
+
+
+def _exact_normals3(Y: np.ndarray, triples: np.ndarray, small: bool) -> np.ndarray:
+    """The normals (p_j − p_i) × (p_k − p_i) of the triples (i, j, k) of rows of Y, each
+    component its exact value rounded: by numba expansions (within 3 ulps), or for
+    small inputs in Fractions (correctly rounded; Y's entries are exact binary
+    fractions)."""
+    if not small:
+        from ._expansions import normals3
+
+        out = np.empty((len(triples), 3))
+        normals3(np.ascontiguousarray(Y, dtype=np.float64), triples, out)
+        return out
+    rows = []
+    for i, j, k in triples.tolist():
+        p, u, w = ([Fraction(v) for v in Y[r]] for r in (i, j, k))
+        a = [x - y for x, y in zip(u, p, strict=True)]
+        b = [x - y for x, y in zip(w, p, strict=True)]
+        rows.append([float(a[1] * b[2] - a[2] * b[1]), float(a[2] * b[0] - a[0] * b[2]),
+                     float(a[0] * b[1] - a[1] * b[0])])
+    return np.array(rows, dtype=np.float64).reshape(-1, 3)
 
 
 def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
@@ -331,13 +361,13 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
     through each subset (those above F may be lower bounds), and whether the subset is
     affinely dependent: by floating-point expansions in numba for k ≤ 3 when
     ``expansions`` (Y exact and in their range), else in integers."""
-    from ._expansions import side_counts
-
     k = Y.shape[1]
     plus = np.zeros(len(subsets), dtype=np.int64)
     minus = np.zeros(len(subsets), dtype=np.int64)
     dependent = np.zeros(len(subsets), dtype=np.bool_)
     if k in (2, 3) and expansions:
+        from ._expansions import side_counts
+
         side_counts(np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64),
                     np.ascontiguousarray(subsets), F, plus, minus, dependent)
         return plus, minus, dependent
