@@ -23,14 +23,14 @@ from numba import njit, prange
 
 from .._rounding import MIN_NORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
+from ._scan_np import HUGE, TINY
 
 #: Dekker's splitter for doubles: 2^27 + 1
 _SPLITTER = 134217729.0
 #: what :func:`side_of_meet` returns for parallel lines
 PARALLEL = 2
-#: nonzero |coordinates| must lie in [TINY, HUGE] for the predicates here to be exact:
-#: then products of up to four differences neither underflow nor overflow
-TINY, HUGE = 2.0**-120, 2.0**120
+#: nonzero |coordinates| must lie in [TINY, HUGE] for the predicates here to be exact
+#: (defined with the numpy twins of :mod:`._scan_np`, which check the same range)
 
 
 @njit(cache=True, nogil=True)
