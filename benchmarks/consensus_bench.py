@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import platform
 import time
 import warnings
@@ -93,6 +94,59 @@ def run(quick: bool) -> list[dict]:
                          "engine_steps_per_s": eng, "naive_steps_per_s": naive,
                          "ratio": ratio, "target": target, "met": met})
         rows.extend(long_runs(quick))
+        rows.extend(scale_runs(quick))
+    return rows
+
+
+#: issue 13 §1 (N, d, steps): every monitor on, target >= 2 steps/s (the whole call:
+#: scenario set-up, the certified benign hull, every step's metrics)
+SCALE_RUNS = [(10000, 2, 10), (1000, 3, 10)]
+
+
+def check_monitors(N: int, d: int, steps: int) -> None:
+    """The answer first: on a run of N agents (the mean baseline: the adversary pulls
+    states out of the benign hull, so distances outside it are compared too), the
+    validity distances equal those of the monitor built from every benign initial state
+    (the exact hull of all of them, the code before issue 13) and each step's diameter
+    is the n² formula's float."""
+    from unittest import mock
+
+    from rescon.consensus import metrics
+
+    sc = dataclasses.replace(case(N, d, 1, steps), algorithm="mean",
+                             adversaries={0: Constant([50.0] * d)})
+    tr = simulate(sc)
+    if not tr.metrics["validity"].max() > 0:
+        raise AssertionError("the check run never left the benign hull")
+    with mock.patch.object(metrics, "_proposed_rows", lambda X: np.arange(len(X))):
+        ref = simulate(sc)
+    if not np.array_equal(tr.metrics["validity_per_agent"], ref.metrics["validity_per_agent"]):
+        raise AssertionError(f"validity differs from the all-states hull (N={N}, d={d})")
+    for k, X in enumerate(tr.states[:, tr.benign]):
+        diff = X[:, None, :] - X[None, :, :]
+        if tr.metrics["diameter"][k] != np.sqrt((diff**2).sum(axis=2)).max():
+            raise AssertionError(f"diameter differs from the n² formula (N={N}, step {k})")
+
+
+def scale_runs(quick: bool) -> list[dict]:
+    """Each SCALE_RUNS case timed after its answer is checked (:func:`check_monitors` on
+    N = 300 in the same family); met if >= 2 steps/s with every monitor on and the
+    states stayed in the benign hull. The 1-minute load average is recorded."""
+    import os
+
+    rows = []
+    for N, d, steps in SCALE_RUNS:
+        check_monitors(300, d, 5)
+        steps = 4 if quick else steps
+        sc = case(N, d, 1, steps)
+        load = os.getloadavg()[0]
+        sec, tr = timed(lambda sc=sc: simulate(sc))
+        ok = float(tr.metrics["validity"].max()) == 0.0
+        rows.append({"case": f"scale: N={N}, d={d}, F=1, every monitor", "steps": steps,
+                     "engine_s": sec, "engine_steps_per_s": steps / sec,
+                     "naive_steps_per_s": None, "ratio": None,
+                     "target": ">= 2 steps/s", "met": ok and steps / sec >= 2,
+                     "load1": load})
     return rows
 
 
@@ -156,7 +210,13 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
         ("- Naive = per-agent loop with one fresh CVXPY subset QP per kernel "
          "(benchmarks/consensus_naive.py), run for 1 step."),
         ("- Long runs: d = 3 as the states converge (they crashed with LinAlgError "
-         "before issue 10); met = finished with max validity <= 1e-9.")], rows, out)
+         "before issue 10); met = finished with max validity <= 1e-9."),
+        ("- Scale (issue 13 §1): the whole `simulate` call (set-up, certified benign "
+         "hull, every monitor) per step; checked first against the all-states hull and "
+         "the n² diameter on N = 300; 1-minute load average of the shared 2-core "
+         "machine at each start (csv `load1`): "
+         + ", ".join(f"{r['load1']:.1f}" for r in rows if "load1" in r) + ".")],
+        rows, out)
 
 
 def bench_main(name: str, doc: str, run, write, argv: list[str] | None) -> int:
