@@ -320,3 +320,12 @@ def test_states_near_the_float_limit_do_not_overflow(centre):
     assert np.isfinite(traj.states).all()
     assert traj.states[-1, 0, 0] > 9e307
     assert np.isfinite(traj.max_validity) and traj.max_validity > 1.4e308
+
+
+def test_trajectory_repr_is_one_line_summary():
+    """The repr printed arrays of 200 × 12 × 2 states (unreadable in a REPL)."""
+    traj = rescon.simulate(rescon.Scenario.paper_example(steps=10))
+    text = repr(traj)
+    assert "\n" not in text and "array" not in text
+    assert text.startswith("Trajectory(steps=10, N=12, d=2, benign=10, final_diameter=")
+    assert "max_validity=0," in text

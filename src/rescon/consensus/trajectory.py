@@ -56,6 +56,17 @@ class Trajectory:
     def final_diameter(self) -> float:
         return float(self.metrics["diameter"][-1])
 
+    def __repr__(self) -> str:
+        """A one-line summary (the arrays are in the attributes, not in the repr)."""
+        K, N, d = self.states.shape
+        shown = [f"steps={max(K - 1, 0)}", f"N={N}", f"d={d}", f"benign={len(self.benign)}"]
+        diameter, validity = self.metrics.get("diameter"), self.metrics.get("validity")
+        if diameter is not None and np.size(diameter):
+            shown.append(f"final_diameter={float(diameter[-1]):.2g}")
+        if validity is not None and np.size(validity):
+            shown.append(f"max_validity={float(np.max(validity)):.2g}")
+        return f"Trajectory({', '.join(shown)}, seconds={self.seconds:.2g})"
+
     @property
     def adversary_rows(self) -> np.ndarray:
         """Row indices of the adversaries (the rows not in ``benign``), in row order."""
