@@ -230,6 +230,42 @@ def test_vectorised_filter_step_selects_the_per_agent_sets(d):
         assert np.array_equal(sets, np.stack(expect[r]))
 
 
+def _wmsr_one(own, X, F):
+    """W-MSR of one agent as it was computed (per coordinate, a sort and a mean)."""
+    out = np.empty_like(own)
+    for p in range(len(own)):
+        v = np.sort(X[:, p])
+        below, equal, above = v[v < own[p]], v[v == own[p]], v[v > own[p]]
+        out[p] = np.concatenate([below[min(F, len(below)):], equal,
+                                 above[:len(above) - min(F, len(above))], [own[p]]]).mean()
+    return out
+
+
+@pytest.mark.parametrize("F", [1, 3])
+@pytest.mark.parametrize("algorithm", ["wmsr", "mean"])
+def test_vectorised_baselines_same_floats_as_per_agent(algorithm, F):
+    """W-MSR and the mean baseline, grouped by number of usable values: the same floats
+    as the per-agent computation (irregular degrees up to ~25 values, unusable links,
+    ties with the own value, magnitudes 1e-140..1e140)."""
+    rng = np.random.default_rng(F)
+    G = nx.gnp_random_graph(80, 0.2, seed=F, directed=True)
+    x0 = rng.integers(0, 5, size=(80, 2)) * rng.choice([1e-140, 1.0, 1e140], size=(80, 1))
+    sc = Scenario(graph=G, x0=x0, F=F, steps=1, residual="none", check_robustness=False,
+                  algorithm=algorithm)
+    links = engine._Links(sc)
+    values = x0[links.send] * rng.choice([1.0, 1.5, 0.5], size=(len(links.send), 1))
+    usable = rng.random(len(links.recv)) < 0.8
+    benign = np.arange(80)
+    aux, starved = engine._auxiliary(sc, links, x0, values, usable, benign, 2, {})
+    assert len(starved) == 0
+    for r in benign:
+        sl = slice(links.start[r], links.start[r + 1])
+        X = values[sl][usable[sl]]
+        one = (_wmsr_one(x0[r], X, F) if algorithm == "wmsr"
+               else engine._scaled_mean(np.vstack([X, x0[r]])))
+        assert np.array_equal(aux[r], one), r
+
+
 # --------------------------------------------------------------------------- #
 # N = 5000 in the plane
 # --------------------------------------------------------------------------- #

@@ -273,6 +273,8 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     ``benign``) that must hold their state."""
     if sc.algorithm == "alg1":
         return _alg1_auxiliary(sc, links, x, values, usable, benign, d, cache)
+    if sc.algorithm in ("wmsr", "mean"):
+        return _baseline_auxiliary(sc, links, x, values, usable, benign, d), []
     m = (d + 1) * sc.F + 1
     aux = np.empty((len(benign), d))
     starved: list[int] = []
@@ -281,17 +283,12 @@ def _auxiliary(sc, links, x, values, usable, benign, d, cache):
     for r, i in enumerate(benign):
         sl = slice(links.start[i], links.start[i + 1])
         X = values[sl][usable[sl]]
-        if sc.algorithm == "kernel" and len(X) < m:
+        if len(X) < m:
             starved.append(r)
             aux[r] = x[i]
             continue
-        if sc.algorithm == "kernel":
-            problems.append(X)
-            where.append((r, 0, 0))
-        elif sc.algorithm == "wmsr":
-            aux[r] = _wmsr(x[i], X, sc.F)
-        else:
-            aux[r] = _scaled_mean(np.vstack([X, x[i]]))
+        problems.append(X)
+        where.append((r, 0, 0))
     points = _kernel_points(problems, sc.F, sc.kernel_point, cache)
     for (r, _, _), pt in zip(where, points, strict=True):
         aux[r] = pt
@@ -417,20 +414,29 @@ def _same_shape(problems: list[np.ndarray] | np.ndarray) -> dict[tuple[int, ...]
     return {shape: np.array(idx) for shape, idx in groups.items()}
 
 
-def _wmsr(own: np.ndarray, X: np.ndarray, F: int) -> np.ndarray:
-    """Coordinate-wise W-MSR: per coordinate, drop the F largest received values above
-    the own value and the F smallest below it (fewer if there are fewer), average the
-    rest with the own value."""
-    out = np.empty_like(own)
-    for p in range(len(own)):
-        v = np.sort(X[:, p])
-        above = v[v > own[p]]
-        below = v[v < own[p]]
-        equal = v[v == own[p]]
-        keep = np.concatenate([below[min(F, len(below)):], equal,
-                               above[:len(above) - min(F, len(above))], [own[p]]])
-        out[p] = keep.mean()
-    return out
+def _baseline_auxiliary(sc, links, x, values, usable, benign, d):
+    """x̃_i of the baselines for every benign agent, one array operation per group of
+    agents with the same number c of usable values (values V (R, c, d), own states
+    O (R, d)): "mean" averages V and O (:func:`_scaled_mean`); "wmsr" per coordinate
+    sorts V, drops the F largest values above the own value and the F smallest below
+    it (fewer if there are fewer) and averages the rest with the own value — the kept
+    values are the contiguous run v[lo:hi] of the sorted ones, averaged per run
+    length (the same float sum as one agent's)."""
+    aux = np.empty((len(benign), d))
+    for c, rows, idx in _usable_groups(links, usable, benign):
+        own = x[benign[rows]]
+        if sc.algorithm == "mean":
+            aux[rows] = _scaled_mean(np.concatenate([values[idx], own[:, None]], axis=1),
+                                     axis=1)
+            continue
+        V = np.sort(values[idx], axis=1)
+        lo = np.minimum(sc.F, (V < own[:, None]).sum(axis=1))  # (R, d)
+        hi = c - np.minimum(sc.F, (V > own[:, None]).sum(axis=1))
+        for L in np.unique(hi - lo):
+            r, p = np.nonzero(hi - lo == L)
+            kept = V[r[:, None], lo[r, p][:, None] + np.arange(L), p[:, None]]
+            aux[rows[r], p] = np.concatenate([kept, own[r, p][:, None]], axis=1).mean(axis=1)
+    return aux
 
 
 def _bar(progress: bool | None, total: int, desc: str = "simulate") -> Any:
