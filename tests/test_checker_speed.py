@@ -167,3 +167,19 @@ def test_normal_fan_agrees_with_the_exact_kernel(d, seed, integer):
         inside = all(small._exact.contains(v) for v in big.exact_vertices)
         assert (check(claim).verdict == "valid") == inside
         assert check(_scaled_claim(big, Fraction(1001, 1000))).verdict == "invalid"
+
+
+def test_normal_fan_work_is_bounded_before_it_is_spent(cube3, monkeypatch):
+    """Beyond the work limit the vertex test is unchecked without sweeping any circle:
+    the K² sweeps of a vertex are charged before they run (an adversary's n = 10^5
+    points crossing one normal cone would otherwise cost 10^10 steps)."""
+    from rescon_certificates import kernels
+
+    calls = []
+    real = kernels._arc_min
+    monkeypatch.setattr(kernels, "_arc_min", lambda pairs: calls.append(1) or real(pairs))
+    n, d = len(cube3["points"]), 3
+    monkeypatch.setattr(kernels, "MAX_EVAL_WORK", len(cube3["vertices"]) * n * (d + 2))
+    res = check(copy.deepcopy(cube3))
+    assert res.verdict == "unchecked" and res.trusted == ("halfspaces",), res.unchecked
+    assert calls == []
