@@ -41,6 +41,13 @@ def _exact_sq_diameter(X: np.ndarray) -> Fraction:
     return Fraction(best, den * den)
 
 
+def _assert_near(D: float, exact_sq: Fraction, rel: float) -> None:
+    """|D − √exact_sq| ≤ rel·D + 2^-1074 (the subnormal grid), decided exactly."""
+    lo = max(Fraction(D) * (1 - Fraction(rel)) - Fraction(2.0**-1074), Fraction(0))
+    hi = Fraction(D) * (1 + Fraction(rel)) + Fraction(2.0**-1074)
+    assert lo**2 <= exact_sq <= hi**2, (D, math.sqrt(exact_sq))
+
+
 def _shapes(draw, n: int, d: int) -> np.ndarray:
     """Integer clouds: general, converged (few distinct rows), collinear."""
     kind = draw(st.sampled_from(["general", "converged", "collinear"]))
@@ -70,10 +77,32 @@ def test_diameter_is_the_exact_one_at_every_magnitude(X):
     """Within (d + 2)u of the exact diameter (scaled by 2^j, converged, collinear,
     subnormal, 1e300 rows); the n² float formula overflowed to inf at 1e300 and lost
     everything to underflow at 1e-300."""
-    D = Fraction(diameter(X))
-    exact = _exact_sq_diameter(X)
-    tol = Fraction((X.shape[1] + 2) * U)
-    assert (D * (1 - tol)) ** 2 <= exact <= (D * (1 + tol)) ** 2
+    _assert_near(diameter(X), _exact_sq_diameter(X), (X.shape[1] + 2) * U)
+
+
+@settings(max_examples=80, deadline=None)
+@given(clouds(n_max=40))
+def test_antipodal_diameter_is_the_exact_one(X):
+    """The plane's near-antipodal pairs (forced on every input, ANGULAR_MIN = 0):
+    within (d + 2)u of the exact diameter at every magnitude."""
+    X = np.c_[X, X[::-1, 0]][:, :2]
+    with mock.patch.object(metrics, "ANGULAR_MIN", 0):
+        D = diameter(X)
+    _assert_near(D, _exact_sq_diameter(X), 4 * U)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_diameter_of_states_on_a_circle(seed):
+    """States on a circle (every row can end a diameter: the pruning kept all of them
+    and compared n² pairs, ~6 s at N = 10 000): near-antipodal pairs only, the same
+    float as all pairs."""
+    rng = np.random.default_rng(seed)
+    th = np.sort(rng.uniform(0, 2 * np.pi, 4000))
+    X = np.c_[np.cos(th), np.sin(th)] * 10.0 ** rng.integers(-5, 5) + rng.normal(size=2)
+    X = X + rng.normal(size=X.shape) * 10.0 ** -rng.integers(8, 16)
+    every_pair = metrics._pairwise_max(X, X)
+    with mock.patch.object(metrics, "_pairwise_max", side_effect=AssertionError("n²")):
+        assert diameter(X) == every_pair
 
 
 def test_diameter_at_1e300_and_converged_rows():

@@ -73,8 +73,9 @@ def diameter(states: np.ndarray) -> float:
     the float test gets a relative slack 4(d + 2)u, far above the rounding of its
     norms (each ‖x − c‖ is computed from exact-rounded differences). When R ≤ 1e-100
     after scaling (the rows agree to 100 digits: converged states) or a row is not
-    finite, the distinct rows are compared pairwise. Memory O(n·d) (pairs in blocks);
-    time O(n·kept)."""
+    finite, the distinct rows are compared pairwise. In the plane, when more than
+    ANGULAR_MIN rows are kept (states on a circle), only near-antipodal pairs are
+    compared (:func:`_antipodal_max`). Memory O(n·d) (pairs in blocks); time O(n·kept)."""
     X = np.asarray(states, dtype=float)
     if len(X) < 2:
         return _pairwise_max(X, X)
@@ -89,9 +90,49 @@ def diameter(states: np.ndarray) -> float:
             if 1e-100 < r.max() < 1e100:
                 far = np.sqrt(((X - X[np.argmax(r)]) ** 2).sum(axis=1)).max()
                 keep = r + r.max() >= far * (1 - 4 * (X.shape[1] + 2) * UNIT_ROUNDOFF)
+                if X.shape[1] == 2 and keep.sum() > ANGULAR_MIN:
+                    return math.ldexp(_antipodal_max(X[keep], X.mean(axis=0), far), scale)
                 return math.ldexp(_pairwise_max(X[keep], X), scale)
     distinct = np.unique(X, axis=0)
     return math.ldexp(_pairwise_max(distinct, distinct), scale)
+
+
+#: kept rows beyond which the plane's diameter compares near-antipodal pairs only
+ANGULAR_MIN = 2048
+
+
+def _antipodal_max(K: np.ndarray, c: np.ndarray, L: float) -> float:
+    """max fl‖p − q‖ over rows of K (n, 2), |K| ≤ 1 in scale, given a pair of rows at
+    float distance L and a point c: only pairs whose angle about c is within w_p of
+    antipodal are compared. With ρ_p = ‖p − c‖, R = max ρ and α = |∠(p, q) − π|,
+    ‖p − q‖² = ρ_p² + ρ_q² − 2 ρ_p ρ_q cos ∠ ≤ ρ_p² + R² + 2 ρ_p R cos α when cos α ≥ 0
+    (and < L² otherwise, if L² > ρ_p² + R²), so a pair at true distance ≥ L' =
+    L(1 − 8u) has cos α ≥ γ_p = (L'² − ρ_p² − R²)/(2 ρ_p R), ρ and R enlarged by 8u.
+    γ_p is rounded within E_p = 16u(L'² + ρ_p² + R²)/(2 ρ_p R) and each angle within
+    ~8u: w_p = arccos(γ_p − E_p) + 1e-12 (π when L'² ≤ ρ_p² + R²). Every pair left out
+    is shorter than L' and its float below L: the result is the all-pairs float."""
+    u8 = 8 * UNIT_ROUNDOFF
+    rho = np.hypot(K[:, 0] - c[0], K[:, 1] - c[1]) * (1 + u8)
+    R = rho.max()
+    Lo = L * (1 - u8)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        num = Lo * Lo - rho * rho - R * R
+        gamma = (num - 16 * UNIT_ROUNDOFF * (Lo * Lo + rho * rho + R * R)) / (2 * rho * R)
+        w = np.where(num > 0, np.arccos(np.clip(gamma, -1.0, 1.0)) + 1e-12, np.pi)
+    w = np.where(np.isnan(w), np.pi, w)
+    theta = np.arctan2(K[:, 1] - c[1], K[:, 0] - c[0])
+    order = np.argsort(theta)
+    ring = np.concatenate([theta[order] - 2 * np.pi, theta[order], theta[order] + 2 * np.pi])
+    who = np.tile(order, 3)
+    lo = np.searchsorted(ring, theta + np.pi - w, side="left")
+    hi = np.searchsorted(ring, theta + np.pi + w, side="right")
+    counts = hi - lo
+    if counts.sum() > 64 * len(K) + 10**6:  # not a thin ring: compare every pair
+        return _pairwise_max(K, K)
+    p = np.repeat(np.arange(len(K)), counts)
+    q = who[np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())]
+    diff = K[p] - K[q]
+    return float(np.sqrt((diff**2).sum(axis=1)).max())
 
 
 def _pairwise_max(P: np.ndarray, X: np.ndarray, chunk: int = 256) -> float:
