@@ -144,6 +144,25 @@ def test_distance_of_a_tiny_state_does_not_underflow():
     assert mon.distances(np.array([[2.0**-538]])).tolist() == [2.0**-538]
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_triangle_distances_within_their_bound(seed):
+    """In R³, states a facet proves outside get the point–triangle distance: within its
+    certified bound of the exact projection's distance (scales 1e-40..1e40), with no
+    exact projection for states clearly outside (each took ~2 ms); zero exactly for
+    the states in the hull."""
+    rng = np.random.default_rng(seed)
+    for scale in (1.0, 1e-40, 1e40):
+        mon = ValidityMonitor(rng.normal(size=(int(rng.integers(4, 120)), 3)) * scale)
+        X = rng.normal(size=(60, 3)) * scale * rng.choice([0.3, 1.0, 3.0, 1e3], size=(60, 1))
+        exact = np.array([mon.distance(x) for x in X])
+        far = exact > 1e-6 * scale
+        with mock.patch.object(mon, "distance", side_effect=AssertionError("exact")):
+            fast = mon.distances(X[far])
+        _, err = mon.triangle_distances(X[far])
+        assert np.all(np.abs(fast - exact[far]) <= err)
+        assert np.array_equal(mon.distances(X) == 0, exact == 0)
+
+
 def test_a_wrong_proposal_is_corrected():
     """A proposal that misses vertices (what Qhull's rounding could do) is completed by
     the exact certification."""

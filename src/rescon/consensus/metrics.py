@@ -151,15 +151,18 @@ class ValidityMonitor:
     cases, exact arithmetic decides the rest). Outside H the distance is a float:
     in the plane with H a polygon, the smallest point–segment distance to H's edges
     (:meth:`edge_distances`), within ``edge_error`` of the exact distance (a rigorous
-    bound, ~1e-14 relative to the data's magnitude); otherwise (d ≠ 2, H flat,
-    magnitudes beyond 1e±100, states the filter cannot place) the exact projection
-    onto H, rounded once (~1.5 ms per state)."""
+    bound, ~1e-14 relative to the data's magnitude); in R³ the smallest point–triangle
+    distance over a triangulation of H's boundary, with a certified error bound
+    (:meth:`triangle_distances`); otherwise (d > 3, H flat, magnitudes beyond 1e±100,
+    states the filter cannot place, bounds not below the distance) the exact
+    projection onto H, rounded once (~1.5 ms per state)."""
 
     def __init__(self, initial: np.ndarray) -> None:
         self.hull = certified_hull(initial)
         full = self.hull.dim == initial.shape[1] and bool(self.hull._exact.facets)
         self._rows = _filter_rows(self.hull._exact.facets) if full else None
         self._edges = _polygon_edges(self.hull) if full and initial.shape[1] == 2 else None
+        self._triangles = _hull_triangles(self.hull) if full and initial.shape[1] == 3 else None
 
     def distance(self, x: np.ndarray) -> float:
         if self.hull.contains(x):
@@ -190,14 +193,21 @@ class ValidityMonitor:
 
     def distances(self, states: np.ndarray) -> np.ndarray:
         """Distances of the rows of ``states``: rows :meth:`surely_inside` the hull are 0,
-        rows a facet proves outside a polygon get :meth:`edge_distances`, the others
-        the exact :meth:`distance`."""
+        rows a facet proves outside a polygon get :meth:`edge_distances`, outside a
+        polytope in R³ :meth:`triangle_distances` where their bound is below the
+        distance, the others the exact :meth:`distance`."""
         out = np.zeros(len(states))
         rest = np.flatnonzero(~self.surely_inside(states))
         if rest.size and self._edges is not None:
             S, bound = self._slacks(states[rest])
             dist, err = self.edge_distances(states[rest])
             fast = (S > bound).any(axis=1) & np.isfinite(err)
+            out[rest[fast]] = dist[fast]
+            rest = rest[~fast]
+        if rest.size and self._triangles is not None:
+            S, bound = self._slacks(states[rest])
+            dist, err = self.triangle_distances(states[rest])
+            fast = (S > bound).any(axis=1) & (dist > err)
             out[rest[fast]] = dist[fast]
             rest = rest[~fast]
         for i in rest:
@@ -216,6 +226,38 @@ class ValidityMonitor:
             t = np.clip(np.where(ee > 0, (w * e).sum(axis=2) / ee, 0.0), 0.0, 1.0)
         r = w - t[:, :, None] * e
         return np.hypot(r[:, :, 0], r[:, :, 1]).min(axis=1), self.edge_error(X)
+
+    def triangle_distances(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For states X (n, 3) outside H: δ = min over the boundary triangles (on the
+        rounded vertices V̂) of ‖x − y‖, y the float closest point of the triangle, and
+        a bound on |δ − dist(x, H)| from both sides, with M = max(‖x‖∞, max|V̂|):
+
+        * above: y is within 64uM of a point of H (per coordinate ≤ 13uM from the
+          rounding of a + s e₀ + t e₁, ≤ uM from V̂ against the exact vertices, and
+          ≤ 8uM from s + t rounded past 1), so dist ≤ δ(1 + 4u) + 64uM;
+        * below: for n = x − y and the exact vertices v (rounded: V̂ = ``hull.vertices``),
+          dist ≥ (n·x − max_v n·v)/‖n‖ (H lies in the halfspace n·z ≤ max_v n·v), in
+          floats with each dot product within 4u‖n‖₁M of its exact value (each
+          further operation is one rounding relative to its result: the factors 1 ± 4u).
+
+        The bound is inf beyond 1e±100 (squares may under- or overflow)."""
+        A, B, C = self._triangles
+        rows = []
+        for s in range(0, len(X), 256):
+            rows.append(_closest_on_triangles(X[s:s + 256], A, B, C))
+        Y = np.concatenate(rows) if rows else np.empty((0, 3))
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            n = X - Y
+            dist = np.sqrt((n * n).sum(axis=1))
+            V = self.hull.vertices
+            M = np.maximum(np.abs(X).max(axis=1), np.abs(V).max())
+            n1 = np.abs(n).sum(axis=1)
+            low = ((X * n).sum(axis=1) - (n @ V.T).max(axis=1) - 8 * UNIT_ROUNDOFF * n1 * M)
+            low = low / (dist * (1 + 4 * UNIT_ROUNDOFF)) * (1 - 4 * UNIT_ROUNDOFF)
+            high = dist * (1 + 4 * UNIT_ROUNDOFF) + 64 * UNIT_ROUNDOFF * M
+            err = np.maximum(high - dist, dist - low) * (1 + 4 * UNIT_ROUNDOFF)
+        ok = (M > 1e-100) & (M < 1e100) & np.isfinite(err)
+        return dist, np.where(ok, err, np.inf)
 
     def edge_error(self, X: np.ndarray) -> np.ndarray:
         """A bound on |edge distance − exact distance| for each row x of X, from
@@ -310,6 +352,52 @@ def _polygon_edges(hull) -> tuple[np.ndarray, np.ndarray] | None:
     except OverflowError:
         return None
     return P, Q
+
+
+def _hull_triangles(hull) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(A, B, C) (T, 3) each: a triangulation of the boundary of conv V̂ (Qhull on the
+    rounded vertices V̂; any triangles of points of conv V̂ serve, their quality only
+    tightens :meth:`ValidityMonitor.triangle_distances`' bound); None if Qhull fails."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    V = hull.vertices
+    if len(V) < 4 or not np.isfinite(V).all():
+        return None
+    try:
+        tri = V[ConvexHull(V).simplices]
+    except QhullError:
+        return None
+    return tri[:, 0], tri[:, 1], tri[:, 2]
+
+
+def _closest_on_triangles(X: np.ndarray, A: np.ndarray, B: np.ndarray,
+                          C: np.ndarray) -> np.ndarray:
+    """For each row x of X (n, 3), the closest point to x over the triangles (A, B, C)
+    (floats): per triangle y = a + s(b − a) + t(c − a) by the Voronoi regions of its
+    vertices, edges and face (Ericson, Real-Time Collision Detection §5.1.5)."""
+    x = X[:, None, :]
+    ab, ac = (B - A)[None], (C - A)[None]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        ap, bp, cp = x - A[None], x - B[None], x - C[None]
+        d1, d2 = (ab * ap).sum(2), (ac * ap).sum(2)
+        d3, d4 = (ab * bp).sum(2), (ac * bp).sum(2)
+        d5, d6 = (ab * cp).sum(2), (ac * cp).sum(2)
+        va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+        denom = va + vb + vc
+        s, t = vb / denom, vc / denom  # the face
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        for mask, s_, t_ in (  # later regions take precedence, as in Ericson's order
+                ((va <= 0) & (d4 >= d3) & (d5 >= d6), 1 - w, w),
+                ((vb <= 0) & (d2 >= 0) & (d6 <= 0), 0.0, d2 / (d2 - d6)),
+                ((d6 >= 0) & (d5 <= d6), 0.0, 1.0),
+                ((vc <= 0) & (d1 >= 0) & (d3 <= 0), d1 / (d1 - d3), 0.0),
+                ((d3 >= 0) & (d4 <= d3), 1.0, 0.0),
+                ((d1 <= 0) & (d2 <= 0), 0.0, 0.0)):
+            s, t = np.where(mask, s_, s), np.where(mask, t_, t)
+        Y = A[None] + s[..., None] * ab + t[..., None] * ac
+        sq = ((x - Y) ** 2).sum(2)
+    best = np.argmin(np.where(np.isnan(sq), np.inf, sq), axis=1)
+    return Y[np.arange(len(X)), best]
 
 
 def _filter_rows(facets) -> tuple[np.ndarray, np.ndarray]:
