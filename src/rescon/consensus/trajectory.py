@@ -24,7 +24,8 @@ class Trajectory:
         a function of time; NaN when nothing finite was sent).
     nodes : the N node labels, in row order.
     benign : indices of the benign agents.
-    metrics : per step — ``spread`` (K+1, d) per-coordinate max − min over benign
+    metrics : per step (the first four only if chosen: ``simulate(metrics=...)``,
+        default all) — ``spread`` (K+1, d) per-coordinate max − min over benign
         agents, ``diameter`` (K+1,), ``validity`` (K+1,) the largest distance of a benign
         state to conv(benign initial states), ``validity_per_agent`` (K+1, |B|),
         ``blocked_links`` (K+1,) links under DoS at t_k, ``starved`` (K+1,) benign
