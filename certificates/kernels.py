@@ -842,19 +842,47 @@ def _proof_method(p: Any, where: str, keys: dict[str, tuple[str, ...]]) -> str:
     return m
 
 
+KERNEL_KEYS = ("dim", "vertices", "equalities", "facets", "adjacency")
+
+
 def kind_kernel_point(c: dict, ctx: Any) -> str:
-    """x ∈ Psi(X, F), by (b) ("halfspaces") or (c) ("tverberg")."""
+    """x ∈ Psi(X, F), by (b) ("halfspaces"), (c) ("tverberg") or "kernel": the kernel
+    itself as a ``safe_kernel`` claim Psi = P = conv(V) (checked as that kind, with the
+    normal fan for V ⊆ Psi) and x ∈ P exactly."""
     _obj(c, "certificate", _HEAD + ("points", "F", "x", "proof"))
     pts, d, F = _problem(c)
     x = _vec(c["x"], "x", d)
-    m = _proof_method(c["proof"], "proof", {"halfspaces": (), "tverberg": ("parts",)})
+    m = _proof_method(c["proof"], "proof", {"halfspaces": (), "tverberg": ("parts",),
+                                            "kernel": KERNEL_KEYS})
     if m == "tverberg":
         _tverberg(c["proof"]["parts"], "proof.parts", pts, F, x, "x", ctx)
         how = "tverberg"
+    elif m == "kernel":
+        _refute_by_axes(pts, F, [x], ["x"])
+        how = _in_kernel_polytope(c, x, d, ctx)
     else:
         _refute_by_axes(pts, F, [x], ["x"])
         how = _in_kernel_halfspaces(pts, F, [x], ["x"], ctx, "x")
     return f"x is in the safe kernel (n={len(pts)}, d={d}, F={F}; {how})"
+
+
+def _in_kernel_polytope(c: dict, x: Vec, d: int, ctx: Any) -> str:
+    """x ∈ P = {equalities, facets} of the proof, and P = Psi checked as a ``safe_kernel``
+    certificate on the same points and F (so x ∈ Psi)."""
+    p = c["proof"]
+    sub = {"rescon_certificate": 1, "kind": "safe_kernel", "points": c["points"], "F": c["F"],
+           **{k: p[k] for k in KERNEL_KEYS}, "proof": {"method": "halfspaces"}}
+    try:
+        how = kind_safe_kernel(sub, ctx)
+    except Invalid as e:
+        raise Invalid(f"proof: {e}") from None
+    for key, strict in (("equalities", True), ("facets", False)):
+        for j, (a, b) in enumerate(_constraints(p[key], f"proof.{key}", d)):
+            ax = _dot(a, x)
+            if ax > b or (strict and ax != b):
+                raise Invalid(f"x = {_fmtv(x)} is not in the kernel: it violates "
+                              f"proof.{key}[{j}]")
+    return f"kernel: {how}"
 
 
 FARKAS_PRIME = 2**61 - 1  # a Mersenne prime: the cheap modular test of the Farkas sum

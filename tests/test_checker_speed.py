@@ -183,3 +183,45 @@ def test_normal_fan_work_is_bounded_before_it_is_spent(cube3, monkeypatch):
     res = check(copy.deepcopy(cube3))
     assert res.verdict == "unchecked" and res.trusted == ("halfspaces",), res.unchecked
     assert calls == []
+
+
+@pytest.mark.parametrize(("n", "d", "F"), [(1000, 2, 100), (100, 3, 10)])
+def test_large_kernel_points_are_verified(n, d, F):
+    """A kernel point's certificate carries the kernel ("kernel" proof); before, the
+    checker enumerated C(n, d) hyperplanes and answered 'unchecked' at these sizes."""
+    X = np.random.default_rng(n).standard_normal((n, d))
+    _, cert = rescon.kernel_point(X, F)
+    assert cert["proof"]["method"] == "kernel"
+    res = check(cert)
+    assert res.verdict == "valid", (res.reason, res.unchecked)
+
+
+def _point_outside(c):
+    """x moved along the normal of a facet it is not on, just past it (so outside Ψ = P)."""
+    x = [Fraction(t) for t in c["x"]]
+    for h in c["proof"]["facets"]:
+        a = [Fraction(t) for t in h["a"]]
+        step = (Fraction(h["b"]) - sum(s * t for s, t in zip(a, x))) / sum(t * t for t in a)
+        if step > 0:
+            c["x"] = [str(t + step * (1 + Fraction(1, 10**6)) * s) for t, s in zip(x, a)]
+            return
+
+
+POINT_TAMPER = {
+    "x outside the kernel": (_point_outside, "is not in the kernel: it violates proof.facets["),
+    "kernel of F - 1": (lambda c: c.__setitem__("F", c["F"] + 1), "proof: "),
+    "forged adjacency": (lambda c: _forge(c["proof"]), "proof: adjacency[0] lists"),
+    "moved vertex": (lambda c: _move_vertex(c["proof"]), "proof: vertices[0]"),
+    "missing adjacency": (lambda c: c["proof"].pop("adjacency"), "missing key 'adjacency'"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(POINT_TAMPER))
+def test_tampered_kernel_point_proofs_are_rejected(name):
+    X = np.random.default_rng(11).standard_normal((24, 3))
+    _, cert = rescon.kernel_point(X, 2)
+    assert check(cert).valid
+    f, needle = POINT_TAMPER[name]
+    f(cert)
+    res = check(cert)
+    assert res.verdict == "invalid" and needle in res.reason, (name, res.reason)

@@ -69,9 +69,12 @@ def test_exit_codes_and_json(tmp_path, capsys):
 
 def test_correct_kernel_too_large_to_enumerate_is_not_invalid(tmp_path, capsys):
     """rescon's own certificate for a d = 3, n = 50 kernel was called "invalid: too large
-    to check"; it is a correct certificate, so now: exit 3 naming the parts."""
+    to check"; it is a correct certificate, so now: exit 3 naming the parts. (With the
+    vertex adjacency rescon now writes, it is valid; the old form, without it, is not.)"""
     X = np.random.default_rng(0).normal(size=(50, 3))
     cert = rescon.safe_kernel(X, 4).certificate
+    assert rescon.check_certificate(cert).verdict == "valid"
+    del cert["adjacency"]
     res = rescon.check_certificate(cert)
     assert res.verdict == "unchecked" and "vertex enumeration" in res.trusted, res
     path = tmp_path / "kernel.json"
