@@ -15,6 +15,9 @@ process: start-up and JSON parsing included, median of ``--repeat`` runs) on
 * ``before``: the old form checked by the checker of git revision ``--before`` (the
   one before issue 13 §4), run once with a ``--timeout``.
 
+Each cloud also gives a ``kernel_point`` row (``rescon.kernel_point``'s certificate,
+now with the ``kernel`` proof; old form: the ``halfspaces`` proof).
+
 The load average (1 min) is recorded before and after each case: the machine is shared.
 Writes ``checker.csv`` and ``checker.md``.
 """
@@ -90,19 +93,36 @@ def bench(repeat: int, before: str, timeout: float) -> list[dict]:
             full, short = tmpdir / "new.json", tmpdir / "old.json"
             full.write_text(json.dumps(cert))
             short.write_text(json.dumps({k: v for k, v in cert.items() if k != "adjacency"}))
-            verdict, sec = _median(new, full, repeat, timeout)
-            old_verdict, old_sec = _median(new, short, repeat, timeout)
-            before_verdict, before_sec = _run(old, short, timeout)
-            rows.append({
-                "case": f"{family} d={d} n={n} F={F}", "vertices": len(cert["vertices"]),
-                "facets": len(cert["facets"]), "build_s": round(build, 3),
-                "after_verdict": verdict, "after_s": round(sec, 3) if verdict == "valid" else None,
-                "old_form_verdict": old_verdict, "old_form_s": round(old_sec, 3),
-                "before_verdict": before_verdict, "before_s": round(before_sec, 3),
-                "met": verdict == "valid" and sec <= TARGET_S,
-                "load_before": round(load0, 2), "load_after": round(os.getloadavg()[0], 2)})
-            print(rows[-1], file=sys.stderr)
+            case = f"{family} d={d} n={n} F={F}"
+            rows.append(_row(case, "safe_kernel", cert, build, (new, old), (full, short),
+                             repeat, timeout, load0))
+            t0 = time.perf_counter()
+            _, point = rescon.kernel_point(X, F)
+            build = time.perf_counter() - t0
+            full.write_text(json.dumps(point))
+            short.write_text(json.dumps({**point, "proof": {"method": "halfspaces"}}))
+            rows.append(_row(case, "kernel_point", cert, build, (new, old), (full, short),
+                             repeat, timeout, os.getloadavg()[0]))
     return rows
+
+
+def _row(case: str, kind: str, cert: dict, build: float, checkers: tuple[Path, Path],
+         files: tuple[Path, Path], repeat: int, timeout: float, load0: float) -> dict:
+    """One table row: today's checker on today's certificate (``files[0]``) and on the
+    old form (``files[1]``), the old checker on the old form."""
+    (new, old), (full, short) = checkers, files
+    verdict, sec = _median(new, full, repeat, timeout)
+    old_verdict, old_sec = _median(new, short, repeat, timeout)
+    before_verdict, before_sec = _run(old, short, timeout)
+    row = {"case": case, "kind": kind, "vertices": len(cert["vertices"]),
+           "facets": len(cert["facets"]), "build_s": round(build, 3),
+           "after_verdict": verdict, "after_s": round(sec, 3) if verdict == "valid" else None,
+           "old_form_verdict": old_verdict, "old_form_s": round(old_sec, 3),
+           "before_verdict": before_verdict, "before_s": round(before_sec, 3),
+           "met": verdict == "valid" and sec <= TARGET_S,
+           "load_before": round(load0, 2), "load_after": round(os.getloadavg()[0], 2)}
+    print(row, file=sys.stderr)
+    return row
 
 
 def write(rows: list[dict], out: Path, seconds: float, before: str) -> None:
@@ -117,16 +137,19 @@ def write(rows: list[dict], out: Path, seconds: float, before: str) -> None:
          f"Python {platform.python_version()}, {os.cpu_count()} cores shared with other jobs "
          "(load average before/after each case in the table)."),
         ("- Wall time of `python certificates/check.py CERT` (fresh process, median of the "
-         "repeats). `after`: today's certificate (with `adjacency`) and checker, verdict "
-         "checked to be `valid` before its time is reported; `old form`: without "
-         f"`adjacency`, today's checker; `before`: the old form, checker of revision {before}."),
+         "repeats). `after`: today's certificate (safe_kernel: with `adjacency`; "
+         "kernel_point: `kernel` proof) and checker, verdict checked to be `valid` before "
+         "its time is reported; `old form`: without `adjacency` / with the `halfspaces` "
+         f"proof, today's checker; `before`: the old form, checker of revision {before}. "
+         "`build s`: rescon's kernel (or point) and certificate, in-process (the first row "
+         "includes imports)."),
         f"- Target: `valid` in ≤ {TARGET_S:g} s.", "",
-        "| case | #V | #facets | kernel s | after | after s | old form | old form s | before "
-        "| before s | met | load |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        "| case | kind | #V | #facets | build s | after | after s | old form | old form s "
+        "| before | before s | met | load |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(
-            f"| {r['case']} | {r['vertices']} | {r['facets']} | {r['build_s']} | "
+            f"| {r['case']} | {r['kind']} | {r['vertices']} | {r['facets']} | {r['build_s']} | "
             f"{r['after_verdict']} | {r['after_s'] if r['after_s'] is not None else '–'} | "
             f"{r['old_form_verdict']} | {r['old_form_s']} | {r['before_verdict']} | "
             f"{r['before_s']} | {'met' if r['met'] else 'NOT met'} | "
