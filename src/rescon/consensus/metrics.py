@@ -159,6 +159,7 @@ class ValidityMonitor:
 
     def __init__(self, initial: np.ndarray) -> None:
         self.hull = certified_hull(initial)
+        self._initial = np.array(initial, dtype=np.float64)
         full = self.hull.dim == initial.shape[1] and bool(self.hull._exact.facets)
         self._rows = _filter_rows(self.hull._exact.facets) if full else None
         self._edges = _polygon_edges(self.hull) if full and initial.shape[1] == 2 else None
@@ -192,12 +193,12 @@ class ValidityMonitor:
         return _slacks(*self._rows, states)
 
     def distances(self, states: np.ndarray) -> np.ndarray:
-        """Distances of the rows of ``states``: rows :meth:`surely_inside` the hull are 0,
-        rows a facet proves outside a polygon get :meth:`edge_distances`, outside a
-        polytope in R³ :meth:`triangle_distances` where their bound is below the
-        distance, the others the exact :meth:`distance`."""
+        """Distances of the rows of ``states``: rows :meth:`surely_inside` the hull or
+        equal to their initial state are 0, rows a facet proves outside a polygon get
+        :meth:`edge_distances`, outside a polytope in R³ :meth:`triangle_distances`
+        where their bound is below the distance, the others the exact :meth:`distance`."""
         out = np.zeros(len(states))
-        rest = np.flatnonzero(~self.surely_inside(states))
+        rest = np.flatnonzero(~(self.surely_inside(states) | self._initial_rows(states)))
         if rest.size and self._edges is not None:
             S, bound = self._slacks(states[rest])
             dist, err = self.edge_distances(states[rest])
@@ -213,6 +214,14 @@ class ValidityMonitor:
         for i in rest:
             out[i] = self.distance(states[i])
         return out
+
+    def _initial_rows(self, states: np.ndarray) -> np.ndarray:
+        """Rows of ``states`` equal to the initial state of the same row (they generate
+        H, so lie in it: step 0, and agents that held their state), often on H's
+        boundary where the filter cannot decide."""
+        if states.shape != self._initial.shape:
+            return np.zeros(len(states), dtype=bool)
+        return (states == self._initial).all(axis=1)
 
     def edge_distances(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For states X (n, 2) outside the polygon H: min over its edges [p, q] of
