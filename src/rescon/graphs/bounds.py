@@ -220,13 +220,17 @@ def descend_pair(ig: IndexedGraph, r: int, A: int, B: int) -> tuple[int, int, in
     """Steepest descent on the pair cost from bitmasks (A, B): each step moves one node
     into A, into B or out of both, taking the cheapest strictly improving move.
     Returns (cost, A, B) at a local minimum, or None when (A, B) is not a valid pair."""
-    inmask = ig.in_masks()
+    return _descend(ig.in_masks(), r, A, B)
+
+
+def _descend(inmask: list[int], r: int, A: int, B: int) -> tuple[int, int, int] | None:
+    """:func:`descend_pair` on in-neighbour bitmasks."""
     cur = _masks_cost(inmask, A, B, r)
     if cur is None:
         return None
     while True:
         best = (cur, A, B)
-        for v in range(ig.n):
+        for v in range(len(inmask)):
             bit = 1 << v
             a0, b0 = A & ~bit, B & ~bit
             for a, b in ((a0 | bit, b0), (a0, b0 | bit), (a0, b0)):
@@ -246,12 +250,13 @@ def descended_pairs(ig: IndexedGraph, r: int, *, starts: int = 40, seed: int = 0
     s*(r) from above."""
     rng = random.Random(seed)
     full = (1 << ig.n) - 1
+    inmask = ig.in_masks()
     found: list[Pair] = []
     for _ in range(50 * starts):
         if len(found) == starts or (deadline is not None and time.perf_counter() > deadline):
             break
         A = rng.getrandbits(ig.n) & full
-        out = descend_pair(ig, r, A, full ^ A)
+        out = _descend(inmask, r, A, full ^ A)
         if out is not None:
             found.append(Pair(_set(out[1]), _set(out[2])))
     return found

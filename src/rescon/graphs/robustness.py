@@ -635,9 +635,10 @@ def robustness(
             break
     used = "bounds"
     bar = _Phases(progress, n)
+    engine = "MILP" if method == "milp" or (method == "auto" and n > MAX_SEARCH_NODES) else method
     candidates = [up_pair]
     while r_lower < r_upper:
-        bar.phase(f"ρ search (r={r_upper})")
+        bar.phase(f"ρ {'search' if engine == 'auto' else engine} (r={r_upper})")
         dec = _decide_r(ig, r_upper, method, deadline, seeds,
                         known_pair=(up_value, up_pair), on_progress=bar.update)
         used = dec.method
@@ -665,7 +666,7 @@ def robustness(
     if rho == 0:
         ss = _SStar(n, n, n, {"method": "trivial"}, None, "bounds")
     else:
-        bar.phase(f"s* search (r={rho})")
+        bar.phase(f"s* {'search' if engine == 'auto' else engine} (r={rho})")
         ss = _s_star(ig, rho, method, deadline, seeds, lower, candidates,
                      on_progress=bar.update)
     bar.close()
