@@ -627,3 +627,27 @@ def test_method_help_names_every_method(capsys):
     assert code == 2
     for m in METHODS:
         assert m in " ".join(out.split()) and m in err
+
+
+SCENARIOS = ROOT / "examples" / "scenarios"
+
+
+def test_simulate_metrics_choose_the_monitors(capsys):
+    """--metrics runs only the named monitors; the others are null, not a crash."""
+    data = run_json(["simulate", SCENARIOS / "paper.toml", "--metrics", "diameter"], capsys)
+    assert data["final_diameter"] < 1e-9 and data["max_validity"] is None
+    data = run_json(["rmdo", SCENARIOS / "paper_rmdo.toml", "--metrics", "validity"], capsys)
+    assert data["final_diameter"] is None and data["max_validity"] >= 0
+    code, out, err = run(["simulate", SCENARIOS / "paper.toml", "--metrics", "diamter"], capsys)
+    assert_clean_error(code, out, err)
+    assert "diamter" in err
+
+
+def test_trajectory_without_a_monitor_says_so():
+    traj = rescon.simulate(rescon.Scenario.paper_example(steps=3), metrics=["spread"])
+    with pytest.raises(rescon.InputError, match="'validity' monitor did not run"):
+        _ = traj.max_validity
+    with pytest.raises(rescon.InputError, match="'diameter' monitor did not run"):
+        _ = traj.final_diameter
+    assert "final_diameter" not in repr(traj)
+    traj.plot()  # the panels of the monitors that ran

@@ -193,9 +193,12 @@ def _warned(run: Callable[[], Any]) -> Any:
 def _run_summary(args: argparse.Namespace, sc: Any, traj: Any, out_dir: Path | None,
                  plot: Path | None) -> tuple[dict[str, Any], list[str]]:
     """The JSON keys and text lines shared by simulate and rmdo; writes DIR's files."""
+    m = traj.metrics
+    diameter = float(m["diameter"][-1]) if "diameter" in m else None
+    validity = float(m["validity"].max()) if "validity" in m else None
     out = {"steps": sc.steps, "N": len(sc.nodes), "d": sc.d, "F": sc.F,
            "algorithm": sc.algorithm, "policy": sc.policy,
-           "final_diameter": traj.final_diameter, "max_validity": traj.max_validity,
+           "final_diameter": diameter, "max_validity": validity,
            "assumptions_violated": traj.info["assumptions_violated"],
            "seconds": round(traj.seconds, 6)}
     if out_dir is not None:
@@ -207,11 +210,23 @@ def _run_summary(args: argparse.Namespace, sc: Any, traj: Any, out_dir: Path | N
         out["out"] = str(out_dir)
     lines = [(f"{sc.algorithm} with policy {sc.policy}: N = {len(sc.nodes)}, d = {sc.d}, "
               f"F = {sc.F}, {sc.steps} steps in {traj.seconds:.2f} s"),
-             (f"final benign diameter {traj.final_diameter:.3e}, largest distance to the "
-              f"initial benign hull {traj.max_validity:.3e}")]
+             (f"final benign diameter {_maybe(diameter)}, largest distance to the "
+              f"initial benign hull {_maybe(validity)}")]
     if args.out:
         lines.append(f"written to {args.out}")
     return out, lines
+
+
+def _maybe(x: float | None) -> str:
+    """A metric for the text summary: 3 significant digits, or "not monitored"."""
+    return "not monitored" if x is None else f"{x:.3e}"
+
+
+def _metrics(args: argparse.Namespace) -> list[str] | None:
+    """``--metrics a,b`` as a list of monitor names (None: every monitor)."""
+    if args.metrics is None:
+        return None
+    return [name.strip() for name in args.metrics.split(",") if name.strip()]
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
@@ -220,7 +235,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
     out_dir, plot = _run_outputs(args)
     sc = Scenario.from_toml(args.scenario)
-    traj = _warned(lambda: simulate(sc, progress=_progress(args)))
+    traj = _warned(lambda: simulate(sc, metrics=_metrics(args), progress=_progress(args)))
     out, lines = _run_summary(args, sc, traj, out_dir, plot)
     _emit(out, args.json, lines)
     return 0
@@ -238,7 +253,7 @@ def _cmd_rmdo(args: argparse.Namespace) -> int:
     out_dir, plot = _run_outputs(args)
     f = read_rmdo(args.scenario)
     traj = _warned(lambda: rmdo(f.scenario, f.costs, step_size=f.step_size,
-                                progress=_progress(args)))
+                                metrics=_metrics(args), progress=_progress(args)))
     out, lines = _run_summary(args, f.scenario, traj, out_dir, plot)
     m, opt = traj.metrics, dict(traj.info["optimum"])
     opt.setdefault("point", None)
@@ -441,6 +456,9 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("scenario", help="scenario TOML file")
     sim.add_argument("--out", metavar="DIR", help="write trajectory.json/.csv (and .png)")
     sim.add_argument("--plot", action="store_true", help="with --out: draw the trajectory")
+    sim.add_argument("--metrics", metavar="NAMES",
+                     help="monitors to run, comma-separated from spread, diameter, validity "
+                          "(default: all; unmonitored values are null)")
     sim.add_argument("--json", action="store_true", help="one JSON object on stdout")
     sim.set_defaults(func=_cmd_simulate)
 
@@ -448,6 +466,9 @@ def _parser() -> argparse.ArgumentParser:
     opt.add_argument("scenario", help="scenario TOML file with [costs] (and [step_size])")
     opt.add_argument("--out", metavar="DIR", help="write trajectory.json/.csv (and .png)")
     opt.add_argument("--plot", action="store_true", help="with --out: draw the trajectory")
+    opt.add_argument("--metrics", metavar="NAMES",
+                     help="monitors to run, comma-separated from spread, diameter, validity "
+                          "(default: all; unmonitored values are null)")
     opt.add_argument("--json", action="store_true", help="one JSON object on stdout")
     opt.set_defaults(func=_cmd_rmdo)
 

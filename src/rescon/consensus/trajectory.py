@@ -10,6 +10,8 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
+
 __all__ = ["Trajectory"]
 
 
@@ -51,11 +53,18 @@ class Trajectory:
     @property
     def max_validity(self) -> float:
         """max over time and benign agents of the distance to conv(initial benign)."""
-        return float(self.metrics["validity"].max())
+        return float(self._metric("validity").max())
 
     @property
     def final_diameter(self) -> float:
-        return float(self.metrics["diameter"][-1])
+        return float(self._metric("diameter")[-1])
+
+    def _metric(self, name: str) -> np.ndarray:
+        """``metrics[name]``, or an InputError saying the monitor did not run."""
+        if name not in self.metrics:
+            raise InputError(f"the {name!r} monitor did not run: simulate with metrics= "
+                             f"including {name!r} (or the default, every monitor)")
+        return self.metrics[name]
 
     def __repr__(self) -> str:
         """A one-line summary (the arrays are in the attributes, not in the repr)."""

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from collections.abc import Callable, Hashable, Mapping
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from fractions import Fraction
 from typing import Any
 
@@ -42,7 +42,8 @@ __all__ = ["CostMonitor", "Optimum", "SubgradientStep", "rmdo"]
 
 
 def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = "paper",
-         optimum: Any = None, progress: bool | None = None) -> Trajectory:
+         optimum: Any = None, metrics: Sequence[str] | None = None,
+         progress: bool | None = None) -> Trajectory:
     """Run Algorithm 2 (resilient multi-dimensional distributed optimisation).
 
     Parameters
@@ -60,6 +61,8 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
         point). Otherwise X* is computed exactly when every cost is a quadratic or affine
         atom (rational linear algebra on the atoms' data), else numerically
         (:class:`Optimum`; ``info["optimum"]`` says which).
+    metrics : the consensus monitors to run, as in :func:`rescon.simulate` ("spread",
+        "diameter", "validity"; default every one); the cost metrics always run.
     progress : a progress bar on stderr (default: when stderr is a terminal).
 
     Returns
@@ -107,7 +110,7 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
     monitor = CostMonitor(F, sc.steps, sc.T, len(benign), opt)
     info = {"assumptions_violated": problems, "update": "rmdo", "step_size": repr(beta),
             "assumption5_violated": violated, "oracles": len(groups), "optimum": opt.info}
-    return run(sc, rule, monitors=[ConsensusMonitor(sc), monitor], progress=progress,
+    return run(sc, rule, monitors=[ConsensusMonitor(sc, metrics), monitor], progress=progress,
                info=info, started=t0)
 
 

@@ -51,7 +51,8 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
         rows.append(("coord", p))
         if limits[p] is not None:
             rows.append(("full", p))
-    rows.append(("diameter", None))
+    if "diameter" in traj.metrics:
+        rows.append(("diameter", None))
     if "cost_at_mean" in traj.metrics:
         rows += [("cost", None), ("rate", None)]
     heights = [0.6 if kind == "full" else 1.0 for kind, _ in rows]
