@@ -30,6 +30,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import rescon
+from rescon.graphs.facts import clear_cache
 from rescon.graphs.generators import ba_robust, circulant, directed_growth, two_cliques
 
 METHODS = ("auto", "search", "milp", "dp")
@@ -120,9 +121,11 @@ def full_check(G: nx.Graph, *, methods=METHODS, grid_methods=("auto",)) -> None:
     o = oracle(G)
     n = o.n
     for m in methods:
+        clear_cache()  # each method computes, none reads another's cached facts
         rep = rescon.robustness(G, method=m)
         check_report(G, rep, o.rho, o.s_star_of(o.rho), m)
     for m in grid_methods:
+        clear_cache()
         for r in range(0, half(n) + 2):
             assert rescon.max_s(G, r, method=m) == o.s_star_of(r), (m, r)
             res1 = rescon.is_r_robust(G, r, method=m)
@@ -384,6 +387,7 @@ def test_random_graphs_forced_methods(G, data):
     method = data.draw(st.sampled_from(("search", "milp", "dp")))
     r = data.draw(st.integers(0, half(n) + 1))
     s = data.draw(st.integers(1, n))
+    clear_cache()  # the forced method computes the answer itself
     check_rs(G, rescon.is_rs_robust(G, r, s, method=method), r, s, o.holds(r, s))
     assert rescon.max_s(G, r, method=method) == o.s_star_of(r)
 
@@ -976,12 +980,14 @@ def test_regression_methods_agree(k):
     rho, ss = fast_oracle(G, rs=None)
     got = {}
     for m in ("dp", "search", "milp", "auto"):
+        clear_cache()  # each method computes, none reads another's cached facts
         rep = rescon.robustness(G, method=m)
         check_report(G, rep, rho, ss[rho], m)
         got[m] = (rep.r_max, rep.s_max)
     assert len(set(got.values())) == 1, got
     # the decision around rho and the s*(r) values, every method
     for m in ("dp", "search", "milp"):
+        clear_cache()
         assert rescon.is_r_robust(G, rho, method=m).holds is True
         res = rescon.is_r_robust(G, rho + 1, method=m)
         assert res.holds is False and pair_violates(G, *res.witness, rho + 1, 1)
