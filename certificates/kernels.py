@@ -39,6 +39,7 @@ from bisect import bisect_left, bisect_right
 from collections.abc import Callable
 from fractions import Fraction
 from itertools import combinations
+from operator import mul
 from typing import Any
 
 MAX_POINTS = 100_000  # resource limit on n
@@ -268,7 +269,7 @@ def _int_constraint(a: Vec, b: Fraction) -> tuple[list[int], int]:
 
 
 def _dot(a: list[int] | Vec, v: list[int] | Vec) -> Any:
-    return sum(x * y for x, y in zip(a, v))
+    return sum(map(mul, a, v))
 
 
 def _sub(u: list[int], v: list[int]) -> list[int]:
@@ -630,22 +631,23 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     d = len(P[0])
     T = [_scaled_test(v, D) for v in V]
     bits = 2 * max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
-    spent = _cost(len(V) * len(P) * (d + 2), bits)  # dv and the signs / pairs
+    spent = _cost(len(V) * len(P) * (d + 2), bits)  # the signs / pairs
     for (X, e), rows, name in zip(T, tight, names):
         if spent > MAX_EVAL_WORK:
             ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
                       f"({bits // 2}-bit numbers) need work > {MAX_EVAL_WORK}")
             return "halfspaces: not checked"
-        dv = [[e * t - x for t, x in zip(p, X)] for p in P]  # e·D·(p − v)
         if d == 2:
             y1, y2 = _edge_directions([], rows, 2)
             w1, w2 = _inward_normal(y1, y2), _inward_normal(y2, y1)
-            pairs = [(_dot(w1, u), _dot(w2, u)) for u in dv if any(u)]
+            c1, c2 = _dot(w1, X), _dot(w2, X)
+            pairs = [(e * _dot(w1, p) - c1, e * _dot(w2, p) - c2) for p in P]  # e·D·w·(p − v)
+            pairs = [st for st in pairs if st[0] or st[1]]
             count, tau = _arc_min(pairs)
-            count += len(dv) - len(pairs)  # points at v
+            count += len(P) - len(pairs)  # points at v
             w = tuple((1 - tau) * a + tau * b for a, b in zip(w1, w2))
         else:
-            base, crossing = _crossing(dv, rows)
+            base, crossing = _crossing(P, X, e, rows)
             spent += _cost(len(crossing) * (2 * len(crossing) + len(rows) ** 2), 2 * bits)
             if spent > MAX_EVAL_WORK:
                 continue  # recorded as unchecked at the top of the loop
@@ -694,19 +696,21 @@ def _arc_min(pairs: list[tuple[int, int]]) -> tuple[int, Fraction]:
     return best
 
 
-def _crossing(dv: list[list[int]], normals: list[list[int]]) -> tuple[int, list[list[int]]]:
-    """(number of points counted on every cell of int N_v, the crossing points) for
-    N_v = cone(normals) and dv = the points minus v (scaled): a point with a·u >= 0 for
-    every normal a is counted everywhere, one with all a·u < 0 nowhere (for w in int N_v),
-    the others cross."""
+def _crossing(P: list[list[int]], X: list[int], e: int, normals: list[list[int]]
+              ) -> tuple[int, list[list[int]]]:
+    """(number of points counted on every cell of int N_v, the crossing points as
+    u = e·p − X, i.e. e·D·(p − v)) for N_v = cone(normals), the points P and the vertex
+    v = X / e scaled by D: a point with a·u >= 0 for every normal a is counted
+    everywhere, one with all a·u < 0 nowhere (for w in int N_v), the others cross."""
     base = 0
     crossing: list[list[int]] = []
-    for u in dv:
-        s = [_dot(a, u) for a in normals]
+    cs = [_dot(a, X) for a in normals]
+    for p in P:
+        s = [e * _dot(a, p) - c for a, c in zip(normals, cs)]
         if min(s) >= 0:
             base += 1
         elif max(s) > 0:
-            crossing.append(u)
+            crossing.append([e * t - x for t, x in zip(p, X)])
     return base, crossing
 
 

@@ -1029,8 +1029,8 @@ def test_kernels_module_is_stdlib_only():
             mods.update(a.name.split(".")[0] for a in node.names)
         elif isinstance(node, ast.ImportFrom):
             mods.add((node.module or "").split(".")[0])
-    stdlib = {"__future__", "bisect", "collections", "fractions", "itertools", "math", "re",
-              "typing"}
+    stdlib = {"__future__", "bisect", "collections", "fractions", "itertools", "math",
+              "operator", "re", "typing"}
     assert mods <= stdlib, mods
     assert KERNEL_KINDS <= set(C.KINDS)
 
