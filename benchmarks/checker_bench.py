@@ -4,7 +4,8 @@
                                        [--before REV] [--timeout 300]
 
 For gaussian and sphere clouds (benchmarks/kernel_clouds.py, fixed seeds) in d = 2
-(n = 100, 1000) and d = 3 (n = 20, 30, 100), with F = ⌊n/10⌋ (every kernel nonempty),
+(n = 100, 1000) and d = 3 (n = 20, 30, 100), with F = ⌊n/10⌋ (every kernel nonempty;
+and F = 1 for n = 1000 points on the circle: a kernel with 1000 vertices),
 the standalone checker's wall time (``python certificates/check.py CERT``, a fresh
 process: start-up and JSON parsing included, median of ``--repeat`` runs) on
 
@@ -43,8 +44,10 @@ from .kernel_clouds import make_cloud
 ROOT = Path(__file__).resolve().parent.parent
 CHECKER_FILES = ("__init__.py", "check.py", "kernels.py", "redundancy.py")
 BEFORE = "df4ddbe"  # the last revision before the adjacency and the normal fan
-CASES = [("gaussian", 2, 100), ("gaussian", 2, 1000), ("sphere", 2, 1000),
-         ("gaussian", 3, 20), ("gaussian", 3, 30), ("gaussian", 3, 100), ("sphere", 3, 100)]
+#: (family, d, n, F); F = ⌊n/10⌋, and F = 1 on the circle (a kernel with n vertices)
+CASES = [("gaussian", 2, 100, 10), ("gaussian", 2, 1000, 100), ("sphere", 2, 1000, 100),
+         ("sphere", 2, 1000, 1), ("gaussian", 3, 20, 2), ("gaussian", 3, 30, 3),
+         ("gaussian", 3, 100, 10), ("sphere", 3, 100, 10)]
 TARGET_S = 5.0
 
 
@@ -82,8 +85,7 @@ def bench(repeat: int, before: str, timeout: float) -> list[dict]:
         tmpdir = Path(tmp)
         old = _old_checker(before, tmpdir)
         new = ROOT / "certificates" / "check.py"
-        for family, d, n in CASES:
-            F = n // 10
+        for family, d, n, F in CASES:
             load0 = os.getloadavg()[0]
             X = make_cloud(family, d, n, F).X
             t0 = time.perf_counter()
