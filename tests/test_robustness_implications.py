@@ -230,3 +230,32 @@ def test_progress_names_every_phase_on_stderr_only(capfd):
     rescon.robustness(G, progress=False)
     out, err = capfd.readouterr()
     assert out == "" and err == ""
+
+
+class _FakeMilp:
+    def __init__(self) -> None:
+        self.t0, self.alive = 0.0, False
+
+    def started(self) -> bool:
+        return self.t0 > 0.0
+
+    def start(self) -> None:
+        self.t0, self.alive = 1.0, True
+
+    def running(self) -> bool:
+        return self.alive
+
+
+def test_race_starts_the_milp_only_after_the_delay(monkeypatch):
+    import time
+
+    from rescon.graphs import robustness as rb
+
+    monkeypatch.setattr(rb, "RACE_DELAY_SECONDS", 0.05)
+    milp = _FakeMilp()
+    stop = rb._rival(milp)
+    assert stop() is False and not milp.started()  # short searches never meet the MILP
+    time.sleep(0.06)
+    assert stop() is False and milp.started()
+    milp.alive = False  # the MILP answered: the search stops
+    assert stop() is True

@@ -139,6 +139,9 @@ class RobustnessMilp:
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
+    def started(self) -> bool:
+        return self._t0 > 0.0
+
     def cancel(self) -> None:
         """Stop a background solve (through HiGHS's interrupt callback) and wait."""
         if self._thread is not None:
