@@ -34,7 +34,7 @@ def small_graphs(count: int, seed: int) -> list[nx.Graph]:
     rng = random.Random(seed)
     out = []
     for k in range(count):
-        n = rng.randint(3, 7)
+        n = rng.randint(3, 8)
         G = nx.gnp_random_graph(n, rng.uniform(0.3, 0.95), directed=rng.random() < 0.6,
                                 seed=seed * 1000 + k)
         out.append(G)
