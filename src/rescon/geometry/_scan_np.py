@@ -17,7 +17,7 @@ from math import comb
 
 import numpy as np
 
-__all__ = ["HUGE", "TINY", "classify", "in_range", "k_subsets"]
+__all__ = ["HUGE", "TINY", "classify", "in_range", "k_subsets", "sets_in_range"]
 
 #: nonzero |coordinates| must lie in [TINY, HUGE] for the expansion predicates of
 #: :mod:`._expansions` to be exact: then products of up to four differences neither
@@ -29,6 +29,12 @@ def in_range(Y: np.ndarray) -> bool:
     """Every nonzero |coordinate| in [TINY, HUGE] (:func:`._expansions.in_range`)."""
     a = np.abs(Y)
     return bool(np.all((a == 0.0) | ((a >= TINY) & (a <= HUGE))))
+
+
+def sets_in_range(Ys: np.ndarray) -> np.ndarray:
+    """:func:`in_range` for each set Ys[b] of a stack (B, m, d), as a boolean (B,)."""
+    a = np.abs(Ys)
+    return np.all((a == 0.0) | ((a >= TINY) & (a <= HUGE)), axis=(1, 2))
 
 
 def k_subsets(n: int, k: int) -> np.ndarray:

@@ -33,10 +33,10 @@ from ._expansions import (
     cross,
     difference,
     exact_mean,
-    in_range,
     orient,
     side_of_meet,
 )
+from ._scan_np import sets_in_range
 
 OK = 0
 #: a batch answer x is used only if its certified error bound is at most this times
@@ -51,20 +51,106 @@ CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED, OUT_OF_RANGE = 2, 3, 4, 5
 
 
 @njit(cache=True, nogil=True)
+def _insertion_sort(a, R, low, high):
+    """Sort R[low:high + 1] by the keys a[R[·]], stably (the runs of ``_argsort``)."""
+    for i in range(low + 1, high + 1):
+        k = R[i]
+        v = a[k]
+        j = i
+        while j > low and v < a[R[j - 1]]:
+            R[j] = R[j - 1]
+            j -= 1
+        R[j] = k
+
+
+@njit(cache=True, nogil=True)
+def _partition(a, R, low, high):
+    """Partition R[low:high + 1] by the keys a[R[·]] around the median of its first,
+    middle and last key; returns the pivot's final index (``_argsort``'s step)."""
+    mid = (low + high) >> 1
+    if a[R[mid]] < a[R[low]]:
+        R[low], R[mid] = R[mid], R[low]
+    if a[R[high]] < a[R[mid]]:
+        R[high], R[mid] = R[mid], R[high]
+    if a[R[mid]] < a[R[low]]:
+        R[low], R[mid] = R[mid], R[low]
+    pivot = a[R[mid]]
+    R[high], R[mid] = R[mid], R[high]
+    i = low
+    j = high - 1
+    while True:
+        while i < high and a[R[i]] < pivot:
+            i += 1
+        while j >= low and pivot < a[R[j]]:
+            j -= 1
+        if i >= j:
+            break
+        R[i], R[j] = R[j], R[i]
+        i += 1
+        j -= 1
+    R[i], R[high] = R[high], R[i]
+    return i
+
+
+@njit(cache=True, nogil=True)
+def _argsort(a):
+    """np.argsort(a) for finite a, exactly as numba's own (its quicksort: partitions
+    while a run has 16 keys or more, the larger part pushed, then insertion sort), ties
+    in the same order — written out because the generic one takes seconds to compile.
+    The stack holds at most log2(n) runs (each push halves what is left)."""
+    n = a.shape[0]
+    R = np.arange(n)
+    lows = np.empty(64, dtype=np.int64)
+    highs = np.empty(64, dtype=np.int64)
+    lows[0], highs[0] = 0, n - 1
+    top = 1 if n >= 2 else 0
+    while top > 0:
+        top -= 1
+        low, high = lows[top], highs[top]
+        while high - low >= 15:
+            i = _partition(a, R, low, high)
+            if high - i > i - low:
+                if high > i:
+                    lows[top], highs[top] = i + 1, high
+                    top += 1
+                high = i - 1
+            else:
+                if i > low:
+                    lows[top], highs[top] = low, i - 1
+                    top += 1
+                low = i + 1
+        _insertion_sort(a, R, low, high)
+    return R
+
+
+@njit(cache=True, nogil=True)
+def _sorted_column(Y, c):
+    """Column c of Y (a fresh array) and its ``_argsort`` order."""
+    col = np.empty(Y.shape[0])
+    for q in range(Y.shape[0]):
+        col[q] = Y[q, c]
+    return col, _argsort(col)
+
+
+@njit(cache=True, nogil=True)
 def cluster_box(Y, F, out):
     """Ψ(Y, F) ⊂ conv(S) ⊂ box(S) for every m − F of the points S (Ψ is the intersection
     of those hulls): with S the m − F points nearest the coordinate-wise median (max
     norm), the point of S nearest it is within w — box(S)'s largest side, rounded up —
     of every point of Ψ, the exact projection included (max norm). Writes that point,
-    returns w; converged states make w a few ulps whatever the set's degeneracy."""
+    returns w; converged states make w a few ulps whatever the set's degeneracy.
+    (Y finite; the median is np.median's, the order np.argsort's, ties included.)"""
     m, d = Y.shape
     med = np.empty(d)
     for c in range(d):
-        med[c] = np.median(Y[:, c])
-    dist = np.empty(m)
+        col, rank = _sorted_column(Y, c)
+        h = m >> 1
+        med[c] = col[rank[h]] if m & 1 else (col[rank[h - 1]] + col[rank[h]]) / 2
+    dist = np.zeros(m)
     for q in range(m):
-        dist[q] = np.abs(Y[q] - med).max()
-    order = np.argsort(dist)
+        for c in range(d):
+            dist[q] = max(dist[q], abs(Y[q, c] - med[c]))
+    order = _argsort(dist)
     w = 0.0
     for c in range(d):
         lo = hi = Y[order[0], c]
@@ -72,7 +158,7 @@ def cluster_box(Y, F, out):
             lo = min(lo, Y[order[r], c])
             hi = max(hi, Y[order[r], c])
         w = max(w, hi - lo)
-    out[:] = Y[order[0]]
+        out[c] = Y[order[0], c]
     return w * (1.0 + 2.0 * EPS)
 
 
@@ -157,8 +243,8 @@ def _collinear(Y, F, rep, mean, merr, out):
     on the line) is the mean clamped to it. Returns its error bound; −1 when the mean's
     position against an end is undecided or Ψ is empty, −2 when not collinear."""
     m = Y.shape[0]
-    i0 = 0
-    j0 = -1
+    i0 = rep[0]
+    j0 = np.int64(-1)  # (typed int64: a literal would compile _orient once more)
     for q in range(m):
         if rep[q] == q and q != i0:
             if j0 < 0:
@@ -166,8 +252,8 @@ def _collinear(Y, F, rep, mean, merr, out):
             elif _orient(Y, i0, j0, q) != 0:
                 return -2.0
     p = 0 if Y[j0, 0] != Y[i0, 0] else 1
-    vals = np.sort(Y[:, p])
-    lo, hi = vals[F], vals[m - 1 - F]
+    col, rank = _sorted_column(Y, p)
+    lo, hi = col[rank[F]], col[rank[m - 1 - F]]
     if lo > hi:
         return -1.0
     mp = mean[p]
@@ -401,7 +487,7 @@ def _project(P, E, EL, nv, Y, ends, box, m0, m1, merr, out):
     if inside and undecided:
         return -1.0
     best = np.inf
-    bv = 0
+    bv = np.int64(0)  # (not a literal: that would compile _edge_nearest twice)
     bt = 0.0
     for v in range(nv):
         w = (v + 1) % nv
@@ -484,25 +570,30 @@ def _edge_nearest(P, E, EL, nv, v, Y, ends, box, m0, m1, merr, out):
     return merr + 16.0 * EPS * dm + 4.0 * EPS * max(abs(out[0]), abs(out[1]))
 
 
+#: for each of 4 points, the other three (ascending)
+_OTHERS = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))
+#: (0, j) and the other two points, for each j: (0, j) is a diagonal of 4 points in
+#: convex position iff those two lie on opposite sides of it
+_DIAGONALS = ((0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2))
+
+
 @njit(cache=True, nogil=True)
 def _radon4(Y, out):
     """Ψ(Y, 1) for 4 points in general position is one point: the crossing of the
     diagonals (convex position) or the point inside the triangle of the others.
     Returns its error bound, or −1 when an orientation is undecided."""
-    tri = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))
     for k in range(4):
-        if _orient(Y, tri[k][0], tri[k][1], tri[k][2]) == 0:
+        a, b, c = _OTHERS[k]
+        if _orient(Y, a, b, c) == 0:
             return -1.0
     for k in range(4):
         if _inside(Y, k):
             out[0] = Y[k, 0]
             out[1] = Y[k, 1]
             return 0.0
-    # convex position: (0, j) is a diagonal iff the other two lie on opposite sides
-    for j in (1, 2, 3):
-        others = [q for q in (1, 2, 3) if q != j]
-        if _orient(Y, 0, j, others[0]) * _orient(Y, 0, j, others[1]) < 0:
-            return _crossing(Y, 0, j, others[0], others[1], out)
+    for a, j, c, d in _DIAGONALS:
+        if _orient(Y, a, j, c) * _orient(Y, a, j, d) < 0:
+            return _crossing(Y, a, j, c, d, out)
     return -1.0
 
 
@@ -538,18 +629,80 @@ def _crossing(Y, a, b, c, d, out):
 @njit(cache=True, nogil=True)
 def _inside(Y, k):
     """Point k strictly inside the triangle of the other three (decided orientations)."""
-    idx = [q for q in range(4) if q != k]
-    s0 = _orient(Y, idx[0], idx[1], k)
-    s1 = _orient(Y, idx[1], idx[2], k)
-    s2 = _orient(Y, idx[2], idx[0], k)
+    a, b, c = _OTHERS[k]
+    s0 = _orient(Y, a, b, k)
+    s1 = _orient(Y, b, c, k)
+    s2 = _orient(Y, c, a, k)
     return s0 != 0 and s0 == s1 and s1 == s2
 
 
-@njit(cache=True, nogil=True)
-def project_small_2d(Ys, F, out, err, status):
+def project_small_2d(Ys: np.ndarray, F: int, out: np.ndarray, err: np.ndarray,
+                     status: np.ndarray) -> None:
     """For each problem b: the point of Ψ(Ys[b], F) nearest to mean(Ys[b]) into out[b],
-    its error bound into err[b], status OK or the reason to compute it exactly."""
+    its error bound into err[b], status OK or the reason to compute it exactly.
+
+    Ys (B, m, 2) float64, C-contiguous; out (B, 2), err (B,), status (B,) int64. The
+    steps are kernels of their own, each run on the sets still open (and compiled only
+    when some set reaches it): converged clusters (m ≥ 3F + 1), the range check, the
+    Radon point of 4 points for F = 1, then halfplanes, clipping and projection."""
     B, m, _ = Ys.shape
+    status[:] = FLAT
+    todo = np.arange(B)
+    if m >= 3 * F + 1:  # (Ψ ≠ ∅) a converged cluster: any of its points will do
+        _clusters(Ys, todo, F, out, err, status)
+        todo = todo[status[todo] != OK]
+    fits = sets_in_range(Ys[todo])
+    status[todo[~fits]] = OUT_OF_RANGE
+    todo = todo[fits]
+    if m == 4 and F == 1 and len(todo):  # in general position Ψ is one (Radon) point
+        _radon_points(Ys, todo, out, err, status)
+        todo = todo[status[todo] != OK]
+    if len(todo):
+        _polygons(Ys, todo, F, out, err, status)
+
+
+@njit(cache=True, nogil=True)
+def _bounding_box(Y):
+    """[min x, max x, min y, max y] over the rows of Y."""
+    box = np.empty(4)
+    box[0] = box[1] = Y[0, 0]
+    box[2] = box[3] = Y[0, 1]
+    for q in range(1, Y.shape[0]):
+        for c in range(2):
+            if Y[q, c] < box[2 * c]:
+                box[2 * c] = Y[q, c]
+            if Y[q, c] > box[2 * c + 1]:
+                box[2 * c + 1] = Y[q, c]
+    return box
+
+
+@njit(cache=True, nogil=True)
+def _clusters(Ys, todo, F, out, err, status):
+    """cluster_box for the sets todo; OK where its width is at most ACCEPT_REL of the
+    point's magnitude."""
+    for b in todo:
+        e = cluster_box(Ys[b], F, out[b])
+        if e <= ACCEPT_REL * max(abs(out[b, 0]), abs(out[b, 1])):
+            err[b] = e
+            status[b] = OK
+
+
+@njit(cache=True, nogil=True)
+def _radon_points(Ys, todo, out, err, status):
+    """_radon4 for the sets todo (m = 4, F = 1); OK where it is decided."""
+    for b in todo:
+        e = _radon4(Ys[b], out[b])
+        if e >= 0:
+            err[b] = e
+            status[b] = OK
+
+
+@njit(cache=True, nogil=True)
+def _polygons(Ys, todo, F, out, err, status):
+    """The general path for the sets todo (status FLAT on entry): a single point, a
+    collinear set, a pinned point, else the polygon cut from the bounding box by the
+    valid halfplanes and its point nearest the exact mean."""
+    _, m, _ = Ys.shape
     H = m * (m - 1)
     A = np.empty((H, 2))
     C = np.empty(H)
@@ -573,24 +726,8 @@ def project_small_2d(Ys, F, out, err, status):
     QVB = np.empty(cap, dtype=np.int64)
     mean = np.empty(2)
     merrs = np.empty(2)
-    for b in range(B):
+    for b in todo:
         Y = Ys[b]
-        if m >= 3 * F + 1:  # (Ψ ≠ ∅) a converged cluster: any of its points will do
-            e = cluster_box(Y, F, out[b])
-            if e <= ACCEPT_REL * np.abs(out[b]).max():
-                err[b] = e
-                status[b] = OK
-                continue
-        if not in_range(Y):
-            status[b] = OUT_OF_RANGE
-            continue
-        if m == 4 and F == 1:  # in general position Ψ is one (Radon) point
-            e = _radon4(Y, out[b])
-            if e >= 0:
-                err[b] = e
-                status[b] = OK
-                continue
-        status[b] = FLAT
         exact_mean(Y, mean, merrs)  # (the exact mean rounded: 2 ulps of itself)
         merr = max(merrs[0], merrs[1])
         if _representatives(Y, rep) == 1:  # every point the same: Ψ is that point
@@ -611,8 +748,8 @@ def project_small_2d(Ys, F, out, err, status):
             err[b] = 0.0
             status[b] = OK
             continue
-        lo0, hi0 = Y[:, 0].min(), Y[:, 0].max()
-        lo1, hi1 = Y[:, 1].min(), Y[:, 1].max()
+        box = _bounding_box(Y)
+        lo0, hi0, lo1, hi1 = box[0], box[1], box[2], box[3]
         P[0, 0], P[0, 1] = lo0, lo1
         P[1, 0], P[1, 1] = hi0, lo1
         P[2, 0], P[2, 1] = hi0, hi1
@@ -627,8 +764,7 @@ def project_small_2d(Ys, F, out, err, status):
             EL[k] = -1 - k  # box side k: edge k → k+1 (bottom, right, top, left)
             VA[k] = -1 - k
             VB[k] = -1 - (k + 3) % 4  # corner k is on sides k and k − 1
-        box = np.array([lo0, hi0, lo1, hi1])
-        nv = 4
+        nv = np.int64(4)  # (not a literal: that would compile _clip twice)
         for h in range(nh):
             nq = _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
                        Q, QE, QPT, QEL, QVA, QVB)
