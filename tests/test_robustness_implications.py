@@ -259,3 +259,14 @@ def test_race_starts_the_milp_only_after_the_delay(monkeypatch):
     assert stop() is False and milp.started()
     milp.alive = False  # the MILP answered: the search stops
     assert stop() is True
+
+
+def test_milp_progress_names_the_phase_and_counts_nodes(capfd):
+    """Beyond the search's reach (n > 64 takes the MILP) the bar is not stuck at a bare
+    0: the phase is named and HiGHS's branch-and-bound nodes are counted."""
+    G = nx.gnp_random_graph(70, 0.2, directed=True, seed=1)  # ρ's MILP runs ≫ 2 s
+    rep = rescon.robustness(G, progress=True, time_limit=2)
+    assert not rep.exact and rep.method == "milp"
+    out, err = capfd.readouterr()
+    assert out == ""
+    assert "ρ MILP (r=" in err and " nodes" in err

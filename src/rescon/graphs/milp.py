@@ -16,9 +16,12 @@ omitted for r-robustness where every member must be closed).
 
 from __future__ import annotations
 
+import math
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -77,6 +80,9 @@ def _rows(ig: IndexedGraph, r: int, with_y: bool):
     return rows
 
 
+PROGRESS_SECONDS = 0.2
+
+
 class RobustnessMilp:
     """The robustness MILP, built once, solved synchronously or in the background.
 
@@ -85,11 +91,14 @@ class RobustnessMilp:
     model has no y: it asks whether two disjoint nonempty r-closed sets exist, i.e.
     whether G is *not* r-robust. Infeasible means every such pair costs ≥ ``upper``.
     ``start()`` runs HiGHS in its own thread (HiGHS releases the GIL), so the
-    combinatorial search can race it on the other core.
+    combinatorial search can race it on the other core. ``on_progress`` (from HiGHS's
+    thread, at most every ``PROGRESS_SECONDS``) gets the dual bound's share of
+    [lower, upper] and the branch-and-bound nodes so far.
     """
 
     def __init__(self, ig: IndexedGraph, r: int, *, upper: int, lower: int = 0,
-                 decision_only: bool = False, time_limit: float | None = None) -> None:
+                 decision_only: bool = False, time_limit: float | None = None,
+                 on_progress: Callable[[float, int], None] | None = None) -> None:
         require_backend("highs", "MILP")
         import highspy
 
@@ -128,6 +137,21 @@ class RobustnessMilp:
         self.h = h
         self._thread = None
         self._t0 = 0.0
+        if on_progress is not None:
+            self._span = (lower, max(upper - lower, 1), on_progress)
+            self._last = 0.0
+            h.cbMipInterrupt.subscribe(self._report)
+
+    def _report(self, event: Any) -> None:
+        """HiGHS's MIP callback → ``on_progress`` (throttled)."""
+        now = time.perf_counter()
+        if now - self._last < PROGRESS_SECONDS:
+            return
+        self._last = now
+        lower, span, on_progress = self._span
+        dual = event.data_out.mip_dual_bound
+        share = min(max((dual - lower) / span, 0.0), 1.0) if math.isfinite(dual) else 0.0
+        on_progress(share, int(event.data_out.mip_node_count))
 
     def start(self) -> None:
         """Solve in a thread of our own (highspy's startSolve shares class-level locks
@@ -187,7 +211,8 @@ def milp_min_cost(
     lower: int = 0,
     decision_only: bool = False,
     time_limit: float | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
 ) -> MilpOutcome:
     """Solve :class:`RobustnessMilp` and wait for the answer."""
     return RobustnessMilp(ig, r, upper=upper, lower=lower, decision_only=decision_only,
-                          time_limit=time_limit).outcome()
+                          time_limit=time_limit, on_progress=on_progress).outcome()

@@ -275,7 +275,8 @@ def _decide_r_fresh(
         assert pair is not None
         return _Decision(False, pair=pair, method="dp")
     return _milp_decision(ig, r, milp_min_cost(ig, r, upper=1, decision_only=True,
-                                               time_limit=_remaining(deadline)))
+                                               time_limit=_remaining(deadline),
+                                               on_progress=on_progress))
 
 
 def _search_decision(out: SearchOutcome) -> _Decision:
@@ -456,8 +457,8 @@ def _s_star_fresh(
     if method == "search":
         found = _deepening_search(ig, r, lower, upper, deadline, on_progress=on_progress)
         return _cost_search_result(ig, r, found, lower, upper, proof, pair)
-    return _milp_s_result(ig, r, _milp_s(ig, r, lower, upper, deadline).outcome(), lower, upper,
-                          proof, pair)
+    milp = _milp_s(ig, r, lower, upper, deadline, on_progress)
+    return _milp_s_result(ig, r, milp.outcome(), lower, upper, proof, pair)
 
 
 DESCENT_SECONDS = 0.25  # budget of the local search for cheap pairs (bounds.descended_pairs)
@@ -476,9 +477,10 @@ def _descended_upper(ig: IndexedGraph, r: int, upper: int, pair: bd.Pair | None,
     return upper, pair
 
 
-def _milp_s(ig: IndexedGraph, r: int, lower: int, upper: int,
-            deadline: float | None) -> RobustnessMilp:
-    return RobustnessMilp(ig, r, lower=lower, upper=upper, time_limit=_remaining(deadline))
+def _milp_s(ig: IndexedGraph, r: int, lower: int, upper: int, deadline: float | None,
+            on_progress: Callable[[float, int], None] | None = None) -> RobustnessMilp:
+    return RobustnessMilp(ig, r, lower=lower, upper=upper, time_limit=_remaining(deadline),
+                          on_progress=on_progress)
 
 
 def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper: int,
