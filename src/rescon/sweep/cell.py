@@ -97,7 +97,10 @@ def _robustness(spec: dict[str, Any], path: Path, epsilon: float) -> dict[str, A
     from ..graphs.robustness import robustness
 
     opts = spec.get("robustness", {})
-    G = _graph(spec.get("graph", {}), path.parent, "[graph]", 0)
+    graph = dict(spec.get("graph", {}))
+    if "generator" not in graph:  # a file or edge list draws nothing from the cell's seed
+        graph.pop("seed", None)
+    G = _graph(graph, path.parent, "[graph]", 0)
     rep = robustness(G, method=opts.get("method", "auto"),
                      time_limit=opts.get("time_limit"), progress=False)
     return {"rho": rep.r_max, "s_star": rep.s_max, "exact": rep.exact,
