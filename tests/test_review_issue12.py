@@ -3,9 +3,15 @@ files and generated graphs, CLI contracts, figures of odd trajectories."""
 
 from __future__ import annotations
 
+import socket
+import threading
+import time
 from pathlib import Path
 
+import pytest
+
 import rescon
+from rescon import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_GRAPH = ROOT / "examples" / "graphs" / "paper_example.edgelist"
@@ -19,3 +25,29 @@ def test_robustness_cells_of_a_graph_file_run_every_repetition():
     assert list(table["status"]) == ["ok", "ok"], list(table["error"])
     assert list(table["rho"]) == [5, 5] and list(table["s_star"]) == [1, 1]
     assert list(table["certificate_verdict"]) == ["valid", "valid"]
+
+
+def test_a_server_that_is_not_a_dask_scheduler_is_a_clear_error():
+    """An address where something else answers (here: an HTTP-like reply, whose first
+    bytes Dask reads as a frame length of ~3 EiB) is "cannot connect", not a
+    MemoryError."""
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen()
+
+    def answer() -> None:
+        conn, _ = srv.accept()
+        with conn:
+            conn.sendall(b"HTTP/1.1 400 Bad Request\r\n\r\n" * 4)
+            time.sleep(1)
+
+    threading.Thread(target=answer, daemon=True).start()
+    grid = {"base": {"points": {"generator": "gaussian", "n": 5, "d": 2},
+                     "kernel": {"F": 1}}, "run": {"kind": "kernel"}}
+    t0 = time.monotonic()
+    try:
+        with pytest.raises(InputError, match="cannot connect"):
+            rescon.sweep(grid, scheduler=f"tcp://127.0.0.1:{srv.getsockname()[1]}")
+    finally:
+        srv.close()
+    assert time.monotonic() - t0 < 20

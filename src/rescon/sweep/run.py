@@ -115,7 +115,8 @@ def _client(scheduler: str | None, workers: int | None) -> Any:
                              f"{scheduler!r}")
         try:
             return Client(scheduler, timeout=CONNECT_SECONDS)
-        except (OSError, TimeoutError, ValueError) as exc:
+        except Exception as exc:  # noqa: BLE001 (whatever answers there may be no Dask
+            # scheduler: an HTTP reply read as a frame length is a MemoryError)
             raise InputError(f"scheduler {scheduler}: cannot connect ({type(exc).__name__}: "
                              f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
     n = workers if workers is not None else (os.cpu_count() or 1)
