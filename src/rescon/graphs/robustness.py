@@ -754,7 +754,8 @@ def _decide_rs(ig: IndexedGraph, r: int, s: int, method: str, deadline: float | 
                seeds: list[list[int]], r_proof: Proof) -> _Decision:
     """(r, s)-robust, for r-robust ig (r ≥ 1, s ≥ 2)? In this order: the cached facts
     (implications, known pairs), (r + s − 1)-robustness (⇒ (r, s), facts.py; decided
-    within ``IMPLIED_SEARCH_SECONDS``), then the exact min(s*(r), s)."""
+    within ``IMPLIED_SEARCH_SECONDS``; not with the DP, which settles min(s*(r), s)
+    in one uninterruptible pass anyway), then the exact min(s*(r), s)."""
     facts = facts_for(ig)
     known = facts.lower(r)
     if known is not None and known[0] >= s:
@@ -762,7 +763,7 @@ def _decide_rs(ig: IndexedGraph, r: int, s: int, method: str, deadline: float | 
     refuted = facts.upper(r)
     if refuted is not None and refuted[0] < s:
         return _Decision(False, pair=refuted[1])
-    if r + s - 1 <= (ig.n + 1) // 2:
+    if r + s - 1 <= (ig.n + 1) // 2 and method != "dp":
         stop = time.perf_counter() + IMPLIED_SEARCH_SECONDS
         strong = _decide_r(ig, r + s - 1, method, stop if deadline is None else
                            min(stop, deadline), seeds)
