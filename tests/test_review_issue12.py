@@ -51,3 +51,28 @@ def test_a_server_that_is_not_a_dask_scheduler_is_a_clear_error():
     finally:
         srv.close()
     assert time.monotonic() - t0 < 20
+
+
+@pytest.mark.parametrize("graph", [
+    {"generator": "complete", "n": 100_000},
+    {"generator": "erdos_renyi", "n": 1_000_000, "p": 1e-5},  # draws every pair
+    {"generator": "two_cliques", "n": 20_000, "b": 1},
+    {"generator": "random_geometric", "n": 200_000, "radius": 0.9},
+])
+def test_huge_generated_graphs_are_refused_before_they_are_built(graph):
+    """A size a grid axis can reach by a typo must not fill the shared machine's memory
+    (K_100000 took 36 s to die of MemoryError under a 4 GB limit)."""
+    from rescon.graphs.named import generate
+
+    t0 = time.monotonic()
+    with pytest.raises(InputError, match=f"generator '{graph['generator']}' with n = "):
+        generate(graph, 0)
+    assert time.monotonic() - t0 < 1
+
+
+def test_generated_graphs_of_ordinary_size_are_built():
+    from rescon.graphs.named import generate
+
+    assert generate({"generator": "complete", "n": 2000}, 0).number_of_nodes() == 2000
+    G = generate({"generator": "erdos_renyi", "n": 5000, "p": 0.001}, 0)
+    assert G.number_of_nodes() == 5000

@@ -21,6 +21,9 @@ Parameters come from the table itself and from a sub-table named after the gener
 (``[graph.circulant] k = 4``), so a sweep axis over ``graph.generator`` can give each
 generator its own parameters; keys of the other generators' sub-tables are ignored.
 Randomness: ``numpy.random.default_rng([seed, 1])`` (stream 1 of the scenario seed).
+A graph whose estimated size exceeds the one budget (:mod:`rescon.geometry._budget`:
+links × :data:`LINK_BYTES` bytes, node pairs drawn in Python) is refused before it is
+built, with the estimate in the message.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ import numpy as np
 
 from .._validate import integer, real
 from ..errors import InputError
+from ..geometry._budget import PYTHON_STEP, require
 from . import generators as gen
 
 __all__ = ["GENERATORS", "generate"]
@@ -87,6 +91,24 @@ GENERATORS: dict[str, tuple[Callable[[dict, np.random.Generator], nx.Graph],
 }
 _INTEGERS = {"n": 2, "m": 1, "k": 1, "b": 0, "dim": 1}
 _FLAGS = {"directed"}
+#: bytes of one directed link of a networkx graph (measured: ~140 per undirected edge
+#: stored twice, ~210 per DiGraph edge), with room for the copies a scenario makes
+LINK_BYTES = 256
+
+
+def _size(name: str, p: dict) -> tuple[float, float]:
+    """(links, pair draws): upper estimates of the directed links of generator ``name``
+    (an undirected edge counts twice) and of the node pairs it draws in Python
+    (G(n, p) draws all n(n − 1)/2 pairs whatever p)."""
+    n = p["n"]
+    links = {"ba_robust": lambda: 2 * p["m"] * n + 4 * p["m"] ** 2,
+             "directed_growth": lambda: p["k"] * n + 4 * p["k"] ** 2,
+             "circulant": lambda: 2 * p["k"] * n,
+             "two_cliques": lambda: n * n / 2 + p["b"] * n,
+             "erdos_renyi": lambda: p["p"] * n * n,
+             "random_geometric": lambda: n * n * min(1.0, (2 * p["radius"]) ** p.get("dim", 2)),
+             "complete": lambda: n * n}[name]()
+    return links, (n * n / 2 if name == "erdos_renyi" else links)
 
 
 def generate(table: Mapping[str, Any], seed: int, *, where: str = "graph") -> nx.Graph:
@@ -113,6 +135,9 @@ def generate(table: Mapping[str, Any], seed: int, *, where: str = "graph") -> nx
     if missing:
         raise InputError(f"{where}: generator {name!r} needs {', '.join(missing)}")
     checked = {k: _param(k, v, where) for k, v in params.items()}
+    links, draws = _size(name, checked)
+    require(f"{where}: generator {name!r} with n = {checked['n']} (~{links:.2g} links)",
+            draws * PYTHON_STEP, links * LINK_BYTES, "reduce n (or the degree)")
     seed = integer(f"{where}: seed", table.get("seed", seed), low=0)
     try:
         return build(checked, np.random.default_rng([seed, GRAPH_STREAM]))
