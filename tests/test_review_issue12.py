@@ -76,3 +76,15 @@ def test_generated_graphs_of_ordinary_size_are_built():
     assert generate({"generator": "complete", "n": 2000}, 0).number_of_nodes() == 2000
     G = generate({"generator": "erdos_renyi", "n": 5000, "p": 0.001}, 0)
     assert G.number_of_nodes() == 5000
+
+
+def test_random_states_and_clouds_beyond_the_memory_budget_are_refused():
+    """12 random states in dimension 3e7 (2.7 GiB) or a 1e8-point cloud in R³ are
+    refused with the estimate, not drawn into memory first."""
+    from rescon.consensus.scenario import _random_states
+    from rescon.sweep.clouds import cloud
+
+    with pytest.raises(InputError, match="12 states in dimension 30000000"):
+        _random_states({"low": 0, "high": 1, "d": 30_000_000}, 12, 0, "random")
+    with pytest.raises(InputError, match="100000000 points in dimension 3"):
+        cloud({"generator": "gaussian", "n": 100_000_000, "d": 3})

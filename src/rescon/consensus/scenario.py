@@ -28,6 +28,7 @@ import numpy as np
 
 from .._validate import integer, positive, real
 from ..errors import InputError
+from ..geometry._budget import require
 from .adversaries import Behaviour, behaviour_from_dict, paper_adversaries
 from .dos import DoSAttack, _attacks, attack_from_dict, paper_attacks
 
@@ -674,6 +675,7 @@ def _random_states(box: Mapping, n: int, seed: int, where: str) -> np.ndarray:
         raise InputError(f"{where}: needs finite low <= high; got low = {box['low']!r}, "
                          f"high = {box['high']!r}")
     seed = integer(f"{where} seed", box.get("seed", seed), low=0)
+    require(f"{where}: {n} states in dimension {d}", n * d, 8 * n * d, "reduce d")
     return np.random.default_rng([seed, 2]).uniform(low, high, size=(n, d))
 
 

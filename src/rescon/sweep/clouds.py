@@ -18,6 +18,7 @@ import numpy as np
 
 from .._validate import integer
 from ..errors import InputError
+from ..geometry._budget import require
 
 __all__ = ["CLOUDS", "cloud"]
 
@@ -56,4 +57,5 @@ def cloud(table: Mapping[str, Any], *, where: str = "points") -> np.ndarray:
     n = integer(f"{where}: n", table["n"], low=1)
     d = integer(f"{where}: d", table["d"], low=1)
     seed = integer(f"{where}: seed", table.get("seed", 0), low=0)
+    require(f"{where}: {n} points in dimension {d}", n * d, 8 * n * d, "reduce n or d")
     return CLOUDS[name](np.random.default_rng([seed, POINTS_STREAM]), n, d)
