@@ -88,3 +88,29 @@ def test_random_states_and_clouds_beyond_the_memory_budget_are_refused():
         _random_states({"low": 0, "high": 1, "d": 30_000_000}, 12, 0, "random")
     with pytest.raises(InputError, match="100000000 points in dimension 3"):
         cloud({"generator": "gaussian", "n": 100_000_000, "d": 3})
+
+
+def _summary_figure(monkeypatch, tmp_path, grid):
+    """The summary figure a sweep of ``grid`` draws (caught before it is closed)."""
+    import matplotlib.pyplot as plt
+
+    figures = []
+    monkeypatch.setattr(plt, "close", figures.append)
+    rescon.sweep(grid, workers=0, out=tmp_path / "out")
+    assert len(figures) == 1
+    return figures[0]
+
+
+def test_summary_of_failed_cells_names_every_axis_value_and_says_why_it_is_empty(
+        monkeypatch, tmp_path):
+    """Every cell failed (F ≥ n): the mean panel still lists every axis value, its y
+    axis does not run below 0 (seconds, steps), and it says there is no value."""
+    grid = {"base": {"points": {"generator": "gaussian", "n": 5, "d": 2},
+                     "kernel": {"F": 9}},
+            "axes": {"points.n": [5, 6, 7]}, "run": {"kind": "kernel"}}
+    fig = _summary_figure(monkeypatch, tmp_path, grid)
+    rate, mean = fig.axes
+    for ax in (rate, mean):
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["5", "6", "7"]
+    assert mean.get_ylim()[0] >= 0
+    assert any("no value" in t.get_text() for t in mean.texts)

@@ -10,6 +10,7 @@ grid there is refused.
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -260,10 +261,18 @@ def _plot(table: Any, axes: Mapping[str, list[Any]], kind: str, folder: Path) ->
         labels = [str(v) for v in table[key]]
         order = list(dict.fromkeys(labels))
         rows = [[x == v for x in labels] for v in order]
-        ax[0, j].bar(order, [hits[r].mean() for r in rows])
-        ax[0, j].set(ylim=(0, 1), ylabel=rate_label, title=key)
-        ax[1, j].plot(order, [values[r].mean() for r in rows], "o-")
-        ax[1, j].set(xlabel=key, ylabel=mean_label)
+        ticks = range(len(order))  # positions, not categories: a NaN mean keeps its tick
+        means = [values[r].mean() for r in rows]
+        ax[0, j].bar(ticks, [hits[r].mean() for r in rows])
+        ax[0, j].set(ylim=(0, 1), ylabel=rate_label, title=key, xticks=ticks,
+                     xticklabels=order)
+        ax[1, j].plot(ticks, means, "o-")
+        ax[1, j].set(xlabel=key, ylabel=mean_label, xticks=ticks, xticklabels=order,
+                     xlim=(-0.5, len(order) - 0.5))
+        ax[1, j].set_ylim(bottom=0)  # seconds and steps are never negative
+        if all(math.isnan(m) for m in means):
+            ax[1, j].text(0.5, 0.5, "no value", ha="center",
+                          transform=ax[1, j].transAxes)
         if sum(map(len, order)) > 24:  # long labels side by side would overlap
             for a in ax[:, j]:
                 a.tick_params(axis="x", labelrotation=35)
