@@ -114,3 +114,15 @@ def test_summary_of_failed_cells_names_every_axis_value_and_says_why_it_is_empty
         assert [t.get_text() for t in ax.get_xticklabels()] == ["5", "6", "7"]
     assert mean.get_ylim()[0] >= 0
     assert any("no value" in t.get_text() for t in mean.texts)
+
+
+def test_rerun_with_the_axes_in_another_order_is_refused_not_mixed(tmp_path):
+    """Cells are numbered in axis order: swapping two axes renumbers them, so resuming
+    would skip cells that never ran and run others twice; it is another grid."""
+    base = {"graph": {"generator": "circulant", "n": 7}}
+    first = {"base": base, "axes": {"graph.n": [7, 9], "graph.circulant.k": [1, 2]},
+             "run": {"kind": "robustness"}}
+    swapped = {**first, "axes": {"graph.circulant.k": [1, 2], "graph.n": [7, 9]}}
+    rescon.sweep(first, workers=0, out=tmp_path)
+    with pytest.raises(InputError, match="another grid"):
+        rescon.sweep(swapped, workers=0, out=tmp_path)

@@ -62,7 +62,8 @@ KEYS: dict[str, frozenset[str]] = {
 class Grid:
     """A parsed grid: ``base`` tables, ``axes`` (key → values, in the given order),
     ``repetitions``, ``epsilon``, ``path`` (names in ``base`` are relative to its
-    directory), ``digest`` (SHA-256 of the canonical JSON of base, axes and run) and
+    directory), ``digest`` (SHA-256 of the canonical JSON of base, axes and run, and of
+    the axis order, which numbers the cells, when it is not the sorted one) and
     ``kind`` (:data:`KINDS`)."""
 
     base: dict[str, Any]
@@ -150,6 +151,8 @@ def read_grid(grid: str | Path | Mapping[str, Any]) -> Grid:
     if kind != "consensus":  # the digests of consensus grids stay what they were
         canon_run["kind"] = kind
     canon = {"base": base, "axes": axes, "run": canon_run}
+    if list(axes) != sorted(axes):  # cells are numbered in axis order (sorted: as before)
+        canon["order"] = list(axes)
     try:
         text = json.dumps(canon, sort_keys=True, separators=(",", ":"), allow_nan=False)
     except (TypeError, ValueError) as exc:
