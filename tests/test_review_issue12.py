@@ -126,3 +126,17 @@ def test_rerun_with_the_axes_in_another_order_is_refused_not_mixed(tmp_path):
     rescon.sweep(first, workers=0, out=tmp_path)
     with pytest.raises(InputError, match="another grid"):
         rescon.sweep(swapped, workers=0, out=tmp_path)
+
+
+@pytest.mark.parametrize("command", ["simulate", "rmdo"])
+@pytest.mark.parametrize("names", [",", "", " , "])
+def test_cli_metrics_naming_no_monitor_is_refused(command, names, capsys):
+    """``--metrics ,`` (or an empty string) names no monitor: a one-line error, not a
+    run whose every metric is silently null."""
+    from rescon.cli import main
+
+    scenario = ROOT / "examples" / "scenarios" / (
+        "paper.toml" if command == "simulate" else "rmdo_quadratic.toml")
+    assert main([command, str(scenario), "--metrics", names, "--json", "-q"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "--metrics" in err

@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from .errors import RESCONError, TimeLimitReached
+from .errors import InputError, RESCONError, TimeLimitReached
 
 __all__ = ["main"]
 
@@ -226,7 +226,11 @@ def _metrics(args: argparse.Namespace) -> list[str] | None:
     """``--metrics a,b`` as a list of monitor names (None: every monitor)."""
     if args.metrics is None:
         return None
-    return [name.strip() for name in args.metrics.split(",") if name.strip()]
+    names = [name.strip() for name in args.metrics.split(",") if name.strip()]
+    if not names:
+        raise InputError(f"--metrics names no monitor ({args.metrics!r}); give some of "
+                         "spread, diameter, validity, or omit it for every one")
+    return names
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
