@@ -29,6 +29,9 @@ from ._scan_np import HUGE, TINY
 _SPLITTER = 134217729.0
 #: what :func:`side_of_meet` returns for parallel lines
 PARALLEL = 2
+#: the numba options of a kernel called only from other kernels: no Python- or
+#: C-callable wrapper is built for it (a third of a small kernel's compile time)
+inner_kernel = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 #: nonzero |coordinates| must lie in [TINY, HUGE] for the predicates here to be exact
 #: (defined with the numpy twins of :mod:`._scan_np`, which check the same range)
 
@@ -43,7 +46,7 @@ def in_range(Y):
     return True
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def two_sum(a, b):
     """a + b = x + y exactly (Knuth)."""
     x = a + b
@@ -52,7 +55,7 @@ def two_sum(a, b):
     return x, (a - av) + (b - bv)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def two_prod(a, b):
     """a · b = x + y exactly (Dekker)."""
     x = a * b
@@ -65,7 +68,7 @@ def two_prod(a, b):
     return x, alo * blo - (((x - ahi * bhi) - alo * bhi) - ahi * blo)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def compress(e, n):
     """Sum the terms e[:n] into a nonoverlapping expansion, in place; returns its length."""
     h = 0
@@ -84,7 +87,7 @@ def compress(e, n):
     return h
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def sign(e, n):
     """Sign of an expansion of length n (its largest component)."""
     if n == 0:
@@ -92,7 +95,7 @@ def sign(e, n):
     return 1 if e[n - 1] > 0 else -1
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def product(e, ne, f, nf, out):
     """e · f exactly into out (room for 2·ne·nf terms); returns the length."""
     k = np.int64(0)  # (not a literal: that would compile compress twice)
@@ -111,7 +114,7 @@ def difference(a, b, out):
     out[1] = x
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def cross(u, w, out):
     """u₀w₁ − u₁w₀ exactly, for vectors with two-term components (u[k, 0:2]); out needs
     16 slots. Returns the length."""
@@ -168,7 +171,7 @@ def side_of_meet(b1, u1, b2, u2, b5, u5):
     return sign(S, compress(S, n1 + n2)) * sign(D, nD)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _normal3(Y, i, j, k, C, nC):
     """The cofactors of (p_j − p_i, p_k − p_i) — the normal (p_j − p_i) × (p_k − p_i)
     — exactly, as three expansions C[c, :nC[c]] (16 slots each)."""
@@ -186,7 +189,7 @@ def _normal3(Y, i, j, k, C, nC):
         nC[c] = cross(pair_u, pair_w, C[c])
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _orient3(Y, i, j, k, q, S):
     """((p_j − p_i) × (p_k − p_i)) · (p_q − p_i) exactly, as an expansion in S (192
     slots); returns its length."""
@@ -201,14 +204,14 @@ def _orient3(Y, i, j, k, q, S):
     return compress(S, n)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def orient3(Y, i, j, k, q):
     """Exact sign of ((p_j − p_i) × (p_k − p_i)) · (p_q − p_i) for rows of Y."""
     S = np.empty(3 * 2 * 2 * 16)
     return sign(S, _orient3(Y, i, j, k, q, S))
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def det3(Y, i, j, k, q):
     """((p_j − p_i) × (p_k − p_i)) · (p_q − p_i), its exact value rounded (within 3
     ulps; 0 only when it is 0)."""
@@ -216,7 +219,7 @@ def det3(Y, i, j, k, q):
     return approximate(S, _orient3(Y, i, j, k, q, S))
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def exact_mean(Y, mean, err):
     """The mean of the rows of Y per coordinate: the exact sum (an expansion) rounded,
     then divided by the row count, into mean; err bounds |mean − exact mean| (2 ulps
@@ -227,7 +230,7 @@ def exact_mean(Y, mean, err):
         err[c] = 4.0 * EPS * abs(mean[c]) + MIN_NORMAL
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def mean_two(Y, hi, lo, err):
     """The mean of the rows of Y as two doubles per coordinate: hi = fl(fl(Σ)/m) as in
     exact_mean, lo = the rest (Σ − m·hi, exact as an expansion, rounded, over m);
@@ -245,7 +248,7 @@ def mean_two(Y, hi, lo, err):
         err[c] = 4.0 * EPS * abs(lo[c]) + MIN_NORMAL
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def approximate(e, n):
     """The value of an expansion, rounded (summed from its smallest component)."""
     s = 0.0
@@ -254,7 +257,7 @@ def approximate(e, n):
     return s
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def normal3(Y, i, j, k, out):
     """The normal (p_j − p_i) × (p_k − p_i), each component its exact value rounded
     (within 3 ulps, however close to collinear the triple is; exactly 0 only when the

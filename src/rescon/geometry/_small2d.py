@@ -33,6 +33,7 @@ from ._expansions import (
     cross,
     difference,
     exact_mean,
+    inner_kernel,
     orient,
     side_of_meet,
 )
@@ -50,7 +51,7 @@ CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED, OUT_OF_RANGE = 2, 3, 4, 5
 
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _insertion_sort(a, R, low, high):
     """Sort R[low:high + 1] by the keys a[R[·]], stably (the runs of ``_argsort``)."""
     for i in range(low + 1, high + 1):
@@ -63,7 +64,7 @@ def _insertion_sort(a, R, low, high):
         R[j] = k
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _partition(a, R, low, high):
     """Partition R[low:high + 1] by the keys a[R[·]] around the median of its first,
     middle and last key; returns the pivot's final index (``_argsort``'s step)."""
@@ -92,7 +93,7 @@ def _partition(a, R, low, high):
     return i
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _argsort(a):
     """np.argsort(a) for finite a, exactly as numba's own (its quicksort: partitions
     while a run has 16 keys or more, the larger part pushed, then insertion sort), ties
@@ -123,7 +124,7 @@ def _argsort(a):
     return R
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _sorted_column(Y, c):
     """Column c of Y (a fresh array) and its ``_argsort`` order."""
     col = np.empty(Y.shape[0])
@@ -132,7 +133,7 @@ def _sorted_column(Y, c):
     return col, _argsort(col)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def cluster_box(Y, F, out):
     """Ψ(Y, F) ⊂ conv(S) ⊂ box(S) for every m − F of the points S (Ψ is the intersection
     of those hulls): with S the m − F points nearest the coordinate-wise median (max
@@ -162,7 +163,7 @@ def cluster_box(Y, F, out):
     return w * (1.0 + 2.0 * EPS)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _orient(Y, i, j, q):
     """Sign of (p_j − p_i) × (p_q − p_i): the float value when its rounding bound
     decides it, else the exact sign."""
@@ -179,7 +180,7 @@ def _orient(Y, i, j, q):
     return orient(Y[i, 0], Y[i, 1], Y[j, 0], Y[j, 1], Y[q, 0], Y[q, 1])
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _representatives(Y, rep):
     """rep[q] = the first index with exactly the coordinates of point q; returns the
     number of distinct points."""
@@ -195,7 +196,7 @@ def _representatives(Y, rep):
     return distinct
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _lines(Y, F, rep, A, C, Aerr, Cerr, ends, sgn):
     """Valid halfplanes a·x ≤ c of Ψ(Y, F): through two distinct points, ≤ F points
     strictly outside (sides decided exactly; copies of an endpoint lie on the line).
@@ -235,7 +236,7 @@ def _lines(Y, F, rep, A, C, Aerr, Cerr, ends, sgn):
     return nh
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _collinear(Y, F, rep, mean, merr, out):
     """When all distinct points lie on one line, Ψ is the segment between the
     (F+1)-th smallest and the (F+1)-th largest point along it (points with multiplicity,
@@ -269,7 +270,7 @@ def _collinear(Y, F, rep, mean, merr, out):
     return -1.0
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _pinned(Y, rep, nh, ends, sgn):
     """Two different lines through a data point p, each valid on both sides (so both
     halfplanes of each are in the list, consecutively), give Ψ ⊂ {p}; then Ψ = {p} iff
@@ -296,7 +297,7 @@ def _pinned(Y, rep, nh, ends, sgn):
     return -1
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _on_side(Y, i, side, box):
     """Data point i lies on box side ``side`` (0 bottom, 1 right, 2 top, 3 left):
     exactly, since the box is made of the data's own extreme coordinates."""
@@ -309,7 +310,7 @@ def _on_side(Y, i, side, box):
     return Y[i, 0] == box[0]
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _meet(g, a0, a1, c, aerr, cerr, A, C, Aerr, Cerr, box, out):
     """The intersection of the edge line g (a data line, or box side −1−g) with
     a0 x + a1 y = c by Cramer's rule, into out; returns its error bound (the lines'
@@ -348,7 +349,7 @@ def _meet(g, a0, a1, c, aerr, cerr, A, C, Aerr, Cerr, box, out):
         + 4.0 * EPS * max(abs(x), abs(y))
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _line_of(g, Y, ends, box, base, u):
     """Line g as base point and direction with two-term components: a data line through
     its two points, or box side −1−g (0 bottom, 1 right, 2 top, 3 left)."""
@@ -365,7 +366,7 @@ def _line_of(g, Y, ends, box, base, u):
     u[side % 2, 1] = 1.0  # along x for the bottom and top, along y for the sides
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _exact_side(h, v, P, E, VA, VB, Y, ends, box):
     """Exact sign of orient(h's points, vertex v) for a computed vertex: from its float
     coordinates when they are exact (E = 0, the box corners), else from the two lines
@@ -381,7 +382,7 @@ def _exact_side(h, v, P, E, VA, VB, Y, ends, box):
     return side_of_meet(b1, u1, b2, u2, b5, u5)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
           Q, QE, QPT, QEL, QVA, QVB):
     """Clip the convex polygon P[:nv] (errors E; PT[v] = the data point (representative)
@@ -459,7 +460,7 @@ def _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
     return nq
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _project(P, E, EL, nv, Y, ends, box, m0, m1, merr, out):
     """Nearest point of the polygon P[:nv] to (m0, m1), if the nearest feature (inside,
     an edge's interior, a vertex) is decided; returns its error bound or −1. Outside,
@@ -508,7 +509,7 @@ def _project(P, E, EL, nv, Y, ends, box, m0, m1, merr, out):
     return _vertex_nearest(P, E, nv, bv if bt == 0.0 else (bv + 1) % nv, m0, m1, merr, out)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _dot_bound(a0, a1, ea, b0, b1, eb):
     """fl(a · b) and a bound on its distance to a* · b* for |a* − a|, |b* − b| ≤ ea, eb
     per coordinate (a, b themselves rounded differences: their u|·| is added here)."""
@@ -519,7 +520,7 @@ def _dot_bound(a0, a1, ea, b0, b1, eb):
     return a0 * b0 + a1 * b1, bound * (1.0 + 8.0 * EPS)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _vertex_nearest(P, E, nv, c, m0, m1, merr, out):
     """Vertex c is the nearest point iff m − P_c makes an angle ≥ 90° with both edges
     at c (its normal cone); decided strictly from the bounds, then the answer is P_c
@@ -534,7 +535,7 @@ def _vertex_nearest(P, E, nv, c, m0, m1, merr, out):
     return E[c]
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _edge_nearest(P, E, EL, nv, v, Y, ends, box, m0, m1, merr, out):
     """The edge v → v+1 holds the nearest point in its interior iff m lies strictly
     outside its line and strictly between its ends along it (convex polygon). Then the
@@ -577,7 +578,7 @@ _OTHERS = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))
 _DIAGONALS = ((0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2))
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _radon4(Y, out):
     """Ψ(Y, 1) for 4 points in general position is one point: the crossing of the
     diagonals (convex position) or the point inside the triangle of the others.
@@ -597,7 +598,7 @@ def _radon4(Y, out):
     return -1.0
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _crossing(Y, a, b, c, d, out):
     """The crossing of the lines p_a p_b and p_c p_d (which cross: decided before),
     x = p_a + t (p_b − p_a) with t = ((p_c − p_a) × (p_d − p_c)) / ((p_b − p_a) ×
@@ -626,7 +627,7 @@ def _crossing(Y, a, b, c, d, out):
     return e + MIN_NORMAL
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _inside(Y, k):
     """Point k strictly inside the triangle of the other three (decided orientations)."""
     a, b, c = _OTHERS[k]
@@ -661,7 +662,7 @@ def project_small_2d(Ys: np.ndarray, F: int, out: np.ndarray, err: np.ndarray,
         _polygons(Ys, todo, F, out, err, status)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _bounding_box(Y):
     """[min x, max x, min y, max y] over the rows of Y."""
     box = np.empty(4)
