@@ -140,3 +140,23 @@ def test_cli_metrics_naming_no_monitor_is_refused(command, names, capsys):
     assert main([command, str(scenario), "--metrics", names, "--json", "-q"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "--metrics" in err
+
+
+def test_an_adversary_without_receivers_is_recorded_as_sending_nothing():
+    """Its row of ``states`` is what it sent: NaN, not its initial state held forever
+    (which the figure drew as an adversary line at x_0 that nobody ever received)."""
+    import networkx as nx
+    import numpy as np
+
+    from rescon.consensus.adversaries import Constant, TwoFaced, TwoFacedTable
+
+    G = nx.complete_graph(8).to_directed()
+    G.remove_edges_from([(0, j) for j in range(1, 8)])  # node 0 talks to nobody
+    x0 = [[i, i % 3] for i in range(8)]
+    for adv in (Constant([5.0, 5.0]), TwoFaced(TwoFacedTable(cycle=[[9, 9], [-9, 0]]))):
+        sc = rescon.Scenario(graph=G, x0=x0, F=1, steps=3, adversaries={0: adv},
+                             check_robustness=False)
+        tr = rescon.simulate(sc, progress=False)
+        assert np.isnan(tr.states[:, 0]).all()
+        assert np.isnan(tr.sent).all()
+        assert tr.to_json()["states"][1][0] == [None, None]

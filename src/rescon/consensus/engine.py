@@ -232,7 +232,8 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
                         rng=rng)
         for a in sorted(adv_idx):  # a fixed order: random draws do not depend on dicts
             rows = np.flatnonzero(links.send == a)
-            if not len(rows):
+            if not len(rows):  # no receiver: it sent nothing (NaN, not its x0 held)
+                sent[a] = np.full((3, d), np.nan)
                 continue
             try:  # one (len(rows), d) array: never broadcast to every receiver
                 msgs = adversary_messages({a: adv_idx[a]}, {a: links.recv[rows]}, view)[a]
