@@ -160,3 +160,26 @@ def test_an_adversary_without_receivers_is_recorded_as_sending_nothing():
         assert np.isnan(tr.states[:, 0]).all()
         assert np.isnan(tr.sent).all()
         assert tr.to_json()["states"][1][0] == [None, None]
+
+
+def _visible_ticks(fig, ylabel: str) -> list[float]:
+    """The major y ticks of the panel ``ylabel`` inside its limits, after drawing."""
+    fig.canvas.draw()
+    ax = next(a for a in fig.axes if a.get_ylabel() == ylabel)
+    lo, hi = ax.get_ylim()
+    return [y for y in ax.yaxis.get_majorticklocs() if lo <= y <= hi]
+
+
+@pytest.mark.parametrize("cost", ["x1 - 100", "x1 + 500", "0.01 * abs(x1) + 0.01 * abs(x2)"])
+def test_cost_panel_of_negative_or_small_costs_has_ticks(cost):
+    """Costs in [−800, −740] (unbounded below) or in [0, 0.07] (F* = 0): the global cost
+    panel was a symlog axis with no tick inside its range — no number on it."""
+    import matplotlib
+    import networkx as nx
+
+    matplotlib.use("Agg")
+    sc = rescon.Scenario(graph=nx.complete_graph(8).to_directed(),
+                         x0=[[i, i % 3] for i in range(8)], F=1, steps=20,
+                         check_robustness=False)
+    fig = rescon.rmdo(sc, {i: cost for i in sc.benign}, progress=False).plot()
+    assert len(_visible_ticks(fig, "global cost")) >= 2

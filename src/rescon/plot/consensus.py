@@ -287,7 +287,7 @@ def _diameter_panel(ax: Any, traj: Any, log: bool) -> None:
 
 def _cost_panel(ax: Any, traj: Any) -> None:
     """F(x̄(t_k)) and the range of F(x_i) over benign agents, F* dotted when known; a
-    log scale when every value is positive, else a symmetric log scale."""
+    log, symmetric log or linear scale (:func:`_cost_scale`)."""
     t, m = traj.times, traj.metrics
     ax.fill_between(t, m["cost"].min(axis=1), m["cost"].max(axis=1), color=BENIGN,
                     alpha=0.2, lw=0, label="F(x_i), i benign")
@@ -297,9 +297,21 @@ def _cost_panel(ax: Any, traj: Any) -> None:
     if value is not None and np.isfinite(value):
         ax.axhline(value, color="k", ls=":", lw=0.9, label="F*")
         shown.append(np.asarray([value]))
-    finite = _finite_range(*shown)
-    ax.set_yscale("log" if finite is not None and finite[0] > 0 else "symlog")
+    ax.set_yscale(_cost_scale(_finite_range(*shown)))
     ax.set_ylabel("global cost")
+
+
+def _cost_scale(finite: tuple[float, float] | None) -> str:
+    """The y scale of the cost panel: log for positive values spanning a decade, symlog
+    for values reaching 0 or negative ones spanning a decade, else linear: a one-sided
+    range within a decade (−800 … −740, 500 … 510) holds no power of ten, so a log
+    axis would show no tick."""
+    if finite is None:
+        return "linear"
+    lo, hi = finite
+    if lo > 0:
+        return "log" if hi >= 10 * lo else "linear"
+    return "symlog" if hi >= 0 or lo <= 10 * hi else "linear"
 
 
 def _rate_panel(ax: Any, traj: Any) -> None:
