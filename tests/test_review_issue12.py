@@ -183,3 +183,19 @@ def test_cost_panel_of_negative_or_small_costs_has_ticks(cost):
                          check_robustness=False)
     fig = rescon.rmdo(sc, {i: cost for i in sc.benign}, progress=False).plot()
     assert len(_visible_ticks(fig, "global cost")) >= 2
+
+
+def test_diameter_of_a_zero_step_run_is_drawn():
+    """steps = 0: the diameter at t = 0 is one point; a plain line of one point draws
+    nothing, so the panel was empty."""
+    import matplotlib
+    import networkx as nx
+
+    matplotlib.use("Agg")
+    sc = rescon.Scenario(graph=nx.complete_graph(6).to_directed(),
+                         x0=[[i, i % 3] for i in range(6)], F=1, steps=0,
+                         check_robustness=False)
+    fig = rescon.simulate(sc, progress=False).plot()
+    ax = next(a for a in fig.axes if a.get_ylabel() == "diameter (benign)")
+    line = ax.get_lines()[0]
+    assert len(line.get_xdata()) == 1 and line.get_marker() not in (None, "None", "")

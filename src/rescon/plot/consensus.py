@@ -269,16 +269,17 @@ def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str
 def _diameter_panel(ax: Any, traj: Any, log: bool) -> None:
     """The benign diameter; on a log axis exact zeros sit at :func:`log_floor`."""
     t, dia = traj.times, traj.metrics["diameter"]
+    dot = {"marker": "o", "ms": 4} if len(t) == 1 else {}  # a line of one point is invisible
     if log:
         plot_log_clipped(ax, t, dia, log_floor(dia), color="k", lw=1.2,
-                         label="benign diameter")
+                         label="benign diameter", **dot)
         zero = np.flatnonzero(dia == 0.0)
         if zero.size:
             ax.text(0.99, 0.95, f"diameter exactly 0 at {zero.size} of {len(t)} steps, "
                     f"first at t = {t[zero[0]]:g} s", transform=ax.transAxes, ha="right",
                     va="top", fontsize=7)
     else:
-        ax.plot(t, dia, color="k", lw=1.2, label="benign diameter")
+        ax.plot(t, dia, color="k", lw=1.2, label="benign diameter", **dot)
     ax.set_ylabel("diameter (benign)")
 
 
