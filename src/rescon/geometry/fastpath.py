@@ -22,11 +22,12 @@ the caller clips exactly (:mod:`.polytope`).
 from __future__ import annotations
 
 import itertools
+from math import gcd
 
 import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
-from .polytope import ExactPolytope, _normalise
+from .polytope import ExactPolytope
 
 __all__ = ["certified_kernel"]
 
@@ -137,16 +138,19 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     verts: list[tuple[int, ...]] = []
     tight: list[int] = []
     of_proposal: list[int] = []
-    for f in facets:
-        T = [int(sel[i]) for i in f]
-        v = _solve(H, T)
-        if v is None:
-            return None
+    kept: list[int] = []  # the proposals whose k rows meet in one point
+    basis: list[list[int]] = []  # per vertex: k independent rows tight at it (positions in S)
+    Ts = [[int(sel[i]) for i in f] for f in facets]
+    for p, (T, v) in enumerate(zip(Ts, _solve_all(H, Ts, k), strict=True)):
+        if v is None:  # a zero-volume piece of qhull's triangulation of a non-simple
+            continue   # vertex: its other pieces (or the closure check) decide
+        kept.append(p)
         i = index.setdefault(v, len(verts))
         of_proposal.append(i)
         if i == len(verts):
             verts.append(v)
             tight.append(0)
+            basis.append([where[h] for h in T])
         for h in T:
             tight[i] |= 1 << where[h]
     # exact feasibility, and the complete tight sets within S: floats of the exact
@@ -163,7 +167,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
 
         top = row_max(H.af, H.bf, np.ascontiguousarray(Vx))
     else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
-        shift = np.abs(V - Vx[of_proposal]).max()
+        shift = np.abs(V[kept] - Vx[of_proposal]).max()
         row_bound = row_bound + l1 * shift
     rows = np.flatnonzero(~(top < -row_bound))  # the rows not surely slack at every vertex
     absV = np.abs(Vx).T
@@ -202,7 +206,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         # a simple vertex (k independent tight rows) has a simplicial tangent cone: its
         # extreme rays keep all but one row tight
         rays = ([tight[vi] ^ (1 << h) for h in T] if len(T) == k
-                else _extreme_rays(normals, T, k))
+                else _tangent_rays(normals, basis[vi], T, k))
         for Z in rays:
             fewest = min((members[h] for h in _bits(Z)), key=len)
             if not any((tight[u] & Z) == Z for u in fewest if u != vi):
@@ -235,45 +239,89 @@ def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
     return (A.astype(np.int64) * V[:, 1:]).sum(axis=1) - b.astype(np.int64) * V[:, 0]
 
 
-def _solve(H, T: list[int]) -> tuple[int, ...] | None:
-    """The point where the k hyperplanes T meet, homogeneous (w > 0, primitive), by
-    Cramer's rule on integers; None if they do not meet in one point."""
-    from .halfspaces import _int_det
+def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
+    """For each list T of k rows, the point where their hyperplanes meet, homogeneous
+    (w, y) with w > 0 and primitive, or None if they do not meet in one point.
 
-    rows = [H.exact(h) for h in T]
-    A = [list(a) for a, _ in rows]
-    w = _int_det(A)
-    if w == 0:
-        return None
-    y = []
-    for j in range(len(A)):
-        Aj = [r[:j] + [b] + r[j + 1:] for r, (_, b) in zip(A, rows, strict=True)]
-        y.append(_int_det(Aj))
-    if w < 0:
-        w, y = -w, [-v for v in y]
-    return _normalise((w, *y))
-
-
-def _extreme_rays(normals: list[tuple[int, ...]], T: list[int], k: int):
-    """For the cone {d : a_h·d ≤ 0, h ∈ T} (a pointed cone: T has rank k), the bitset of
-    the constraints tight along each extreme ray. A ray is the null direction of k − 1
-    independent normals, signed to satisfy all of T."""
-    seen = set()
-    for sub in itertools.combinations(T, k - 1):
-        d = _null_direction([normals[h] for h in sub], k)
-        if d is None:
+    (w, y) spans the null space of the k × (k+1) integer matrix R with rows (−b_h, a_h):
+    its entries are the signed maximal minors x_j = (−1)^j det R_{−j} (R without column
+    j), computed for all T at once by Laplace expansion along the rows — the minors of
+    the first r rows on every r-set of columns from those of the first r − 1 — on numpy
+    object arrays of Python ints (exact)."""
+    if not Ts:
+        return []
+    R = np.empty((len(Ts), k, k + 1), dtype=object)
+    for p, T in enumerate(Ts):
+        for r, h in enumerate(T):
+            a, b = H.exact(h)
+            R[p, r, 0] = -b
+            R[p, r, 1:] = a
+    minors = {(c,): R[:, 0, c] for c in range(k + 1)}
+    for r in range(1, k):
+        nxt = {}
+        for cols in itertools.combinations(range(k + 1), r + 1):
+            acc = 0
+            for i, c in enumerate(cols):
+                term = R[:, r, c] * minors[cols[:i] + cols[i + 1:]]
+                acc = acc + term if (r + i) % 2 == 0 else acc - term
+            nxt[cols] = acc
+        minors = nxt
+    full = tuple(range(k + 1))
+    x = np.stack([minors[full[:j] + full[j + 1:]] * (-1) ** j for j in range(k + 1)], axis=1)
+    out: list[tuple[int, ...] | None] = []
+    for row in x.tolist():
+        if row[0] == 0:
+            out.append(None)
             continue
-        vals = [sum(x * y for x, y in zip(normals[h], d, strict=True)) for h in T]
-        if all(v <= 0 for v in vals):
-            pass
-        elif all(v >= 0 for v in vals):
-            vals = [-v for v in vals]
-        else:
+        g = gcd(*row) if row[0] > 0 else -gcd(*row)
+        out.append(tuple(v // g for v in row))
+    return out
+
+
+def _tangent_rays(normals: list[tuple[int, ...]], basis: list[int], T: list[int], k: int):
+    """For the pointed cone C = {d : a_h·d ≤ 0, h ∈ T} (``basis``: k independent rows of
+    T), the bitset of the rows of T tight along each extreme ray, by the
+    double-description method on integers: start from the simplicial cone of the basis
+    (its rays: the null directions of k − 1 of its rows, signed into the cone), then
+    cut by each further row h, keeping the rays with a_h·d ≤ 0 and adding
+    s_p·q − s_q·p for every adjacent pair with s_p = a_h·p > 0 > s_q = a_h·q. Two
+    extreme rays are adjacent iff no third ray is tight on every row tight on both (the
+    combinatorial test, exact for degenerate cones)."""
+    rays: list[tuple[tuple[int, ...], int]] = []  # (direction, tight rows as a bitset)
+    for h in basis:
+        d = _null_direction([normals[g] for g in basis if g != h], k)
+        if _dot(normals[h], d) > 0:
+            d = tuple(-v for v in d)
+        rays.append((d, sum(1 << g for g in basis if g != h)))
+    for h in T:
+        if h in basis:
             continue
-        Z = sum(1 << h for h, v in zip(T, vals, strict=True) if v == 0)
-        if Z not in seen:
-            seen.add(Z)
-            yield Z
+        s = [_dot(normals[h], d) for d, _ in rays]
+        plus = [i for i, v in enumerate(s) if v > 0]
+        minus = [i for i, v in enumerate(s) if v < 0]
+        new = []
+        for p in plus:
+            for q in minus:
+                common = rays[p][1] & rays[q][1]
+                if bin(common).count("1") < k - 2 or any(
+                        (z & common) == common for i, (_, z) in enumerate(rays)
+                        if i != p and i != q):
+                    continue
+                d = tuple(s[p] * x - s[q] * y for x, y in zip(rays[q][0], rays[p][0],
+                                                                 strict=True))
+                new.append((_primitive_direction(d), common | 1 << h))
+        rays = [(d, z | (1 << h if v == 0 else 0)) for (d, z), v in zip(rays, s, strict=True)
+                if v <= 0] + new
+    return [z for _, z in rays]
+
+
+def _dot(a: tuple[int, ...], d: tuple[int, ...]) -> int:
+    return sum(x * y for x, y in zip(a, d, strict=True))
+
+
+def _primitive_direction(d: tuple[int, ...]) -> tuple[int, ...]:
+    g = gcd(*d)
+    return tuple(v // g for v in d) if g > 1 else d
 
 
 def _null_direction(rows: list[tuple[int, ...]], k: int) -> tuple[int, ...] | None:
