@@ -199,3 +199,15 @@ def test_diameter_of_a_zero_step_run_is_drawn():
     ax = next(a for a in fig.axes if a.get_ylabel() == "diameter (benign)")
     line = ax.get_lines()[0]
     assert len(line.get_xdata()) == 1 and line.get_marker() not in (None, "None", "")
+
+
+def test_kernel_plot_takes_a_file_name_as_trajectory_plot_does(tmp_path):
+    """``K.plot("kernel.png")`` (the README's ``plot(path)``) wrote nothing and crashed
+    with "'str' object has no attribute 'scatter'": the first parameter was ``ax``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    K = rescon.safe_kernel([[0, 0], [4, 0], [4, 4], [0, 4], [1, 3]], 1)
+    for target in (str(tmp_path / "k.png"), tmp_path / "k2.png"):
+        K.plot(target)
+        assert Path(target).stat().st_size > 1000

@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from fractions import Fraction
+from os import PathLike
 from typing import Any
 
 import numpy as np
@@ -157,9 +158,12 @@ class SafeKernel:
              view: tuple[float, float] | None = None) -> Any:
         """Points, kernel and (optionally) a chosen point; d = 2 or 3 (matplotlib), axes
         x₁, x₂ (, x₃) at equal scale, a 3-D kernel seen from ``view`` = (elevation,
-        azimuth) in degrees (:func:`rescon.plot.kernel.plot_kernel`)."""
+        azimuth) in degrees (:func:`rescon.plot.kernel.plot_kernel`). A file name in
+        place of ``ax`` is the ``path`` (``K.plot("kernel.png")``, as ``Trajectory.plot``)."""
         from ..plot.kernel import plot_kernel
 
+        if isinstance(ax, (str, PathLike)):
+            ax, path = None, ax
         return plot_kernel(self, ax=ax, point=point, path=path, view=view)
 
 
