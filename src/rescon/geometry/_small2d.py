@@ -48,7 +48,9 @@ ACCEPT_REL = 2.0**-40
 #: parallel lines, a flat kernel the path does not handle, the nearest feature
 #: undecided, coordinates outside the range where expansions are exact (in_range)
 CLIP_UNDECIDED, FLAT, NEAREST_UNDECIDED, OUT_OF_RANGE = 2, 3, 4, 5
-
+#: ``_argsort`` sorts runs of at most this many keys by insertion, stably: on sets that
+#: small its order is np.argsort(kind="stable")'s (the numpy cluster step's)
+INSERTION_RUN = 15
 
 
 @inner_kernel
@@ -96,9 +98,9 @@ def _partition(a, R, low, high):
 @inner_kernel
 def _argsort(a):
     """np.argsort(a) for finite a, exactly as numba's own (its quicksort: partitions
-    while a run has 16 keys or more, the larger part pushed, then insertion sort), ties
-    in the same order — written out because the generic one takes seconds to compile.
-    The stack holds at most log2(n) runs (each push halves what is left)."""
+    while a run has more than INSERTION_RUN keys, the larger part pushed, then insertion
+    sort), ties in the same order — written out because the generic one takes seconds
+    to compile. The stack holds at most log2(n) runs (each push halves what is left)."""
     n = a.shape[0]
     R = np.arange(n)
     lows = np.empty(64, dtype=np.int64)
@@ -108,7 +110,7 @@ def _argsort(a):
     while top > 0:
         top -= 1
         low, high = lows[top], highs[top]
-        while high - low >= 15:
+        while high - low >= INSERTION_RUN:
             i = _partition(a, R, low, high)
             if high - i > i - low:
                 if high > i:
@@ -650,7 +652,10 @@ def project_small_2d(Ys: np.ndarray, F: int, out: np.ndarray, err: np.ndarray,
     status[:] = FLAT
     todo = np.arange(B)
     if m >= 3 * F + 1:  # (Ψ ≠ ∅) a converged cluster: any of its points will do
-        _clusters(Ys, todo, F, out, err, status)
+        if m <= INSERTION_RUN:
+            _clusters_np(Ys, F, out, err, status)
+        else:
+            _clusters(Ys, todo, F, out, err, status)
         todo = todo[status[todo] != OK]
     fits = sets_in_range(Ys[todo])
     status[todo[~fits]] = OUT_OF_RANGE
@@ -660,6 +665,24 @@ def project_small_2d(Ys: np.ndarray, F: int, out: np.ndarray, err: np.ndarray,
         todo = todo[status[todo] != OK]
     if len(todo):
         _polygons(Ys, todo, F, out, err, status)
+
+
+def _clusters_np(Ys: np.ndarray, F: int, out: np.ndarray, err: np.ndarray,
+                 status: np.ndarray) -> None:
+    """_clusters for every set in numpy, nothing to compile (m ≤ INSERTION_RUN, where a
+    stable argsort orders as _argsort): the same floats — the median of each coordinate
+    (its middle value, or the rounded half-sum of the middle two), the max-norm distances
+    to it, the m − F nearest points in the same order, their box."""
+    m = Ys.shape[1]
+    med = np.median(Ys, axis=1)
+    dist = np.abs(Ys - med[:, None, :]).max(axis=2)
+    order = np.argsort(dist, axis=1, kind="stable")
+    near = np.take_along_axis(Ys, order[:, :m - F, None], axis=1)
+    w = (near.max(axis=1) - near.min(axis=1)).max(axis=1) * (1.0 + 2.0 * EPS)
+    out[:] = near[:, 0]
+    ok = w <= ACCEPT_REL * np.abs(out).max(axis=1)
+    err[ok] = w[ok]
+    status[ok] = OK
 
 
 @inner_kernel
