@@ -211,3 +211,20 @@ def test_kernel_plot_takes_a_file_name_as_trajectory_plot_does(tmp_path):
     for target in (str(tmp_path / "k.png"), tmp_path / "k2.png"):
         K.plot(target)
         assert Path(target).stat().st_size > 1000
+
+
+@pytest.mark.parametrize("grid", [
+    {"axes": {"graph.circulant.kk": [1, 2]}},  # a misspelt parameter of another generator
+    {"axes": {"graph.circulant.k.x": [1, 2]}},
+    {"base": {"graph": {"generator": "ba_robust", "n": 8, "m": 2,
+                        "circulant": {"kk": 3}}}},
+])
+def test_misspelt_generator_parameters_are_refused_when_the_grid_is_read(grid):
+    """A sub-table key of a generator that is not its parameter was accepted and, while
+    another generator ran, silently ignored: an axis that changed nothing."""
+    from rescon.sweep.grid import read_grid
+
+    full = {"base": {"graph": {"generator": "ba_robust", "n": 8, "m": 2}},
+            "run": {"kind": "robustness"}, **grid}
+    with pytest.raises(InputError, match="circulant takes n, k, directed"):
+        read_grid(full)

@@ -141,6 +141,10 @@ def read_grid(grid: str | Path | Mapping[str, Any]) -> Grid:
                          f"(allowed: {sorted(tables)})")
     for name in sorted(set(base) & set(KEYS)):
         _known(name, _mapping(base[name], f"{where} [base.{name}]"), f"{where} [base]")
+    for gen, params in base.get("graph", {}).items():
+        if gen in GENERATORS and isinstance(params, Mapping):
+            for param in params:
+                _parameter(f"graph.{gen}.{param}", f"{where} [base.graph.{gen}]")
     axes = {k: _axis(k, v, tables, f"{where} [axes]")
             for k, v in _mapping(data.get("axes", {}), f"{where} [axes]").items()}
     reps = integer("repetitions", run.get("repetitions", 1), low=1)
@@ -182,12 +186,25 @@ def _axis(key: str, values: Any, tables: frozenset[str], where: str) -> list[Any
         raise InputError(f"{where}: axis {key!r} must be a non-empty list; got {values!r}")
     if table in KEYS:
         _known(table, {name.split(".")[0]: None}, where)
+    _parameter(key, where)
     known = _NAMED.get(key)
     bad = [v for v in values if not isinstance(v, str) or v not in known] if known else []
     if bad:
         raise InputError(f"{where}: axis {key!r}: unknown generators {bad} "
                          f"(available: {', '.join(known)})")
     return list(values)
+
+
+def _parameter(key: str, where: str) -> None:
+    """A key "graph.<generator>.<name>" names a parameter of that generator (its
+    sub-table is read only when it runs: a misspelt name would silently change nothing
+    in the cells of the other generators)."""
+    parts = key.split(".")
+    if parts[0] == "graph" and len(parts) > 2 and parts[1] in GENERATORS:
+        _, required, optional = GENERATORS[parts[1]]
+        if len(parts) > 3 or parts[2] not in required + optional:
+            raise InputError(f"{where}: {key!r}: {parts[1]} takes "
+                             f"{', '.join(required + optional)}")
 
 
 def _known(table: str, keys: Mapping[str, Any], where: str) -> None:
