@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+from numba.extending import register_jitable
 
 from .._rounding import MIN_NORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
@@ -29,9 +30,11 @@ from ._scan_np import HUGE, TINY
 _SPLITTER = 134217729.0
 #: what :func:`side_of_meet` returns for parallel lines
 PARALLEL = 2
-#: the numba options of a kernel called only from other kernels: no Python- or
-#: C-callable wrapper is built for it (a third of a small kernel's compile time)
-inner_kernel = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+#: the decorator of a kernel called from other kernels: compiled when a kernel uses it,
+#: without the Python- and C-callable wrappers of an njit function (a third of a small
+#: kernel's compile time) and typed with plain int64 for literal arguments (no second
+#: specialisation); called from Python it runs as Python
+inner_kernel = register_jitable(cache=True, no_cfunc_wrapper=True)
 #: nonzero |coordinates| must lie in [TINY, HUGE] for the predicates here to be exact
 #: (defined with the numpy twins of :mod:`._scan_np`, which check the same range)
 
