@@ -68,12 +68,12 @@ def test_fast_path_refuses_a_missing_non_simple_vertex():
     _, _, H, unit, first = _both_paths(X, 2)
     V, facets = fastpath._propose(H, first)
     assert fastpath._certify(H, 4, unit, first, facets) is not None
-    # every proposal (triangulated piece) of one non-simple vertex left out
+    # every proposal of one non-simple vertex left out
     P = fastpath._certify(H, 4, unit, first, facets)
     vi = next(i for i, t in enumerate(P.tight) if bin(t).count("1") > 4)
     target = P.verts[vi]
-    keep = [f for f, v in zip(facets, fastpath._solve_all(H, [[int(first[i]) for i in f]
-                                                             for f in facets], 4), strict=True)
+    bases = [fastpath._basis_of(H, [int(first[i]) for i in f], 4) for f in facets]
+    keep = [f for f, v in zip(facets, fastpath._solve_all(H, bases, 4), strict=True)
             if v != target]
     assert len(keep) < len(facets)
     assert fastpath._certify(H, 4, unit, first, keep) is None
@@ -105,7 +105,8 @@ def test_tangent_rays_equal_brute_force(k, extra, data):
     normals = basis + more
     # pointed: the basis rows alone make the cone pointed; keep it nonzero
     T = list(range(len(normals)))
-    got = fastpath._tangent_rays(normals, list(range(k)), T, k)
+    start = fastpath._simplicial_rays(normals, [list(range(k))], k)[0]
+    got = fastpath._tangent_rays(normals, list(range(k)), T, k, start)
     assert len(got) == len(set(got))
     assert set(got) == _brute_rays(normals, T, k)
 
@@ -127,3 +128,26 @@ def test_large_d4_certificate_is_never_refuted():
     report = rescon.check_certificate(K.certificate)
     assert report.verdict in ("valid", "unchecked"), report
     assert "vertex enumeration" not in (report.reason or ""), report
+
+
+def test_extra_rows_of_a_merged_proposal_are_decided_exactly():
+    """A proposal may list more than k rows (qhull merges a non-simple vertex); only
+    the k it is solved from are tight by construction, a row listed by mistake is not."""
+    X = np.random.default_rng(5).normal(size=(20, 4))
+    _, _, H, unit, first = _both_paths(X, 1)
+    _, facets = fastpath._propose(H, first)
+    honest = fastpath._certify(H, 4, unit, first, facets)
+    assert honest is not None
+    simple = next(p for p, f in enumerate(facets) if len(f) == 4)
+    vertex = fastpath._solve_all(H, [[int(first[i]) for i in facets[simple]]], 4)[0]
+    stranger = next(i for i in range(len(first))
+                    if i not in facets[simple] and not any(
+                        i in f for f, v in zip(facets, fastpath._solve_all(
+                            H, [fastpath._basis_of(H, [int(first[j]) for j in f], 4)
+                                for f in facets], 4), strict=True) if v == vertex))
+    lied = [list(f) for f in facets]
+    lied[simple] = [*lied[simple], stranger]
+    P = fastpath._certify(H, 4, unit, first, lied)
+    if P is not None:
+        assert P.tight[P.verts.index(vertex)].bit_count() == honest.tight[
+            honest.verts.index(vertex)].bit_count()

@@ -22,6 +22,7 @@ the caller clips exactly (:mod:`.polytope`).
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 from math import gcd
 
 import numpy as np
@@ -36,6 +37,9 @@ MAX_ROUNDS = 4
 LOCAL_RADIUS = 1e-4
 #: in the local pass, halfspaces farther than FAR kernel sizes from the centre are left out
 FAR = 1e4
+#: vertices with more tight rows than this are left out of the fast closure count
+#: (C(t, k − 1) keys each); rays ending there are found by a scan
+MAX_TIGHT = 12
 
 
 def _chebyshev(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -91,7 +95,7 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
         return None
     try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
         with np.errstate(divide="ignore", invalid="ignore"):
-            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0, qhull_options="Qt")
+            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0)
     except (QhullError, ValueError):
         return None
     if not np.isfinite(hs.intersections).all():
@@ -111,7 +115,7 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
         if prop is None:
             return None
         V, facets = prop
-        if any(len(f) != k for f in facets):
+        if any(len(f) < k for f in facets):
             return None
         # floats first: halfspaces clearly violated by a proposed vertex join sel
         from ._candidates import row_max
@@ -140,10 +144,10 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     of_proposal: list[int] = []
     kept: list[int] = []  # the proposals whose k rows meet in one point
     basis: list[list[int]] = []  # per vertex: k independent rows tight at it (positions in S)
-    Ts = [[int(sel[i]) for i in f] for f in facets]
+    Ts = [_basis_of(H, [int(sel[i]) for i in f], k) for f in facets]
     for p, (T, v) in enumerate(zip(Ts, _solve_all(H, Ts, k), strict=True)):
-        if v is None:  # a zero-volume piece of qhull's triangulation of a non-simple
-            continue   # vertex: its other pieces (or the closure check) decide
+        if v is None:  # k dependent rows (a zero-volume piece of a triangulated
+            continue   # non-simple vertex): the other proposals or the closure decide
         kept.append(p)
         i = index.setdefault(v, len(verts))
         of_proposal.append(i)
@@ -161,7 +165,8 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     M = np.abs(Vx).max()
     floor = H.floor()
     l1, perm_sum, babs = H.row_terms()
-    row_bound = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs) + floor
+    coarse = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs) + floor
+    row_bound = coarse
     if V is None or top is None:
         from ._candidates import row_max
 
@@ -170,13 +175,10 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         shift = np.abs(V[kept] - Vx[of_proposal]).max()
         row_bound = row_bound + l1 * shift
     rows = np.flatnonzero(~(top < -row_bound))  # the rows not surely slack at every vertex
-    absV = np.abs(Vx).T
-    Sv = H.af[rows] @ Vx.T - H.bf[rows, None]
-    bound = H.c_err * (H.af_abs[rows] @ absV + H.b_abs[rows, None]) + c * (
-        np.abs(H.af[rows]) @ absV + np.abs(H.bf[rows])[:, None]) + floor
-    if (Sv > bound).any():
+    near = _near_pairs(H, rows, Vx, coarse[rows], c, floor)
+    if near is None:
         return None
-    near_r, near_v = np.nonzero(~(np.abs(Sv) > bound))
+    near_r, near_v = near
     slacks = _int64_slacks(H, scale, verts, rows[near_r], near_v)
     if slacks is not None:  # small integers: all undecided pairs at once
         if (slacks > 0).any():
@@ -197,20 +199,8 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         if slack == 0 and h in where:
             tight[vi] |= 1 << where[h]
     normals = [H.exact(h)[0] for h in S_set]
-    members: dict[int, list[int]] = {}
-    for vi, t in enumerate(tight):
-        for h in _bits(t):
-            members.setdefault(h, []).append(vi)
-    for vi in range(len(verts)):
-        T = list(_bits(tight[vi]))
-        # a simple vertex (k independent tight rows) has a simplicial tangent cone: its
-        # extreme rays keep all but one row tight
-        rays = ([tight[vi] ^ (1 << h) for h in T] if len(T) == k
-                else _tangent_rays(normals, basis[vi], T, k))
-        for Z in rays:
-            fewest = min((members[h] for h in _bits(Z)), key=len)
-            if not any((tight[u] & Z) == Z for u in fewest if u != vi):
-                return None
+    if not _closed(tight, basis, normals, k):
+        return None
     P = ExactPolytope(k, unit=scale)
     for h in S_set:
         a, b = H.exact(h)
@@ -219,6 +209,69 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     P.verts = verts
     P.tight = tight
     return P
+
+
+def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
+            k: int) -> bool:
+    """Every extreme ray of every vertex's tangent cone leads to another vertex. A
+    simple vertex (k tight rows) has a simplicial cone whose rays keep all but one row
+    tight; a non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight
+    along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆
+    tight[u]. Fast test: the (k − 1)-subsets of the tight sets (of at most MAX_TIGHT
+    rows) counted — a key counted twice is in some u ≠ v; otherwise the vertices on
+    Z's rarest row are scanned."""
+    count: Counter[int] = Counter()
+    for t in tight:
+        if t.bit_count() <= MAX_TIGHT:
+            count.update(sum(1 << h for h in sub)
+                         for sub in itertools.combinations(_bits(t), k - 1))
+    members: dict[int, list[int]] = {}
+    for vi, t in enumerate(tight):
+        for h in _bits(t):
+            members.setdefault(h, []).append(vi)
+    non_simple = [vi for vi, t in enumerate(tight) if t.bit_count() > k]
+    starts = dict(zip(non_simple, _simplicial_rays(normals, [basis[vi] for vi in non_simple], k),
+                      strict=True))
+    for vi, t in enumerate(tight):
+        rays = ([t ^ (1 << h) for h in _bits(t)] if vi not in starts
+                else _tangent_rays(normals, basis[vi], list(_bits(t)), k, starts[vi]))
+        for Z in rays:
+            if count[Z] >= 2:
+                continue
+            fewest = min((members[h] for h in _bits(Z)), key=len)
+            if not any((tight[u] & Z) == Z for u in fewest if u != vi):
+                return False
+    return True
+
+
+def _near_pairs(H, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray, c: float,
+                floor: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The pairs (index into rows, vertex) whose float slack s = a·v − b is within its
+    rounding bound of 0 — to be decided exactly — or None if some s is surely > 0.
+
+    The bound of a pair is c_err (|a|_perm·|v| + b_abs) + c (|a|·|v| + |b|) + floor;
+    ``coarse`` bounds it per row for every vertex (|v| ≤ max |V|), so only the pairs with
+    |s| ≤ coarse get their own bound; vertices in chunks (memory rows × chunk)."""
+    out_r, out_v = [], []
+    chunk = max(1, 2**22 // max(len(rows), 1))
+    A, b = H.af[rows], H.bf[rows]
+    for lo in range(0, len(Vx), chunk):
+        S = A @ Vx[lo:lo + chunk].T - b[:, None]
+        if (S > coarse[:, None]).any():
+            return None
+        r, v = np.nonzero(~(np.abs(S) > coarse[:, None]))  # NaN stays undecided
+        h, absV = rows[r], np.abs(Vx[lo + v])
+        bound = H.c_err * (np.einsum("ij,ij->i", H.af_abs[h], absV) + H.b_abs[h]) + c * (
+            np.einsum("ij,ij->i", np.abs(H.af[h]), absV) + np.abs(H.bf[h])) + floor
+        s = S[r, v]
+        if (s > bound).any():
+            return None
+        keep = ~(np.abs(s) > bound)
+        out_r.append(r[keep])
+        out_v.append(v[keep] + lo)
+    if not out_r:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    return np.concatenate(out_r), np.concatenate(out_v)
 
 
 def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
@@ -239,15 +292,24 @@ def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
     return (A.astype(np.int64) * V[:, 1:]).sum(axis=1) - b.astype(np.int64) * V[:, 0]
 
 
+def _basis_of(H, T: list[int], k: int) -> list[int]:
+    """k of the rows T that floats suggest are independent (QR with column pivoting of
+    their unit normals): the rows a merged (non-simple) proposal is solved from. Only
+    these k are tight by construction; the others are decided exactly later."""
+    if len(T) == k:
+        return T
+    from scipy.linalg import qr
+
+    A = H.af[T]
+    A = A / np.linalg.norm(A, axis=1)[:, None]
+    _, _, piv = qr(A.T, pivoting=True, mode="economic")
+    return [T[i] for i in piv[:k]]
+
+
 def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     """For each list T of k rows, the point where their hyperplanes meet, homogeneous
-    (w, y) with w > 0 and primitive, or None if they do not meet in one point.
-
-    (w, y) spans the null space of the k × (k+1) integer matrix R with rows (−b_h, a_h):
-    its entries are the signed maximal minors x_j = (−1)^j det R_{−j} (R without column
-    j), computed for all T at once by Laplace expansion along the rows — the minors of
-    the first r rows on every r-set of columns from those of the first r − 1 — on numpy
-    object arrays of Python ints (exact)."""
+    (w, y) with w > 0 and primitive, or None if they do not meet in one point: (w, y)
+    spans the null space of the k × (k+1) integer matrix with rows (−b_h, a_h)."""
     if not Ts:
         return []
     R = np.empty((len(Ts), k, k + 1), dtype=object)
@@ -256,20 +318,8 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
             a, b = H.exact(h)
             R[p, r, 0] = -b
             R[p, r, 1:] = a
-    minors = {(c,): R[:, 0, c] for c in range(k + 1)}
-    for r in range(1, k):
-        nxt = {}
-        for cols in itertools.combinations(range(k + 1), r + 1):
-            acc = 0
-            for i, c in enumerate(cols):
-                term = R[:, r, c] * minors[cols[:i] + cols[i + 1:]]
-                acc = acc + term if (r + i) % 2 == 0 else acc - term
-            nxt[cols] = acc
-        minors = nxt
-    full = tuple(range(k + 1))
-    x = np.stack([minors[full[:j] + full[j + 1:]] * (-1) ** j for j in range(k + 1)], axis=1)
     out: list[tuple[int, ...] | None] = []
-    for row in x.tolist():
+    for row in _cross_all(R).tolist():
         if row[0] == 0:
             out.append(None)
             continue
@@ -278,21 +328,62 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     return out
 
 
-def _tangent_rays(normals: list[tuple[int, ...]], basis: list[int], T: list[int], k: int):
+def _cross_all(R: np.ndarray) -> np.ndarray:
+    """The generalised cross products of the m × (m+1) integer matrices R[p] (an object
+    array (P, m, m+1) of Python ints): x_j = (−1)^j det R_{−j} (R without column j), so
+    R x = 0, and x = 0 iff the rows are dependent. All P at once, by Laplace expansion
+    along the rows — the minors of the first r rows on every r-set of columns from those
+    of the first r − 1: Σ_r r·C(m+1, r) products of arrays, exact."""
+    m = R.shape[1]
+    minors = {(c,): R[:, 0, c] for c in range(m + 1)}
+    for r in range(1, m):
+        nxt = {}
+        for cols in itertools.combinations(range(m + 1), r + 1):
+            acc = 0
+            for i, c in enumerate(cols):
+                term = R[:, r, c] * minors[cols[:i] + cols[i + 1:]]
+                acc = acc + term if (r + i) % 2 == 0 else acc - term
+            nxt[cols] = acc
+        minors = nxt
+    full = tuple(range(m + 1))
+    return np.stack([minors[full[:j] + full[j + 1:]] * (-1) ** j for j in range(m + 1)],
+                    axis=1)
+
+
+def _simplicial_rays(normals: list[tuple[int, ...]], bases: list[list[int]], k: int
+                     ) -> list[list[tuple[int, ...]]]:
+    """For each basis B (k independent rows), the extreme rays of {d : a_h·d ≤ 0, h ∈ B}:
+    for each h ∈ B the null direction of B − {h}, signed so that a_h·d < 0."""
+    if not bases:
+        return []
+    R = np.empty((len(bases) * k, k - 1, k), dtype=object)
+    for p, B in enumerate(bases):
+        for j, h in enumerate(B):
+            for r, g in enumerate(g for g in B if g != h):
+                R[p * k + j, r] = normals[g]
+    D = _cross_all(R).tolist()
+    out = []
+    for p, B in enumerate(bases):
+        rays = []
+        for j, h in enumerate(B):
+            d = D[p * k + j]
+            rays.append(tuple(-v for v in d) if _dot(normals[h], d) > 0 else tuple(d))
+        out.append(rays)
+    return out
+
+
+def _tangent_rays(normals: list[tuple[int, ...]], basis: list[int], T: list[int], k: int,
+                  start: list[tuple[int, ...]]):
     """For the pointed cone C = {d : a_h·d ≤ 0, h ∈ T} (``basis``: k independent rows of
     T), the bitset of the rows of T tight along each extreme ray, by the
     double-description method on integers: start from the simplicial cone of the basis
-    (its rays: the null directions of k − 1 of its rows, signed into the cone), then
+    (its rays ``start``, one per basis row: :func:`_simplicial_rays`), then
     cut by each further row h, keeping the rays with a_h·d ≤ 0 and adding
     s_p·q − s_q·p for every adjacent pair with s_p = a_h·p > 0 > s_q = a_h·q. Two
     extreme rays are adjacent iff no third ray is tight on every row tight on both (the
     combinatorial test, exact for degenerate cones)."""
-    rays: list[tuple[tuple[int, ...], int]] = []  # (direction, tight rows as a bitset)
-    for h in basis:
-        d = _null_direction([normals[g] for g in basis if g != h], k)
-        if _dot(normals[h], d) > 0:
-            d = tuple(-v for v in d)
-        rays.append((d, sum(1 << g for g in basis if g != h)))
+    # (direction, tight rows as a bitset)
+    rays = [(d, sum(1 << g for g in basis if g != h)) for h, d in zip(basis, start, strict=True)]
     for h in T:
         if h in basis:
             continue
