@@ -101,7 +101,7 @@ def sign(e, n):
 @inner_kernel
 def product(e, ne, f, nf, out):
     """e · f exactly into out (room for 2·ne·nf terms); returns the length."""
-    k = np.int64(0)  # (not a literal: that would compile compress twice)
+    k = 0
     for i in range(ne):
         for j in range(nf):
             out[k], out[k + 1] = two_prod(e[i], f[j])
@@ -121,7 +121,7 @@ def difference(a, b, out):
 def cross(u, w, out):
     """u₀w₁ − u₁w₀ exactly, for vectors with two-term components (u[k, 0:2]); out needs
     16 slots. Returns the length."""
-    k = np.int64(0)  # (not a literal: that would compile compress twice)
+    k = 0
     for a in range(2):
         for b in range(2):
             out[k], out[k + 1] = two_prod(u[0, a], w[1, b])

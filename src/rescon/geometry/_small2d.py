@@ -246,8 +246,8 @@ def _collinear(Y, F, rep, mean, merr, out):
     on the line) is the mean clamped to it. Returns its error bound; −1 when the mean's
     position against an end is undecided or Ψ is empty, −2 when not collinear."""
     m = Y.shape[0]
-    i0 = rep[0]
-    j0 = np.int64(-1)  # (typed int64: a literal would compile _orient once more)
+    i0 = 0
+    j0 = -1
     for q in range(m):
         if rep[q] == q and q != i0:
             if j0 < 0:
@@ -490,7 +490,7 @@ def _project(P, E, EL, nv, Y, ends, box, m0, m1, merr, out):
     if inside and undecided:
         return -1.0
     best = np.inf
-    bv = np.int64(0)  # (not a literal: that would compile _edge_nearest twice)
+    bv = 0
     bt = 0.0
     for v in range(nv):
         w = (v + 1) % nv
@@ -788,7 +788,7 @@ def _polygons(Ys, todo, F, out, err, status):
             EL[k] = -1 - k  # box side k: edge k → k+1 (bottom, right, top, left)
             VA[k] = -1 - k
             VB[k] = -1 - (k + 3) % 4  # corner k is on sides k and k − 1
-        nv = np.int64(4)  # (not a literal: that would compile _clip twice)
+        nv = 4
         for h in range(nh):
             nq = _clip(P, E, PT, EL, VA, VB, nv, h, A, C, Aerr, Cerr, ends, sgn, Y, box,
                        Q, QE, QPT, QEL, QVA, QVB)
