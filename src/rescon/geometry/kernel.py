@@ -312,10 +312,17 @@ def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
     of X by 2^j, as is then everything computed from them in floats (origin, basis,
     the guides' frame)."""
     if hull.dim == len(P.ints[0]):  # the pivot coordinates are all of x
-        return tuple(sorted(tuple(Fraction(y, w * P.scale) for y in ys)
-                            for w, *ys in poly.verts))
-    return tuple(sorted(hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
-                        for y in poly.fraction_vertices()))
+        return tuple(sorted((tuple(Fraction(y, w * P.scale) for y in ys)
+                             for w, *ys in poly.verts), key=_lex_key))
+    return tuple(sorted((hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
+                         for y in poly.fraction_vertices()), key=_lex_key))
+
+
+def _lex_key(x: tuple[Fraction, ...]) -> tuple:
+    """A sort key giving the lexicographic order of x: each coordinate's correctly
+    rounded float (monotone: fl(s) < fl(t) implies s < t) before its exact value, so
+    Fractions are compared only when the floats tie."""
+    return tuple(z for v in x for z in (float(v), v))
 
 
 def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
