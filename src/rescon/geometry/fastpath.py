@@ -118,15 +118,33 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
         if any(len(f) < k for f in facets):
             return None
         # floats first: halfspaces clearly violated by a proposed vertex join sel
-        from ._candidates import row_max
-
-        top = row_max(H.af, H.bf, np.ascontiguousarray(V))
+        top = _row_max(H, V)
         bad = top > 1e-9 * (1.0 + np.abs(H.bf))
         if bad.any():
             sel = np.union1d(sel, np.flatnonzero(bad))
             continue
         return _certify(H, k, scale, sel, facets, V, top)
     return None
+
+
+def _row_max(H, V: np.ndarray) -> np.ndarray:
+    """Per row h, an upper bound on max_v a_h·v − b_h over the float vertices V (the
+    value itself where it may be ≥ 0). With x0 their mean and R ≥ max ‖v − x0‖,
+    a·v − b ≤ a·x0 − b + ‖a‖ R; the bound adds 1e-6 of the magnitudes of its terms (far
+    above the rounding of these few operations), and the rows it does not place
+    below 0 (NaN included) get the maximum over V itself (:func:`._candidates.row_max`)."""
+    from ._candidates import row_max
+
+    x0 = V.mean(axis=0)
+    R = float(np.sqrt(((V - x0) ** 2).sum(axis=1).max()))
+    norm_r = np.sqrt((H.af**2).sum(axis=1)) * R
+    centre = H.af @ x0
+    top = centre - H.bf + norm_r + 1e-6 * (np.abs(H.af) @ np.abs(x0) + np.abs(H.bf) + norm_r)
+    rows = np.flatnonzero(~(top < 0.0))
+    if len(rows):
+        top[rows] = row_max(np.ascontiguousarray(H.af[rows]), np.ascontiguousarray(H.bf[rows]),
+                            np.ascontiguousarray(V))
+    return top
 
 
 def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
@@ -168,9 +186,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     coarse = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs) + floor
     row_bound = coarse
     if V is None or top is None:
-        from ._candidates import row_max
-
-        top = row_max(H.af, H.bf, np.ascontiguousarray(Vx))
+        top = _row_max(H, Vx)
     else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
         shift = np.abs(V[kept] - Vx[of_proposal]).max()
         row_bound = row_bound + l1 * shift
@@ -222,7 +238,10 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     Z's rarest row are scanned."""
     count: Counter[int] = Counter()
     for t in tight:
-        if t.bit_count() <= MAX_TIGHT:
+        m = t.bit_count()
+        if m == k:
+            count.update(t ^ (1 << h) for h in _bits(t))
+        elif m <= MAX_TIGHT:
             count.update(sum(1 << h for h in sub)
                          for sub in itertools.combinations(_bits(t), k - 1))
     members: dict[int, list[int]] = {}

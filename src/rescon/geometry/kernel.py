@@ -275,8 +275,9 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     else:
         poly = _clip(P, hull, F)
         verts = _lifted_vertices(poly, hull, P)
+        incidence = poly.incidence()
         ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
-                   for h in sorted(poly.incidence())}
+                   for h in sorted(incidence)}
         constraints = tuple(ambient.values())
     if not verts:
         exact = _Exact(verts, constraints, eqs)
@@ -286,9 +287,9 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
                           lambda: _empty_certificate(Xa, F, hull, poly, P.scale, d))
     full = poly is not None and hull.dim == d and poly.dim() == d
     dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d, full)
-    facets = _relative_facets(poly, ambient, dim) if poly is not None else []
+    facets = _relative_facets(poly, incidence, ambient, dim) if poly is not None else []
     if poly is not None:
-        constraints = _needed_rows(poly, ambient, facets)
+        constraints = _needed_rows(poly, incidence, ambient, facets)
     A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts[0]), d)
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
 
@@ -403,7 +404,7 @@ def _affine_of(verts, d: int, full: bool):
     return dim, origin, basis, Aeq, beq, kernel_eqs
 
 
-def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
+def _relative_facets(poly: ExactPolytope, incidence: dict, ambient: dict, dim: int):
     """Constraints whose tight vertices span a (dim − 1)-face: the facets of Ψ relative
     to its affine hull (implicit equalities, tight everywhere, are left out), as
     ``ambient[h]`` (the constraint h in the original coordinates), ordered by their
@@ -414,7 +415,7 @@ def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
         return []
     nv = len(poly.verts)
     out = []
-    for h, members in sorted(poly.incidence().items()):
+    for h, members in sorted(incidence.items()):
         # a face tight on h (not on every vertex) has dimension ≤ dim − 1, so it is a
         # facet iff its dimension is at least dim − 1
         if len(members) >= dim and len(members) < nv and (
@@ -423,14 +424,14 @@ def _relative_facets(poly: ExactPolytope, ambient: dict, dim: int):
     return sorted(out, key=lambda row: tuple(v / max(map(abs, row[0])) for v in row[0]))
 
 
-def _needed_rows(poly: ExactPolytope, ambient: dict, facets: list) -> tuple:
+def _needed_rows(poly: ExactPolytope, incidence: dict, ambient: dict, facets: list) -> tuple:
     """The constraints that state Ψ: those tight at every vertex (they cut out aff Ψ
     within aff X) and the relative facets. A polytope is the intersection of its
     facets within its affine hull, and each vertex is the meet of the facets through
     it, so the rows tight only on smaller faces (the fast path's extra supporting
     planes at degenerate vertices) are redundant — the certificate leaves them out."""
     nv = len(poly.verts)
-    implicit = [ambient[h] for h, members in sorted(poly.incidence().items())
+    implicit = [ambient[h] for h, members in sorted(incidence.items())
                 if len(members) == nv]
     return tuple(implicit + facets)
 
