@@ -604,7 +604,7 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
 def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[int]]],
                    names: list[str], ctx: Any) -> str:
     """P = conv(V) ⊆ Psi for a full-dimensional polytope P in d = 2 or 3 (vert(P) = V
-    already proved; ``tight[i]``: the integer normals of the facets tight at V[i]), by
+    already proved; ``tight[i]``: the nonzero integer normals of the facets tight at V[i]), by
     the normal fan:
 
         P ⊆ Psi  iff  for every vertex v and every w ≠ 0 in the normal cone N_v of P
@@ -1198,8 +1198,10 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
             _tverberg(parts, f"proof.vertex_parts[{i}]", pts, F, V[i], names[i], ctx)
         how = "tverberg"
     elif spanned and d == dim and d in (2, 3):
-        how = _fan_in_kernel(pts, F, V, [[Fi[j][0] for j in on] for on in incidence],
-                             names, ctx)
+        # a zero normal (0·x <= b, tight when b = 0) adds nothing to N_v: dropped, as
+        # the d = 3 sweep needs nonzero generators of N_v ∩ u^⊥
+        how = _fan_in_kernel(pts, F, V, [[Fi[j][0] for j in on if any(Fi[j][0])]
+                                         for on in incidence], names, ctx)
     else:
         how = _in_kernel_halfspaces(pts, F, V, names, ctx, "vertices")
     nv = f"{len(V)} vertex" if len(V) == 1 else f"{len(V)} vertices"
