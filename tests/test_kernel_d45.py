@@ -151,3 +151,16 @@ def test_extra_rows_of_a_merged_proposal_are_decided_exactly():
     if P is not None:
         assert P.tight[P.verts.index(vertex)].bit_count() == honest.tight[
             honest.verts.index(vertex)].bit_count()
+
+
+@pytest.mark.parametrize("d,n,F", [(3, 40, 4), (4, 22, 2), (5, 12, 1)])
+def test_fast_path_adjacency_equals_the_incidence_one(d, n, F):
+    """The certificate's edges come from the fast path's closure proof; they are the
+    edges the incidence test finds (and the checker accepts them)."""
+    from rescon.geometry._skeleton import vertex_adjacency
+
+    X = np.random.default_rng([d, n]).normal(size=(n, d))
+    K = rescon.safe_kernel(X, F)
+    cert = K.certificate
+    verts = K.exact_vertices
+    assert cert["adjacency"] == vertex_adjacency(verts, K._exact.constraints)

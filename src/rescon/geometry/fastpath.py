@@ -1,28 +1,32 @@
-"""Certified fast path for full-dimensional, simple kernels: qhull proposes, integers decide.
+"""Certified fast path for full-dimensional kernels: qhull proposes, integers decide.
 
 Floats (a Chebyshev LP for an interior point, then qhull's halfspace intersection)
-propose the vertices of Ψ and, for each vertex, the k valid halfspaces that define it.
-The proposal is accepted only if, in exact arithmetic,
+propose the vertices of Ψ and, for each vertex, the valid halfspaces that qhull finds
+tight there (k of them at a simple vertex, more where qhull merged a non-simple one —
+common in d ≥ 4, where many hyperplanes through data points meet). Each proposal is
+solved exactly from k of its rows that floats suggest are independent (Cramer's rule
+for all vertices at once); the proposal is accepted only if, in exact arithmetic,
 
-1. every proposed vertex v (the exact solution of its k defining equations) satisfies
-   every valid halfspace, and is tight on none but its own k (a simple vertex) —
-   so conv(V) ⊆ Ψ by the characterisation theorem;
-2. for every vertex and every k − 1 of its defining halfspaces there is another
-   proposed vertex with the same k − 1: the edge of P_S = ⋂ (defining halfspaces)
-   leaving v along them ends at a proposed vertex (it lies on that line and in P_S),
-   so every edge of P_S is bounded and the vertex set V is closed under adjacency;
-   the graph of a polyhedron is connected, hence V is all of P_S's vertices and P_S
-   is the polytope conv(V).
+1. every proposed vertex v satisfies every valid halfspace, and its tight set within
+   the defining halfspaces S (the rows of all proposals) is computed exactly — so
+   conv(V) ⊆ Ψ by the characterisation theorem;
+2. every extreme ray of every vertex's tangent cone {d : a_h·d ≤ 0, h tight at v}
+   leads to another proposed vertex: for a simple vertex the rays keep all but one of
+   its k rows tight; for a non-simple one they come from an integer double description
+   of the cone. The rows Z tight along a ray have rank k − 1, so a vertex u ≠ v with
+   Z ⊆ tight(u) lies on the ray's line, hence on the ray (v is a vertex) and the edge of
+   P_S = ⋂ S leaving v along it is bounded and ends at a proposed vertex. So V is
+   closed under adjacency; the graph of a polyhedron is connected, hence V is all of
+   P_S's vertices and P_S is the polytope conv(V).
 
 Then Ψ ⊆ P_S (valid halfspaces) = conv(V) ⊆ Ψ. Anything else — a lower-dimensional
-or degenerate kernel, a qhull failure, a vertex the check rejects — returns None and
-the caller clips exactly (:mod:`.polytope`).
+kernel, a qhull failure, a vertex the check rejects, or one missed (e.g. its k chosen
+rows were dependent) — returns None and the caller clips exactly (:mod:`.polytope`).
 """
 
 from __future__ import annotations
 
 import itertools
-from collections import Counter
 from math import gcd
 
 import numpy as np
@@ -215,7 +219,8 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         if slack == 0 and h in where:
             tight[vi] |= 1 << where[h]
     normals = [H.exact(h)[0] for h in S_set]
-    if not _closed(tight, basis, normals, k):
+    edges = _closed(tight, basis, normals, k)
+    if edges is None:
         return None
     P = ExactPolytope(k, unit=scale)
     for h in S_set:
@@ -224,26 +229,31 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         P.b.append(b)
     P.verts = verts
     P.tight = tight
+    P.edges = edges
     return P
 
 
 def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
-            k: int) -> bool:
-    """Every extreme ray of every vertex's tangent cone leads to another vertex. A
-    simple vertex (k tight rows) has a simplicial cone whose rays keep all but one row
-    tight; a non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight
-    along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆
-    tight[u]. Fast test: the (k − 1)-subsets of the tight sets (of at most MAX_TIGHT
-    rows) counted — a key counted twice is in some u ≠ v; otherwise the vertices on
-    Z's rarest row are scanned."""
-    count: Counter[int] = Counter()
-    for t in tight:
+            k: int) -> list[list[int]] | None:
+    """The edges of P_S — for each vertex, its neighbours, increasing — if every extreme
+    ray of every vertex's tangent cone leads to another vertex, else None. A simple
+    vertex (k tight rows) has a simplicial cone whose rays keep all but one row tight; a
+    non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight along a ray
+    have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆ tight[u], and then
+    it is the other end of the edge (the line meets P_S in that edge). Found through the
+    (k − 1)-subsets of the tight sets (of at most MAX_TIGHT rows) — a ray whose Z is one
+    of them names its vertices — else among the vertices on Z's rarest row."""
+    on: dict[int, list[int]] = {}
+    for vi, t in enumerate(tight):
         m = t.bit_count()
         if m == k:
-            count.update(t ^ (1 << h) for h in _bits(t))
+            keys = [t ^ (1 << h) for h in _bits(t)]
         elif m <= MAX_TIGHT:
-            count.update(sum(1 << h for h in sub)
-                         for sub in itertools.combinations(_bits(t), k - 1))
+            keys = [sum(1 << h for h in sub) for sub in itertools.combinations(_bits(t), k - 1)]
+        else:
+            continue
+        for key in keys:
+            on.setdefault(key, []).append(vi)
     members: dict[int, list[int]] = {}
     for vi, t in enumerate(tight):
         for h in _bits(t):
@@ -251,16 +261,21 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     non_simple = [vi for vi, t in enumerate(tight) if t.bit_count() > k]
     starts = dict(zip(non_simple, _simplicial_rays(normals, [basis[vi] for vi in non_simple], k),
                       strict=True))
+    edges = []
     for vi, t in enumerate(tight):
         rays = ([t ^ (1 << h) for h in _bits(t)] if vi not in starts
                 else _tangent_rays(normals, basis[vi], list(_bits(t)), k, starts[vi]))
+        ends = set()
         for Z in rays:
-            if count[Z] >= 2:
-                continue
-            fewest = min((members[h] for h in _bits(Z)), key=len)
-            if not any((tight[u] & Z) == Z for u in fewest if u != vi):
-                return False
-    return True
+            u = next((u for u in on.get(Z, ()) if u != vi), None)
+            if u is None:
+                fewest = min((members[h] for h in _bits(Z)), key=len)
+                u = next((u for u in fewest if u != vi and (tight[u] & Z) == Z), None)
+                if u is None:
+                    return None
+            ends.add(u)
+        edges.append(sorted(ends))
+    return edges
 
 
 def _near_pairs(H, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray, c: float,

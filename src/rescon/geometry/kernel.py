@@ -271,10 +271,11 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     if hull.dim == 0:
         poly = None
         verts = (P.fraction(0),)
+        order: list[int] = []
         constraints: tuple = ()
     else:
         poly = _clip(P, hull, F)
-        verts = _lifted_vertices(poly, hull, P)
+        verts, order = _lifted_vertices(poly, hull, P)
         incidence = poly.incidence()
         ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
                    for h in sorted(incidence)}
@@ -297,7 +298,7 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         return {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(),
                 "F": F, "dim": dim, "vertices": [[fraction_str(v) for v in x] for x in verts],
                 "equalities": halfspaces_json(eqs), "facets": halfspaces_json(constraints),
-                "adjacency": vertex_adjacency(verts, constraints),
+                "adjacency": _adjacency(poly, order, verts, constraints),
                 "proof": {"method": "halfspaces"}}
 
     V = np.array([[float(v) for v in x] for x in verts])
@@ -306,17 +307,30 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
 
 
 def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
-                     ) -> tuple[tuple[Fraction, ...], ...]:
+                     ) -> tuple[tuple[tuple[Fraction, ...], ...], list[int]]:
     """The vertices of Ψ in the original coordinates, exactly (from the homogeneous
     scaled-integer vertices (w, y) of the clipped polytope: x = y / (w · scale)), in
     lexicographic order — independent of how the polytope was built and of a scaling
     of X by 2^j, as is then everything computed from them in floats (origin, basis,
-    the guides' frame)."""
+    the guides' frame). Also ``order``: the polytope's index of each vertex returned."""
     if hull.dim == len(P.ints[0]):  # the pivot coordinates are all of x
-        return tuple(sorted((tuple(Fraction(y, w * P.scale) for y in ys)
-                             for w, *ys in poly.verts), key=_lex_key))
-    return tuple(sorted((hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
-                         for y in poly.fraction_vertices()), key=_lex_key))
+        pts = [tuple(Fraction(y, w * P.scale) for y in ys) for w, *ys in poly.verts]
+    else:
+        pts = [hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
+               for y in poly.fraction_vertices()]
+    order = sorted(range(len(pts)), key=lambda i: _lex_key(pts[i]))
+    return tuple(pts[i] for i in order), order
+
+
+def _adjacency(poly: ExactPolytope | None, order: list[int], verts, constraints
+               ) -> list[list[int]]:
+    """The certificate's edges: those the fast path found while proving closure
+    (renumbered as the sorted vertices), else from the incidence
+    (:func:`._skeleton.vertex_adjacency`)."""
+    if poly is None or poly.edges is None:
+        return vertex_adjacency(verts, constraints)
+    where = {p: j for j, p in enumerate(order)}
+    return [sorted(where[u] for u in poly.edges[p]) for p in order]
 
 
 def _lex_key(x: tuple[Fraction, ...]) -> tuple:

@@ -81,6 +81,7 @@ class ExactPolytope:
     unit: int = 1  # a power of two: the float vertices are y / (w · unit)
     _fv: np.ndarray | None = field(default=None, repr=False)  # float vertices (cache)
     work: int = 0  # estimated steps spent clipping so far (:mod:`._budget`)
+    edges: list[list[int]] | None = None  # per vertex its neighbours, when known (fast path)
 
     @classmethod
     def box(cls, lo: list[int], hi: list[int], unit: int = 1) -> ExactPolytope:
@@ -198,6 +199,7 @@ class ExactPolytope:
         fv = self._float_array()
         self.verts = [self.verts[i] for i in keep] + new_v
         self.tight = [self.tight[i] | (bit if sign[i] == 0 else 0) for i in keep] + new_t
+        self.edges = None
         self._fv = np.vstack([fv[keep], np.array(new_f, dtype=np.float64).reshape(-1, self.k)])
         self.a.append(a)
         self.b.append(b)
