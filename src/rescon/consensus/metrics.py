@@ -166,13 +166,13 @@ class ValidityMonitor:
         self._triangles = _hull_triangles(self.hull) if full and initial.shape[1] == 3 else None
 
     def distance(self, x: np.ndarray) -> float:
+        """dist(x, H): 0 iff x ∈ H (exact test); else ‖x − y‖ for the exact projection y
+        of x onto H, from the exact differences x_j − y_j (rounding y first made x − fl(y)
+        0 or all cancellation for a state within a few ulps of H): :func:`_norm`."""
         if self.hull.contains(x):
             return 0.0
-        y, _ = self.hull.point("project", target=x)
-        v = x - y
-        if 1e-150 <= np.abs(v).max() <= 1e150:  # no square over- or underflows
-            return float(np.linalg.norm(v))
-        return math.hypot(*v)  # scaled: 1e-162 no longer gives 0, 1e300 no longer inf
+        _, cert = self.hull.point("project", target=x)
+        return _norm([Fraction(float(a)) - Fraction(b) for a, b in zip(x, cert["x"])])
 
     def surely_inside(self, states: np.ndarray) -> np.ndarray:
         """Rows of ``states`` (n, d) that a float filter proves inside the hull (False:
@@ -228,13 +228,13 @@ class ValidityMonitor:
         ‖w − t e‖, e = q − p, w = x − p, t = clip(w·e / e·e, 0, 1), on the vertices
         rounded to floats, and ``edge_error`` (inf where the bound does not apply)."""
         P, Q = self._edges
-        e = Q - P
-        ee = (e * e).sum(axis=1)
-        w = X[:, None, :] - P[None, :, :]
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # 1e300: inf
+            e = Q - P  # (edge_error is inf there: the exact path decides)
+            ee = (e * e).sum(axis=1)
+            w = X[:, None, :] - P[None, :, :]
             t = np.clip(np.where(ee > 0, (w * e).sum(axis=2) / ee, 0.0), 0.0, 1.0)
-        r = w - t[:, :, None] * e
-        return np.hypot(r[:, :, 0], r[:, :, 1]).min(axis=1), self.edge_error(X)
+            r = w - t[:, :, None] * e
+            return np.hypot(r[:, :, 0], r[:, :, 1]).min(axis=1), self.edge_error(X)
 
     def triangle_distances(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For states X (n, 3) outside H: δ = min over the boundary triangles (on the
@@ -416,6 +416,20 @@ def _filter_rows(facets) -> tuple[np.ndarray, np.ndarray]:
             for a, beta in facets for top in (max(map(abs, a)),)]
     A = np.array([[float(v) for v in a] for a, _ in rows])
     return A, np.array([_float(beta) for _, beta in rows])
+
+
+def _norm(v: list[Fraction]) -> float:
+    """‖v‖₂ of an exact nonzero vector, within a few u: v·2^-e with max|v_j|·2^-e ∈
+    [1/2, 2) rounded per coordinate (no over- or underflow), its hypot times 2^e; at
+    least the smallest subnormal (a nonzero distance never rounds to 0), inf beyond
+    the float range."""
+    top = max(map(abs, v))
+    e = top.numerator.bit_length() - top.denominator.bit_length()
+    try:
+        return max(math.ldexp(math.hypot(*(float(t / Fraction(2) ** e) for t in v)), e),
+                   MIN_SUBNORMAL)
+    except OverflowError:
+        return math.inf
 
 
 def _float(v: Fraction) -> float:

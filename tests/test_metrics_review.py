@@ -1,0 +1,142 @@
+"""Hostile review of the engine's monitors (issue 13 §1): validity distances and the
+diameter against an independent exact brute force (Fractions: a state is in the hull
+iff it is in the hull of d + 1 initial states (Carathéodory); outside, its distance is
+the least distance to a segment / triangle of initial states)."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from itertools import combinations, combinations_with_replacement
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rescon.consensus.metrics import ValidityMonitor
+
+
+def _solve(M, rhs):
+    """The solution of M λ = rhs for M of full column rank; None if inconsistent or
+    the columns are dependent."""
+    rows, cols = len(M), len(M[0])
+    A = [list(M[i]) + [rhs[i]] for i in range(rows)]
+    for c in range(cols):
+        p = next((i for i in range(c, rows) if A[i][c]), None)
+        if p is None:
+            return None
+        A[c], A[p] = A[p], A[c]
+        A[c] = [x / A[c][c] for x in A[c]]
+        for i in range(rows):
+            if i != c and A[i][c]:
+                f = A[i][c]
+                A[i] = [x - f * y for x, y in zip(A[i], A[c])]
+    if any(A[i][cols] for i in range(cols, rows)):
+        return None
+    return [A[i][cols] for i in range(cols)]
+
+
+def _in_hull(P, x) -> bool:
+    d = len(x)
+    for k in range(1, d + 2):
+        for T in combinations(P, k):
+            lam = _solve([[p[j] for p in T] for j in range(d)] + [[1] * k], list(x) + [1])
+            if lam is not None and min(lam) >= 0:
+                return True
+    return False
+
+
+def _seg2(x, p, q):
+    e = [b - a for a, b in zip(p, q)]
+    w = [a - b for a, b in zip(x, p)]
+    ee = sum(t * t for t in e)
+    t = 0 if ee == 0 else min(Fraction(1), max(Fraction(0), sum(map(
+        lambda a, b: a * b, w, e)) / ee))
+    return sum((a - t * b) ** 2 for a, b in zip(w, e))
+
+
+def _tri2(x, a, b, c):
+    e0, e1 = [q - p for p, q in zip(a, b)], [q - p for p, q in zip(a, c)]
+    w = [q - p for p, q in zip(a, x)]
+    g00, g01, g11 = (sum(i * j for i, j in zip(u, v)) for u, v in ((e0, e0), (e0, e1), (e1, e1)))
+    r0, r1 = sum(i * j for i, j in zip(e0, w)), sum(i * j for i, j in zip(e1, w))
+    best = min(_seg2(x, a, b), _seg2(x, a, c), _seg2(x, b, c))
+    det = g00 * g11 - g01 * g01
+    if det:
+        s, t = (r0 * g11 - r1 * g01) / det, (g00 * r1 - g01 * r0) / det
+        if s >= 0 and t >= 0 and s + t <= 1:
+            best = min(best, sum((xi - ai - s * u - t * v) ** 2
+                                 for xi, ai, u, v in zip(x, a, e0, e1)))
+    return best
+
+
+def exact_distance(initial: np.ndarray, x: np.ndarray) -> float:
+    """dist(x, conv initial) (d = 2, 3) as the float nearest its exact value (0 iff in)."""
+    P = [[Fraction(t) for t in p] for p in initial]
+    xq = [Fraction(t) for t in x]
+    if _in_hull(P, xq):
+        return 0.0
+    if len(xq) == 2:
+        sq = min(_seg2(xq, p, q) for p, q in combinations_with_replacement(P, 2))
+    else:
+        sq = min(_tri2(xq, *t) for t in combinations_with_replacement(P, 3))
+    e = (sq.numerator.bit_length() - sq.denominator.bit_length()) // 2
+    return math.ldexp(math.sqrt(float(sq / Fraction(4) ** e)), e)
+
+
+def _agrees(got: float, want: float) -> bool:
+    """Equal zeros, or within 1e-14 relative (two subnormal steps below 1e-308)."""
+    return got == want == 0 or (want > 0 and abs(got - want) <= 1e-14 * want + 2**-1073)
+
+
+def test_state_just_outside_a_flat_hull_is_not_at_distance_zero():
+    """The exact projection y of a state outside a segment rounded to the state itself,
+    so x − fl(y) was 0: 'distance 0 exactly when inside' was broken (8e-22 at 1e-5)."""
+    X0 = np.array([[2.5e-05, -5e-06], [-3.5000000000000004e-05, 2.5e-05]])
+    x = np.array([-5.000000000000001e-06, 1e-05])
+    mon = ValidityMonitor(X0)
+    want = exact_distance(X0, x)
+    assert want > 0
+    assert _agrees(mon.distance(x), want)
+    assert _agrees(mon.distances(x[None])[0], want)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-150, 1e-5, 1.0, 1e5, 1e150, 1e300])
+@pytest.mark.parametrize("d", [2, 3])
+def test_float_mean_of_a_flat_hull_at_every_magnitude(scale, d):
+    """The float mean of coplanar / collinear initial states is generally just off their
+    plane: its distance is tiny but not 0."""
+    rng = np.random.default_rng(d)
+    Y = rng.integers(-3, 4, (6, d - 1)).astype(float)
+    X0 = np.c_[Y, Y @ rng.integers(1, 3, d - 1) / 3] * scale
+    S = np.vstack([X0.mean(axis=0), X0[:3] * 0.7, X0[:1] * (1 + 1e-9)])
+    got = ValidityMonitor(X0).distances(S)
+    for g, x in zip(got, S):
+        assert _agrees(g, exact_distance(X0, x)), (g, exact_distance(X0, x), x)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 10**6), d=st.sampled_from([2, 3]),
+       kind=st.sampled_from(["gauss", "int", "flat", "dup", "same"]),
+       scale=st.sampled_from([1e-300, 1e-5, 1.0, 1e150, 1e300]))
+def test_validity_distances_agree_with_brute_force(seed, d, kind, scale):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 7))
+    if kind == "gauss":
+        X0 = rng.standard_normal((n, d))
+    elif kind == "int":
+        X0 = rng.integers(-3, 4, (n, d)).astype(float)
+    elif kind == "flat":
+        Y = rng.integers(-3, 4, (n, d - 1)).astype(float)
+        X0 = np.c_[Y, Y @ rng.integers(-2, 3, d - 1) / 3]
+    elif kind == "dup":
+        X0 = np.repeat(rng.standard_normal((max(1, n // 2), d)), 2, axis=0)
+    else:
+        X0 = np.tile(rng.standard_normal(d), (n, 1))
+    X0 = X0 * scale
+    S = np.vstack([X0[rng.integers(0, len(X0), 2)] * rng.uniform(0.5, 1.5, (2, 1)),
+                   rng.standard_normal((2, d)) * scale, X0.mean(axis=0, keepdims=True)])
+    got = ValidityMonitor(X0).distances(S)
+    for g, x in zip(got, S):
+        assert _agrees(g, exact_distance(X0, x)), (g, exact_distance(X0, x), x)
