@@ -228,3 +228,22 @@ def test_misspelt_generator_parameters_are_refused_when_the_grid_is_read(grid):
             "run": {"kind": "robustness"}, **grid}
     with pytest.raises(InputError, match="circulant takes n, k, directed"):
         read_grid(full)
+
+
+@pytest.mark.slow
+def test_a_cell_that_kills_its_worker_is_a_failed_row_not_a_crash(tmp_path):
+    """User code (an RMDO ``module`` cost, an out-of-memory kill) can end the worker
+    process: Dask then raises KilledWorker from the future, which stopped the whole
+    sweep with a traceback instead of recording the cell."""
+    import dask
+
+    (tmp_path / "killer.py").write_text("import os\n\n\ndef build():\n    os._exit(1)\n")
+    (tmp_path / "grid.toml").write_text(
+        '[base.scenario]\nF = 1\nsteps = 3\ncheck_robustness = false\n'
+        '[base.graph]\ngenerator = "complete"\nn = 6\n'
+        '[base.initial.random]\nlow = 0.0\nhigh = 1.0\nd = 2\n'
+        '[base.costs]\nmodule = "killer:build"\n')
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        table = rescon.sweep(tmp_path / "grid.toml", workers=1, out=tmp_path / "out")
+    assert list(table["status"]) == ["failed"]
+    assert table["error"][0].startswith("KilledWorker")

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["METRICS", "run_cell", "steps_to_consensus"]
+__all__ = ["METRICS", "failed_row", "run_cell", "steps_to_consensus"]
 
 #: the result columns of a row, after the axes, ``repetition`` and ``seed``
 METRICS = ("status", "error", "final_diameter", "max_validity", "steps_to_consensus",
@@ -46,21 +46,32 @@ def run_cell(cell: dict[str, Any]) -> dict[str, Any]:
     """Run one cell (:meth:`rescon.sweep.grid.Grid.cells`) and return its row. Any
     exception — an invalid scenario included — is recorded: status "failed", error
     "<Type>: <message>" (first line), metrics null; it never escapes."""
-    from .. import __version__
-
-    row: dict[str, Any] = {**{k: cell["params"][k] for k in cell["params"]},
-                           "repetition": cell["repetition"], "seed": cell["seed"]}
     t0 = time.perf_counter()
-    row.update(dict.fromkeys(_RESULTS))
     try:
         run = _KIND_RUNS[cell.get("kind", "consensus")]
         metrics = run(cell["spec"], Path(cell["path"]), cell["epsilon"])
-        row.update(status="ok", error=None, **metrics)
     except Exception as exc:  # noqa: BLE001 (a failing cell is recorded, not raised)
-        message = str(exc).splitlines()[0] if str(exc) else ""
-        row.update(status="failed", error=f"{type(exc).__name__}: {message}")
-    row.update(seconds=time.perf_counter() - t0, rescon_version=__version__)
-    return row
+        return failed_row(cell, exc, time.perf_counter() - t0)
+    return _row(cell, status="ok", error=None, **metrics,
+                seconds=time.perf_counter() - t0)
+
+
+def failed_row(cell: dict[str, Any], exc: BaseException,
+               seconds: float | None = None) -> dict[str, Any]:
+    """The row of a cell that raised ``exc`` — in the cell, or as the worker running it
+    died (Dask's KilledWorker) —: status "failed", error "<Type>: <first line>"."""
+    message = str(exc).splitlines()[0] if str(exc) else ""
+    return _row(cell, status="failed", error=f"{type(exc).__name__}: {message}",
+                seconds=seconds)
+
+
+def _row(cell: dict[str, Any], **results: Any) -> dict[str, Any]:
+    """A row: the cell's axis values, repetition and seed, then every column of
+    :data:`METRICS` (null unless in ``results``)."""
+    from .. import __version__
+
+    return {**cell["params"], "repetition": cell["repetition"], "seed": cell["seed"],
+            **dict.fromkeys(_RESULTS), **results, "rescon_version": __version__}
 
 
 def _run(spec: dict[str, Any], path: Path, epsilon: float) -> dict[str, Any]:

@@ -18,7 +18,7 @@ from typing import Any
 
 from .._progress import progress_bar
 from ..errors import InputError, MissingDependency
-from .cell import METRICS, run_cell
+from .cell import METRICS, failed_row, run_cell
 from .grid import Grid, read_grid
 
 __all__ = ["sweep"]
@@ -96,9 +96,14 @@ def _execute(cells: list[dict[str, Any]], scheduler: str | None,
         from distributed import as_completed
 
         futures = client.map(run_cell, cells, pure=False)
-        index = {f.key: c["cell"] for f, c in zip(futures, cells, strict=True)}
+        index = {f.key: c for f, c in zip(futures, cells, strict=True)}
         for fut in as_completed(futures):
-            yield {"cell": index[fut.key], **fut.result()}
+            cell = index[fut.key]
+            try:
+                row = fut.result()
+            except Exception as exc:  # noqa: BLE001 (the workers running it died: KilledWorker)
+                row = failed_row(cell, exc)
+            yield {"cell": cell["cell"], **row}
             fut.release()
 
 
