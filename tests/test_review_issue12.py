@@ -247,3 +247,40 @@ def test_a_cell_that_kills_its_worker_is_a_failed_row_not_a_crash(tmp_path):
         table = rescon.sweep(tmp_path / "grid.toml", workers=1, out=tmp_path / "out")
     assert list(table["status"]) == ["failed"]
     assert table["error"][0].startswith("KilledWorker")
+
+
+@pytest.mark.slow
+def test_a_scheduler_without_workers_is_a_clear_error_not_a_hang(tmp_path, monkeypatch):
+    """`dask scheduler` running but no `dask worker`: the sweep waited forever."""
+    import shutil
+    import subprocess
+    import sys
+
+    from rescon.sweep import run as run_mod
+
+    monkeypatch.setattr(run_mod, "WORKER_SECONDS", 2)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    dask = shutil.which("dask", path=str(Path(sys.executable).parent))
+    proc = subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port),
+                             "--no-dashboard"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    grid = {"base": {"points": {"generator": "gaussian", "n": 5, "d": 2},
+                     "kernel": {"F": 1}}, "run": {"kind": "kernel"}}
+    try:
+        deadline = time.monotonic() + 30
+        while True:  # until the scheduler listens
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                assert time.monotonic() < deadline
+                time.sleep(0.3)
+        t0 = time.monotonic()
+        with pytest.raises(InputError, match="no worker joined"):
+            rescon.sweep(grid, scheduler=f"tcp://127.0.0.1:{port}")
+        assert time.monotonic() - t0 < 20
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)

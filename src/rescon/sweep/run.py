@@ -25,6 +25,8 @@ __all__ = ["sweep"]
 
 #: seconds to reach a scheduler given by address before giving up
 CONNECT_SECONDS = 5
+#: seconds to wait for a first worker on a scheduler that has none (else: no task runs)
+WORKER_SECONDS = 30
 
 
 def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
@@ -109,7 +111,8 @@ def _execute(cells: list[dict[str, Any]], scheduler: str | None,
 
 def _client(scheduler: str | None, workers: int | None) -> Any:
     """A distributed.Client on ``scheduler`` (refused within CONNECT_SECONDS when
-    unreachable) or on an embedded LocalCluster of processes (closed with the client)."""
+    unreachable, within WORKER_SECONDS when no worker joins it: its tasks would wait
+    forever) or on an embedded LocalCluster of processes (closed with the client)."""
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -120,11 +123,18 @@ def _client(scheduler: str | None, workers: int | None) -> Any:
             raise InputError(f"scheduler must be an address such as tcp://host:8786; got "
                              f"{scheduler!r}")
         try:
-            return Client(scheduler, timeout=CONNECT_SECONDS)
+            client = Client(scheduler, timeout=CONNECT_SECONDS)
         except Exception as exc:  # noqa: BLE001 (whatever answers there may be no Dask
             # scheduler: an HTTP reply read as a frame length is a MemoryError)
             raise InputError(f"scheduler {scheduler}: cannot connect ({type(exc).__name__}: "
                              f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
+        try:
+            client.wait_for_workers(1, timeout=WORKER_SECONDS)
+        except TimeoutError:
+            client.close()
+            raise InputError(f"scheduler {scheduler}: no worker joined in {WORKER_SECONDS} s "
+                             f"(start one: dask worker {scheduler})") from None
+        return client
     n = workers if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                            dashboard_address=None)
