@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rescon.consensus.metrics import ValidityMonitor
+from rescon.consensus.metrics import ValidityMonitor, diameter
 
 
 def _solve(M, rhs):
@@ -140,3 +140,44 @@ def test_validity_distances_agree_with_brute_force(seed, d, kind, scale):
     got = ValidityMonitor(X0).distances(S)
     for g, x in zip(got, S):
         assert _agrees(g, exact_distance(X0, x)), (g, exact_distance(X0, x), x)
+
+
+def _exact_diameter(X: np.ndarray) -> float:
+    P = [[Fraction(t) for t in p] for p in X]
+    sq = max(sum((a - b) ** 2 for a, b in zip(p, q)) for p in P for q in P)
+    if sq == 0:
+        return 0.0
+    e = (sq.numerator.bit_length() - sq.denominator.bit_length()) // 2
+    return math.ldexp(math.sqrt(float(sq / Fraction(4) ** e)), e)
+
+
+@pytest.mark.parametrize("rows", [
+    [[1.0, 1e-200], [1.0, 2e-200]],
+    [[0.3, 1e-200], [0.3, 2e-200], [0.3, 3e-200]],
+    [[0.3, -1.7, 5e-170], [0.3, -1.7, -5e-170], [0.3, -1.7, 0.0]],
+    [[1e300, 1e-300], [1e300, 0.0]],
+])
+def test_diameter_of_tiny_differences_beside_large_coordinates(rows):
+    """Rows equal but in a coordinate ~1e-200 (states converging along one axis): the
+    squares of the differences underflowed and the diameter was 0."""
+    X = np.array(rows)
+    assert _agrees(diameter(X), _exact_diameter(X))
+
+
+@pytest.mark.parametrize(("n", "d"), [(10000, 2), (3000, 3)])
+def test_diameter_of_identical_rows_compares_no_pairs(monkeypatch, n, d):
+    """Converged (bit-identical) states: their float mean is off by a rounding, so they
+    did not count as converged and all n² pairs were compared (5 s at N = 10 000 in the
+    plane, every step of a converged run)."""
+    from rescon.consensus import metrics
+
+    seen = []
+    real = metrics._pairwise_max
+    monkeypatch.setattr(metrics, "_pairwise_max",
+                        lambda P, X, *a, **k: seen.append(len(P) * len(X)) or real(P, X, *a, **k))
+    X = np.tile([0.3, -1.7, 2.1][:d], (n, 1))
+    assert diameter(X) == 0.0
+    assert sum(seen) <= 4 * n, seen
+    X[::2] += 2.0**-50  # two distinct values
+    assert _agrees(diameter(X), _exact_diameter(X[:2]))
+    assert sum(seen) <= 8 * n, seen

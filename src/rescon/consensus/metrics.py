@@ -71,9 +71,11 @@ def diameter(states: np.ndarray) -> float:
     ‖p − c‖ + R, so p ends no diameter when ‖p − c‖ + R < L for a lower bound L (the
     distances from the row farthest from c). Both ends of a diameter pass that test;
     the float test gets a relative slack 4(d + 2)u, far above the rounding of its
-    norms (each ‖x − c‖ is computed from exact-rounded differences). When R ≤ 1e-100
-    after scaling (the rows agree to 100 digits: converged states) or a row is not
-    finite, the distinct rows are compared pairwise. In the plane, when more than
+    norms (each ‖x − c‖ is computed from exact-rounded differences); repeated rows
+    are kept once (states at a few values: every row may end a diameter). When R or L
+    is ≤ 1e-100 after scaling (converged rows: their float mean is off by a rounding,
+    so R alone does not see it) or a row is not finite, the distinct rows are compared
+    pairwise by chained hypot (no square underflows). In the plane, when more than
     ANGULAR_MIN rows are kept (states on a circle), only near-antipodal pairs are
     compared (:func:`_antipodal_max`). Memory O(n·d) (pairs in blocks); time O(n·kept)."""
     X = np.asarray(states, dtype=float)
@@ -87,14 +89,15 @@ def diameter(states: np.ndarray) -> float:
         X = np.ldexp(X, -scale)
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             r = np.sqrt(((X - X.mean(axis=0)) ** 2).sum(axis=1))
-            if 1e-100 < r.max() < 1e100:
-                far = np.sqrt(((X - X[np.argmax(r)]) ** 2).sum(axis=1)).max()
+            far = np.sqrt(((X - X[np.argmax(r)]) ** 2).sum(axis=1)).max()
+            if 1e-100 < r.max() < 1e100 and far > 1e-100:
                 keep = r + r.max() >= far * (1 - 4 * (X.shape[1] + 2) * UNIT_ROUNDOFF)
-                if X.shape[1] == 2 and keep.sum() > ANGULAR_MIN:
-                    return math.ldexp(_antipodal_max(X[keep], X.mean(axis=0), far), scale)
-                return math.ldexp(_pairwise_max(X[keep], X), scale)
+                K = np.unique(X[keep], axis=0)  # states at a few values: all ends
+                if X.shape[1] == 2 and len(K) > ANGULAR_MIN:
+                    return math.ldexp(_antipodal_max(K, X.mean(axis=0), far), scale)
+                return math.ldexp(_pairwise_max(K, X), scale)
     distinct = np.unique(X, axis=0)
-    return math.ldexp(_pairwise_max(distinct, distinct), scale)
+    return math.ldexp(_pairwise_max(distinct, distinct, hypot=True), scale)
 
 
 #: kept rows beyond which the plane's diameter compares near-antipodal pairs only
@@ -135,12 +138,18 @@ def _antipodal_max(K: np.ndarray, c: np.ndarray, L: float) -> float:
     return float(np.sqrt((diff**2).sum(axis=1)).max())
 
 
-def _pairwise_max(P: np.ndarray, X: np.ndarray, chunk: int = 256) -> float:
-    """max ‖p − x‖₂ over rows p of ``P`` and x of ``X``, in blocks of ``chunk`` rows."""
+def _pairwise_max(P: np.ndarray, X: np.ndarray, chunk: int = 256, hypot: bool = False
+                  ) -> float:
+    """max ‖p − x‖₂ over rows p of ``P`` and x of ``X``, in blocks of ``chunk`` rows;
+    ``hypot``: by chained hypot (no square under- or overflows: rows that differ by
+    1e-200 beside entries ~1, or at 1e300; within (d + 1)u, ~3x slower)."""
     best = -np.inf
     for s in range(0, max(len(P), 1), chunk):
         diff = P[s:s + chunk, None, :] - X[None, :, :]
-        best = np.maximum(best, np.sqrt((diff**2).sum(axis=2)).max())  # NaN propagates
+        with np.errstate(over="ignore"):  # a difference beyond the float range: inf
+            dist = (np.hypot.reduce(np.abs(diff), axis=2) if hypot
+                    else np.sqrt((diff**2).sum(axis=2)))
+        best = np.maximum(best, dist.max())  # NaN propagates
     return float(best)
 
 
