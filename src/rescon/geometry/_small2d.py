@@ -136,6 +136,21 @@ def _sorted_column(Y, c):
 
 
 @inner_kernel
+def _sorted_values(Y, c):
+    """Column c of Y in increasing order (insertion sort: a few dozen values, of the
+    collinear sets only)."""
+    vals = np.empty(Y.shape[0])
+    for q in range(Y.shape[0]):
+        v = Y[q, c]
+        j = q
+        while j > 0 and v < vals[j - 1]:
+            vals[j] = vals[j - 1]
+            j -= 1
+        vals[j] = v
+    return vals
+
+
+@inner_kernel
 def cluster_box(Y, F, out):
     """Ψ(Y, F) ⊂ conv(S) ⊂ box(S) for every m − F of the points S (Ψ is the intersection
     of those hulls): with S the m − F points nearest the coordinate-wise median (max
@@ -255,8 +270,8 @@ def _collinear(Y, F, rep, mean, merr, out):
             elif _orient(Y, i0, j0, q) != 0:
                 return -2.0
     p = 0 if Y[j0, 0] != Y[i0, 0] else 1
-    col, rank = _sorted_column(Y, p)
-    lo, hi = col[rank[F]], col[rank[m - 1 - F]]
+    vals = _sorted_values(Y, p)
+    lo, hi = vals[F], vals[m - 1 - F]
     if lo > hi:
         return -1.0
     mp = mean[p]
