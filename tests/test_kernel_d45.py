@@ -164,3 +164,16 @@ def test_fast_path_adjacency_equals_the_incidence_one(d, n, F):
     cert = K.certificate
     verts = K.exact_vertices
     assert cert["adjacency"] == vertex_adjacency(verts, K._exact.constraints)
+
+
+@pytest.mark.slow
+def test_joggled_proposals_when_qhull_merging_fails(monkeypatch):
+    """gaussian(d=5, n=20, F=3) of the benchmark: qhull's facet merging stops with a
+    topology error (dupridge) or proposes an uncertifiable set; the joggled proposals
+    are certified and equal the exact clipping."""
+    X = np.random.default_rng([0, 10_000_000 * 5 + 1000 * 20 + 3]).normal(size=(20, 5))
+    fast, slow, H, unit, first = _both_paths(X, 3)
+    assert fast is not None
+    assert set(fast.fraction_vertices()) == set(slow.fraction_vertices())
+    monkeypatch.setattr(fastpath, "QHULL_OPTIONS", (None,))
+    assert fastpath.certified_kernel(H, 5, unit, first) is None

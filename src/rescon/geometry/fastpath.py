@@ -44,6 +44,10 @@ FAR = 1e4
 #: vertices with more tight rows than this are left out of the fast closure count
 #: (C(t, k − 1) keys each); rays ending there are found by a scan
 MAX_TIGHT = 12
+#: qhull's options, tried in turn until a proposal is certified: merged facets (one
+#: proposal per vertex), then joggled input (simplicial pieces; qhull's merging can
+#: fail on the many near-coincident hyperplanes of d = 5 clouds)
+QHULL_OPTIONS = (None, "QJ")
 
 
 def _chebyshev(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -59,7 +63,8 @@ def _chebyshev(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     return found.x, found.t
 
 
-def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
+def _propose(H, sel: np.ndarray, options: str | None = None
+             ) -> tuple[np.ndarray, list[list[int]]] | None:
     """Vertices and their defining halfspaces (indices into sel) of {A x ≤ b}, from
     qhull around a Chebyshev centre. A kernel small against its coordinates (states
     that have nearly converged) is re-centred and rescaled first: x = o + s y with o
@@ -99,7 +104,7 @@ def _propose(H, sel: np.ndarray) -> tuple[np.ndarray, list[list[int]]] | None:
         return None
     try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
         with np.errstate(divide="ignore", invalid="ignore"):
-            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0)
+            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0, qhull_options=options)
     except (QhullError, ValueError):
         return None
     if not np.isfinite(hs.intersections).all():
@@ -114,8 +119,19 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
     if len(H) < k + 1:
         return None
     sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
+    for options in QHULL_OPTIONS:
+        P = _attempt(H, k, scale, sel, options)
+        if P is not None:
+            return P
+    return None
+
+
+def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
+             ) -> ExactPolytope | None:
+    """Proposals from qhull with ``options`` (halfspaces violated by a proposed vertex
+    join ``sel`` for the next round), certified by :func:`_certify`; None on failure."""
     for _ in range(MAX_ROUNDS):
-        prop = _propose(H, sel)
+        prop = _propose(H, sel, options)
         if prop is None:
             return None
         V, facets = prop
