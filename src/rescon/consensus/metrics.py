@@ -360,16 +360,28 @@ def _slacks(A: np.ndarray, b: np.ndarray, states: np.ndarray) -> tuple[np.ndarra
 
 def _polygon_edges(hull) -> tuple[np.ndarray, np.ndarray] | None:
     """(P, Q): the rounded end vertices of a polygon's edges, an edge per exact facet
-    a·x ≤ β (its two exact vertices with a·v = β); None if they do not fit in floats."""
+    a·x ≤ β (its two exact vertices with a·v = β); None if they do not fit in floats.
+    The vertices are tried in the order of their float slack β − a·v, so each facet
+    takes ~2 exact tests instead of one per vertex (h² Fraction products: 8 s for a
+    1000-gon)."""
     V = hull.exact_vertices
-    ends = [[v for v in V if a[0] * v[0] + a[1] * v[1] == beta] for a, beta in
-            hull._exact.facets]
     try:
-        P = np.array([[float(c) for c in pq[0]] for pq in ends])
-        Q = np.array([[float(c) for c in pq[1]] for pq in ends])
+        Vf = np.array([[float(c) for c in v] for v in V])
+        A, b = _filter_rows(hull._exact.facets)
     except OverflowError:
         return None
-    return P, Q
+    with np.errstate(over="ignore", invalid="ignore"):
+        order = np.argsort(np.abs(b[:, None] - A @ Vf.T), axis=1, kind="stable")
+    ends = []
+    for (a, beta), row in zip(hull._exact.facets, order):
+        pq = []
+        for i in row:
+            if a[0] * V[i][0] + a[1] * V[i][1] == beta:
+                pq.append(i)
+                if len(pq) == 2:
+                    break
+        ends.append(pq)
+    return Vf[[pq[0] for pq in ends]], Vf[[pq[1] for pq in ends]]
 
 
 def _hull_triangles(hull) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
