@@ -6,9 +6,16 @@ a claim "v ∈ Ψ(X, F)" is decided by brute force (Carathéodory + hitting sets
 
 from __future__ import annotations
 
+import copy
 from fractions import Fraction
 
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from rescon_certificates.check import check
+
+import rescon
 
 
 def _cross(a, b):
@@ -81,3 +88,103 @@ def test_zero_facet_does_not_blind_the_normal_fan():
         cert["facets"].insert(0, {"a": [0, 0, 0], "b": 0})
         res = check(cert)
         assert res.verdict == "invalid" and "Tukey depth is at most 0" in res.reason, res.reason
+
+
+def _solve(M, rhs):
+    """The solution of M λ = rhs for M of full column rank; None otherwise."""
+    rows, cols = len(M), len(M[0])
+    A = [list(M[i]) + [rhs[i]] for i in range(rows)]
+    for c in range(cols):
+        p = next((i for i in range(c, rows) if A[i][c]), None)
+        if p is None:
+            return None
+        A[c], A[p] = A[p], A[c]
+        A[c] = [x / A[c][c] for x in A[c]]
+        for i in range(rows):
+            if i != c and A[i][c]:
+                f = A[i][c]
+                A[i] = [x - f * y for x, y in zip(A[i], A[c])]
+    if any(A[i][cols] for i in range(cols, rows)):
+        return None
+    return [A[i][cols] for i in range(cols)]
+
+
+def in_kernel(X, F, v) -> bool:
+    """v ∈ Ψ(X, F) by brute force: the simplices of data points holding v
+    (Carathéodory); v is in every conv(S), |S| = n − F, iff no F indices hit them all."""
+    from itertools import combinations
+
+    n, d = len(X), len(v)
+    hits = []
+    for k in range(1, d + 2):
+        for T in combinations(range(n), k):
+            lam = _solve([[X[i][j] for i in T] for j in range(d)] + [[1] * k], list(v) + [1])
+            if lam is not None and min(lam) >= 0:
+                hits.append(set(T))
+    return bool(hits) and not any(all(h & set(R) for h in hits)
+                                  for R in combinations(range(n), F))
+
+
+def _mutations(c: dict):
+    """False or unproved variants of a true certificate: enlarged / shrunk about the
+    vertex mean, the claim for F + 1, a facet or a vertex dropped, a vertex moved to the
+    middle of an edge, a zero facet, the adjacency rotated."""
+    V = [[Fraction(t) for t in v] for v in c["vertices"]]
+    d = len(V[0])
+    mean = [sum(v[j] for v in V) / len(V) for j in range(d)]
+    for f in (Fraction(1001, 1000), Fraction(999, 1000)):
+        m = copy.deepcopy(c)
+        m["vertices"] = [[str(mean[j] + f * (v[j] - mean[j])) for j in range(d)] for v in V]
+        for h in m["facets"]:
+            am = sum(Fraction(a) * x for a, x in zip(h["a"], mean))
+            h["b"] = str(am + f * (Fraction(h["b"]) - am))
+        yield m
+    yield {**copy.deepcopy(c), "F": c["F"] + 1}
+    if c["facets"]:
+        yield {**copy.deepcopy(c), "facets": c["facets"][1:]}
+    yield {**copy.deepcopy(c), "facets": [{"a": [0] * d, "b": 0}] + c["facets"]}
+    if len(V) > 1:
+        m = copy.deepcopy(c)
+        m["vertices"].pop()
+        m["adjacency"] = [[j for j in a if j != len(V) - 1] for a in m["adjacency"][:-1]]
+        yield m
+        j = c["adjacency"][0][0]
+        m = copy.deepcopy(c)
+        m["vertices"][0] = [str((a + b) / 2) for a, b in zip(V[0], V[j])]
+        yield m
+        yield {**copy.deepcopy(c), "adjacency": c["adjacency"][1:] + c["adjacency"][:1]}
+
+
+@pytest.mark.slow
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 10**6), d=st.sampled_from([2, 3]),
+       kind=st.sampled_from(["gauss", "int", "dup", "flat"]))
+def test_checker_verdicts_agree_with_brute_force(seed, d, kind):
+    """rescon's certificates are valid; a mutated one is valid only if its claim is true
+    (every vertex in Ψ by brute force, and the vertices are Ψ's exact vertices)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(d + 2, 10 if d == 3 else 12))
+    if kind == "gauss":
+        X = rng.standard_normal((n, d))
+    elif kind == "int":
+        X = rng.integers(-3, 4, (n, d)).astype(float)
+    elif kind == "dup":
+        X = rng.integers(-2, 3, (n, d)).astype(float)
+        X[n // 2:] = X[: n - n // 2]
+    else:
+        Y = rng.integers(-3, 4, (n, d - 1)).astype(float)
+        X = np.c_[Y, Y @ rng.integers(-2, 3, d - 1)]
+    F = int(rng.integers(0, n // (d + 1) + 1))
+    K = rescon.safe_kernel(X, F)
+    if K.is_empty:
+        return
+    c = K.certificate
+    assert check(c).verdict == "valid"
+    Xq = [[Fraction(t) for t in p] for p in X]
+    for m in _mutations(c):
+        if check(m).verdict != "valid":
+            continue
+        Km = rescon.safe_kernel(X, m["F"])
+        V = [tuple(Fraction(t) for t in v) for v in m["vertices"]]
+        assert set(V) == set(Km.exact_vertices)
+        assert all(in_kernel(Xq, m["F"], v) for v in V)
