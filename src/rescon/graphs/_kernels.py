@@ -353,6 +353,28 @@ def core_free(U: np.uint64, free: np.uint64, inmask: np.ndarray, r: int) -> np.u
 
 
 @njit(cache=True, nogil=True)
+def core_hard(U: np.uint64, free: np.uint64, hard: np.uint64, inmask: np.ndarray, r: int,
+              slack: int) -> np.uint64:
+    """Largest A ⊆ U whose members i have |N(i) ∩ hard| < r and
+    |N(i) \\ (A ∪ free)| < r + slack (the nodes of ``free`` count as inside).
+
+    Bound for the uncharged part A of a set S = A ∪ Q ∪ P with P ⊆ free, Q ⊆ U \\ A
+    unknown, |Q| ≤ slack and ``hard`` ∩ S = ∅: a member i of A with fewer than r
+    in-neighbours outside S has |N(i) ∩ hard| ≤ |N(i) \\ S| < r and
+    |N(i) \\ (A ∪ free)| ≤ |N(i) \\ S| + |Q| < r + slack; such sets are closed under
+    union, so the fixpoint of peeling holds every such A. With hard = ∅ this is
+    :func:`core_free`; the hard part is what the slack may not excuse.
+    """
+    m = U
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        if popcount(inmask[i] & hard) >= r:
+            U &= ~(U1 << np.uint64(i))
+    return core_free(U, free, inmask, r + slack)
+
+
+@njit(cache=True, nogil=True)
 def cheapest_side(U: np.uint64, least: int, budget: int, inmask: np.ndarray, r: int,
                   out: np.ndarray) -> np.int64:
     """Fewest charged nodes Q2 ⊆ U (between ``least``, already proven necessary, and
@@ -441,7 +463,9 @@ def min_cost_step(
       nonempty is a lower bound on |Q2|, and k > b prunes;
     * S1's uncharged part avoids X and has |N(i) \\ (A1 ∪ C ∪ F)| ≤ r − 1 + (b − k), so
       M ⊆ core at threshold r + b − k of V \\ X with C ∪ F counted inside;
-    * a member of M with r in-neighbours in X cannot be closed.
+    * in both cores, a node with r in-neighbours where its set cannot reach (S ∪ B for
+      S2, X for S1) is peeled whatever the charges (``core_hard``): the charges only
+      excuse in-neighbours that may still join the set.
 
     An unmarked member of S with ≥ r outside in-neighbours is charged or marked
     closed (two branches); a member of M with ≥ r outside in-neighbours takes one of
@@ -491,7 +515,7 @@ def min_cost_step(
             # S2 needs ≥ k charges when core_{r+k−1}(V \ S \ B) is empty
             rest = full & ~S & ~B
             k = 0
-            while k <= budget and core(rest, inmask, r + k) == ZERO:
+            while k <= budget and core_hard(rest, ZERO, S | B, inmask, r, k) == ZERO:
                 k += 1
             if k > budget:
                 prune = True
@@ -499,16 +523,8 @@ def min_cost_step(
                 # uncharged members i of S1 have |N(i) \\ (A1 ∪ C ∪ F)| ≤ r − 1 + (charges
                 # still to come on side 1) ≤ r − 1 + budget − k
                 free = C | F
-                if M & ~core_free(full & ~X & ~free, free, inmask, r + budget - k):
+                if M & ~core_hard(full & ~X & ~free, free, X, inmask, r, budget - k):
                     prune = True
-        if not prune:
-            m = M
-            while m:
-                i = low_index(m)
-                m &= ~(U1 << np.uint64(i))
-                if popcount(inmask[i] & X) >= r:
-                    prune = True
-                    break
         if prune:
             progress[0] += 0.5 ** depth / n
             continue
