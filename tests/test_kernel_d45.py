@@ -83,8 +83,10 @@ def _brute_rays(normals, T, k):
     """Extreme rays of {d : a_h·d ≤ 0, h ∈ T} by enumerating every k − 1 rows."""
     out = set()
     for sub in itertools.combinations(T, k - 1):
-        d = fastpath._null_direction([normals[h] for h in sub], k)
-        if d is None:
+        R = np.empty((1, k - 1, k), dtype=object)
+        R[0] = [list(normals[h]) for h in sub]
+        d = tuple(fastpath._cross_all(R)[0])
+        if not any(d):
             continue
         vals = [fastpath._dot(normals[h], d) for h in T]
         if all(v >= 0 for v in vals):

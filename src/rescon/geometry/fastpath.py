@@ -465,16 +465,6 @@ def _primitive_direction(d: tuple[int, ...]) -> tuple[int, ...]:
     return tuple(v // g for v in d) if g > 1 else d
 
 
-def _null_direction(rows: list[tuple[int, ...]], k: int) -> tuple[int, ...] | None:
-    """The generalised cross product of k − 1 integer vectors in Z^k (None if they are
-    dependent)."""
-    from .halfspaces import _int_det
-
-    d = tuple((-1) ** (k - 1 + j) * _int_det([list(r[:j] + r[j + 1:]) for r in rows])
-              for j in range(k))
-    return d if any(d) else None
-
-
 def _bits(t: int):
     while t:
         low = t & -t
