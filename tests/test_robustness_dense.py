@@ -79,6 +79,9 @@ def test_tabu_pairs_are_valid_and_improving(G, r):
         assert p.S1 and p.S2 and not p.S1 & p.S2
     if costs:
         assert costs[-1] >= leblanc_max_s(G, r)  # an upper bound on s*(r)
+        below = costs[0]
+        assert all(bd.pair_cost(ig, p, r) < below
+                   for p in bd.tabu_pairs(ig, r, below=below, draws=3))
 
 
 def test_tabu_pairs_need_a_stop():

@@ -265,38 +265,43 @@ def descended_pairs(ig: IndexedGraph, r: int, *, starts: int = 40, seed: int = 0
 
 TABU_MOVES = 100  # moves per tabu walk
 TABU_TENURE = 7  # a moved node stays put for this many moves (plus 0-2 at random)
+TABU_PATIENCE = 16  # draws in a row without a cheaper pair end the search
 
 
-def tabu_pairs(ig: IndexedGraph, r: int, *, floor: int = 0, seed: int = 0,
-               deadline: float | None = None, draws: int | None = None) -> list[Pair]:
+def tabu_pairs(ig: IndexedGraph, r: int, *, floor: int = 0, below: int | None = None,
+               seed: int = 0, deadline: float | None = None,
+               draws: int | None = None) -> list[Pair]:
     """Pairs found by tabu walks on the pair cost, each from a descended random
     bisection (:func:`descend_pair`): every step takes the cheapest move of one node
     into S1, into S2 or out of both (ties at random), except that a node moved in the
     last ``TABU_TENURE`` steps stays put unless the move beats the walk's best.
     Unlike plain descent the walk crosses plateaus (on ER(25, 0.8) it reaches the
     cost-2 optimum where descent stops at 4). Returns each improvement on the best cost
-    so far, cheapest last; stops at ``deadline``, after ``draws`` random bisections (one
-    of the two must be given; seeded, so reproducible when only ``draws`` is; a draw
-    that descends to no valid pair starts no walk) or on reaching cost
-    ``floor`` (a proven lower bound). Every returned pair's cost bounds s*(r) from
-    above."""
+    so far (from ``below``, a known upper bound; default n + 1), cheapest last.
+    Stops at ``deadline``, after ``draws`` random bisections (one of the two must be
+    given; seeded, so reproducible when only ``draws`` is; a draw that descends to no
+    valid pair starts no walk), on reaching cost ``floor`` (a proven lower bound) or
+    after ``TABU_PATIENCE`` draws in a row without a cheaper pair (on sparse graphs the
+    first walks find what the walks find).
+    Every returned pair's cost bounds s*(r) from above."""
     if deadline is None and draws is None:
         raise ValueError("tabu_pairs needs a deadline or a number of draws")
     rng = random.Random(seed)
     inmask = ig.in_masks()
     full = (1 << ig.n) - 1
     found: list[Pair] = []
-    best, done = ig.n + 1, 0
-    while best > floor and (draws is None or done < draws) and (
+    best, done, stale = ig.n + 1 if below is None else below, 0, 0
+    while best > floor and stale < TABU_PATIENCE and (draws is None or done < draws) and (
             deadline is None or time.perf_counter() < deadline):
         A = rng.getrandbits(ig.n) & full
         start = _descend(inmask, r, A, full ^ A)
         done += 1
+        stale += 1
         if start is None:
             continue
         cost, A, B = _tabu_walk(inmask, r, start, rng, floor, deadline)
         if cost < best:
-            best = cost
+            best, stale = cost, 0
             found.append(Pair(_set(A), _set(B)))
     return found
 

@@ -476,13 +476,13 @@ def _descended_upper(ig: IndexedGraph, r: int, upper: int, pair: bd.Pair | None,
     stop, tabu_stop = now + DESCENT_SECONDS, now + DESCENT_SECONDS + TABU_SECONDS
     if deadline is not None:
         stop, tabu_stop = min(stop, deadline), min(tabu_stop, deadline)
-    found = bd.descended_pairs(ig, r, deadline=stop)
-    if ig.n > DP_AUTO_NODES:
-        found += bd.tabu_pairs(ig, r, floor=lower, deadline=tabu_stop)
-    for cand in found:
+    for cand in bd.descended_pairs(ig, r, deadline=stop):
         cost = bd.pair_cost(ig, cand, r)
         if cost is not None and cost < upper:
             upper, pair = cost, cand
+    if ig.n > DP_AUTO_NODES and lower < upper:
+        for cand in bd.tabu_pairs(ig, r, floor=lower, below=upper, deadline=tabu_stop):
+            upper, pair = bd.pair_cost(ig, cand, r), cand
     return upper, pair
 
 
