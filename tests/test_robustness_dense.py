@@ -111,3 +111,19 @@ def test_dense_er25_search_agrees_with_the_dp(seed):
     dp, _ = _dp_min_cost(ig, 11)
     out = min_cost_pair(ig, 11, 3, lower=1)
     assert out.status == "done" and out.best == dp == 2
+
+
+def test_a_stopped_deepening_keeps_the_bound_its_finished_rounds_proved(monkeypatch):
+    """s* search stopped by the time limit after proving 'no pair below 2': the report's
+    s_lower is 2 with a cost_search proof, not the bounds' 1 (ER(30, 0.8) at 60 s)."""
+    from rescon.graphs import robustness as rb
+    from rescon.graphs.search import CostOutcome
+
+    ig = index_graph(nx.gnp_random_graph(12, 0.8, directed=True, seed=1))
+    rounds = iter([CostOutcome("done", 2, None, 10, ()), CostOutcome("stopped", 3, None, 5, ())])
+    monkeypatch.setattr(rb, "min_cost_pair", lambda *a, **k: next(rounds))
+    out = rb._deepening_search(ig, 3, 1, 6, None)
+    assert out.status == "stopped" and out.floor == 2 and out.nodes == 15
+    ss = rb._cost_search_result(ig, 3, out, 1, 6, {"method": "degree"}, None)
+    assert ss.value is None and (ss.lower, ss.upper) == (2, 6)
+    assert ss.proof["method"] == "cost_search"

@@ -520,10 +520,12 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
             raise RESCONError(f"internal error: the s* search returned a pair of cost {cost} "
                               f"for a claimed {out.best}")
         upper, pair = cost, found
-    if out.status == "stopped":
-        return _SStar(None, lower, upper, proof, pair, "search")
     search_proof = {"method": "cost_search", "order": list(out.order),
                     "info": {"nodes": out.nodes}}
+    if out.status == "stopped":
+        if out.floor > lower:  # finished deepening rounds proved more than the bounds
+            lower, proof = out.floor, search_proof
+        return _SStar(None, lower, upper, proof, pair, "search")
     return _SStar(upper, upper, upper, search_proof, pair, "search")
 
 
@@ -548,7 +550,8 @@ def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
                             on_progress=on_progress)
         nodes += out.nodes
         if out.status == "stopped" or out.pair is not None or cap == upper:
-            return replace(out, nodes=nodes, best=out.best if out.pair is not None else upper)
+            return replace(out, nodes=nodes, best=out.best if out.pair is not None else upper,
+                           floor=lower)
         cheap = time.perf_counter() - t0 < DEEPEN_CHEAP_SECONDS
         lower, step = cap, 2 * step if cheap else 1
 

@@ -158,13 +158,15 @@ def decide_r_robust(
 class CostOutcome:
     """Result of the s*(r) branch and bound: ``status`` "done" (``best`` = s*(r)
     when < ``upper``, with ``pair`` the cheapest pair; otherwise s*(r) = ``upper``)
-    or "stopped" (``best`` is still an upper bound)."""
+    or "stopped" (``best`` is still an upper bound). ``floor``: every pair is proven to
+    cost at least this much (rounds of a deepening search that finished; 0 if none)."""
 
     status: str
     best: int
     pair: tuple[frozenset[int], frozenset[int]] | None
     nodes: int
     order: tuple[int, ...]
+    floor: int = 0
 
 
 def min_cost_pair(
