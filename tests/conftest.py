@@ -258,3 +258,24 @@ def cert_graph_matches(cert: dict, G: nx.Graph) -> bool:
                 expected.add((idx[repr(labels[j])], idx[repr(labels[i])]))
     got = {tuple(e) for e in g["edges"]}
     return got == expected and len(got) == len(g["edges"])
+
+
+def solve_exact(M, rhs):
+    """The solution of M λ = rhs (Fractions, Gauss–Jordan) for M of full column rank;
+    None if inconsistent or the columns are dependent. Independent of rescon: the
+    review tests' brute-force oracles (hull membership, Tukey depth) use it."""
+    rows, cols = len(M), len(M[0])
+    A = [list(M[i]) + [rhs[i]] for i in range(rows)]
+    for c in range(cols):
+        p = next((i for i in range(c, rows) if A[i][c]), None)
+        if p is None:
+            return None
+        A[c], A[p] = A[p], A[c]
+        A[c] = [x / A[c][c] for x in A[c]]
+        for i in range(rows):
+            if i != c and A[i][c]:
+                f = A[i][c]
+                A[i] = [x - f * y for x, y in zip(A[i], A[c])]
+    if any(A[i][cols] for i in range(cols, rows)):
+        return None
+    return [A[i][cols] for i in range(cols)]

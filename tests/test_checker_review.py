@@ -11,6 +11,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from conftest import solve_exact
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from rescon_certificates.check import check
@@ -90,25 +91,6 @@ def test_zero_facet_does_not_blind_the_normal_fan():
         assert res.verdict == "invalid" and "Tukey depth is at most 0" in res.reason, res.reason
 
 
-def _solve(M, rhs):
-    """The solution of M λ = rhs for M of full column rank; None otherwise."""
-    rows, cols = len(M), len(M[0])
-    A = [list(M[i]) + [rhs[i]] for i in range(rows)]
-    for c in range(cols):
-        p = next((i for i in range(c, rows) if A[i][c]), None)
-        if p is None:
-            return None
-        A[c], A[p] = A[p], A[c]
-        A[c] = [x / A[c][c] for x in A[c]]
-        for i in range(rows):
-            if i != c and A[i][c]:
-                f = A[i][c]
-                A[i] = [x - f * y for x, y in zip(A[i], A[c])]
-    if any(A[i][cols] for i in range(cols, rows)):
-        return None
-    return [A[i][cols] for i in range(cols)]
-
-
 def in_kernel(X, F, v) -> bool:
     """v ∈ Ψ(X, F) by brute force: the simplices of data points holding v
     (Carathéodory); v is in every conv(S), |S| = n − F, iff no F indices hit them all."""
@@ -118,7 +100,7 @@ def in_kernel(X, F, v) -> bool:
     hits = []
     for k in range(1, d + 2):
         for T in combinations(range(n), k):
-            lam = _solve([[X[i][j] for i in T] for j in range(d)] + [[1] * k], list(v) + [1])
+            lam = solve_exact([[X[i][j] for i in T] for j in range(d)] + [[1] * k], list(v) + [1])
             if lam is not None and min(lam) >= 0:
                 hits.append(set(T))
     return bool(hits) and not any(all(h & set(R) for h in hits)

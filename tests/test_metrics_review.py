@@ -11,37 +11,18 @@ from itertools import combinations, combinations_with_replacement
 
 import numpy as np
 import pytest
+from conftest import solve_exact
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rescon.consensus.metrics import ValidityMonitor, diameter
 
 
-def _solve(M, rhs):
-    """The solution of M λ = rhs for M of full column rank; None if inconsistent or
-    the columns are dependent."""
-    rows, cols = len(M), len(M[0])
-    A = [list(M[i]) + [rhs[i]] for i in range(rows)]
-    for c in range(cols):
-        p = next((i for i in range(c, rows) if A[i][c]), None)
-        if p is None:
-            return None
-        A[c], A[p] = A[p], A[c]
-        A[c] = [x / A[c][c] for x in A[c]]
-        for i in range(rows):
-            if i != c and A[i][c]:
-                f = A[i][c]
-                A[i] = [x - f * y for x, y in zip(A[i], A[c])]
-    if any(A[i][cols] for i in range(cols, rows)):
-        return None
-    return [A[i][cols] for i in range(cols)]
-
-
 def _in_hull(P, x) -> bool:
     d = len(x)
     for k in range(1, d + 2):
         for T in combinations(P, k):
-            lam = _solve([[p[j] for p in T] for j in range(d)] + [[1] * k], list(x) + [1])
+            lam = solve_exact([[p[j] for p in T] for j in range(d)] + [[1] * k], list(x) + [1])
             if lam is not None and min(lam) >= 0:
                 return True
     return False
