@@ -5,8 +5,9 @@
 * δ-validity: dist(x_i(t), conv{x_j(0) : j ∈ B}) for every benign i (validity: it stays
   ≤ δ). The hull is computed exactly once: Qhull proposes its vertices V, the exact
   polytope conv V (the safe kernel of V with F = 0) is built and every initial state is
-  proven in it (:func:`certified_hull`); a state inside it (decided exactly) is at
-  distance 0, one outside gets a certified float distance or the exact projection.
+  proven in it (:func:`certified_hull`; in the plane an exact monotone chain); a state
+  inside it (decided exactly) is at distance 0, one outside gets a certified float
+  distance or the exact projection.
 
 :data:`MONITORS` names the metrics a run can record (``simulate(..., metrics=...)``).
 """
@@ -14,6 +15,7 @@
 from __future__ import annotations
 
 import math
+import time
 from fractions import Fraction
 from typing import Any
 
@@ -21,7 +23,8 @@ import numpy as np
 
 from .._rounding import MIN_SUBNORMAL, UNIT_ROUNDOFF
 from ..errors import InputError
-from ..geometry.kernel import safe_kernel
+from ..geometry.exact import exact_points, fraction_str, halfspaces_json
+from ..geometry.kernel import SafeKernel, _affine_of, _Exact, _unit_rows, safe_kernel
 
 __all__ = ["MONITORS", "ValidityMonitor", "certified_hull", "diameter", "monitor_names",
            "spread"]
@@ -32,6 +35,10 @@ MONITORS = ("spread", "diameter", "validity")
 
 #: up to this many initial states the hull is built from all of them (no proposal)
 PROPOSE_MIN = 64
+#: a polygon of more vertices first filters states with an inner polygon of this many
+INNER_FACETS = 64
+#: rows × facets (or edges) of one block of the polygon's float filters
+BLOCK = 2**20
 
 
 def monitor_names(metrics: Any) -> tuple[str, ...]:
@@ -173,6 +180,7 @@ class ValidityMonitor:
         self._rows = _filter_rows(self.hull._exact.facets) if full else None
         self._edges = _polygon_edges(self.hull) if full and initial.shape[1] == 2 else None
         self._triangles = _hull_triangles(self.hull) if full and initial.shape[1] == 3 else None
+        self._inner = _inner_rows(self.hull) if self._edges is not None else None
 
     def distance(self, x: np.ndarray) -> float:
         """dist(x, H): 0 iff x ∈ H (exact test); else ‖x − y‖ for the exact projection y
@@ -191,11 +199,21 @@ class ValidityMonitor:
         ((d + 2) u + O(u²)) (|Â| |x| + |b̂|) (entry rounding, then the d + 1 terms of
         the dot product) plus (d + 2)(‖x‖∞ + 1)·2^-1074 for gradual underflow; twice
         the first term covers the rounding of the bound itself. Overflow makes the
-        bound inf or the value NaN, and the row unproven."""
+        bound inf or the value NaN, and the row unproven. A polygon of many edges first
+        tries its inner polygon (:func:`_inner_rows`), then its own facets in blocks."""
+        sure = np.zeros(len(states), dtype=bool)
         if self._rows is None:
-            return np.zeros(len(states), dtype=bool)
-        S, bound = self._slacks(states)
-        return (S < -bound).all(axis=1)
+            return sure
+        if self._inner is not None:
+            S, bound = _slacks(*self._inner, states)
+            sure = (S < -bound).all(axis=1)
+        todo = np.flatnonzero(~sure)
+        block = max(1, BLOCK // len(self._rows[1]))
+        for s in range(0, todo.size, block):
+            rows = todo[s:s + block]
+            S, bound = self._slacks(states[rows])
+            sure[rows] = (S < -bound).all(axis=1)
+        return sure
 
     def _slacks(self, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """fl(Â x − b̂) per row and facet, and its error bound (:meth:`surely_inside`)."""
@@ -207,7 +225,8 @@ class ValidityMonitor:
         :meth:`edge_distances`, outside a polytope in R³ :meth:`triangle_distances`
         where their bound is below the distance, the others the exact :meth:`distance`."""
         out = np.zeros(len(states))
-        rest = np.flatnonzero(~(self.surely_inside(states) | self._initial_rows(states)))
+        rest = np.flatnonzero(~self._initial_rows(states))
+        rest = rest[~self.surely_inside(states[rest])]
         if rest.size and self._edges is not None:
             S, bound = self._slacks(states[rest])
             dist, err = self.edge_distances(states[rest])
@@ -237,13 +256,17 @@ class ValidityMonitor:
         ‖w − t e‖, e = q − p, w = x − p, t = clip(w·e / e·e, 0, 1), on the vertices
         rounded to floats, and ``edge_error`` (inf where the bound does not apply)."""
         P, Q = self._edges
+        block = max(1, BLOCK // len(P))
+        dist = np.empty(len(X))
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # 1e300: inf
             e = Q - P  # (edge_error is inf there: the exact path decides)
             ee = (e * e).sum(axis=1)
-            w = X[:, None, :] - P[None, :, :]
-            t = np.clip(np.where(ee > 0, (w * e).sum(axis=2) / ee, 0.0), 0.0, 1.0)
-            r = w - t[:, :, None] * e
-            return np.hypot(r[:, :, 0], r[:, :, 1]).min(axis=1), self.edge_error(X)
+            for s in range(0, len(X), block):
+                w = X[s:s + block, None, :] - P[None, :, :]
+                t = np.clip(np.where(ee > 0, (w * e).sum(axis=2) / ee, 0.0), 0.0, 1.0)
+                r = w - t[:, :, None] * e
+                dist[s:s + block] = np.hypot(r[:, :, 0], r[:, :, 1]).min(axis=1)
+        return dist, self.edge_error(X)
 
     def triangle_distances(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For states X (n, 3) outside H: δ = min over the boundary triangles (on the
@@ -298,8 +321,12 @@ def certified_hull(X: np.ndarray):
     facets, :meth:`ValidityMonitor.surely_inside`, and the exact test where the filter
     is unsure); rows that are not are added to V and conv X[V] is rebuilt. The hull of
     n points costs one Qhull call, the exact kernel of its h vertices and O(n·facets)
-    float work, instead of the O(n^d) candidates of safe_kernel(X, 0)."""
+    float work, instead of the O(n^d) candidates of safe_kernel(X, 0). In the plane
+    (n > PROPOSE_MIN) the exact monotone chain builds it (:func:`_exact_polygon`):
+    initial states that are all vertices (a circle) cost O(n log n), not O(h³)."""
     X = np.asarray(X, dtype=np.float64)
+    if X.ndim == 2 and X.shape[1] == 2 and len(X) > PROPOSE_MIN and np.isfinite(X).all():
+        return _exact_polygon(X)
     rows = _proposed_rows(X)
     while True:
         hull = safe_kernel(X[rows], 0)
@@ -307,6 +334,86 @@ def certified_hull(X: np.ndarray):
         if not outside.size:
             return hull
         rows = np.union1d(rows, outside)
+
+
+def _exact_polygon(X: np.ndarray):
+    """conv X in the plane (rows of X finite, (n, 2)) as the exact polytope that
+    safe_kernel(X, 0) returns, built from the vertices of an exact monotone chain
+    (:func:`_chain`): for a counter-clockwise cycle v_0 … v_{h−1} (h ≥ 3) each edge
+    [p, q] gives the facet a·x ≤ a·p with a = (q₂ − p₂, p₁ − q₁) (outward: the cycle
+    turns left); its certificate lists each vertex's two cycle neighbours as its
+    adjacency, and its cache the rows ending each edge (:func:`_polygon_edges`).
+    O(n log n) and h exact facets instead of safe_kernel's O(n³) side tests; a flat X
+    (h ≤ 2) is left to safe_kernel on those vertices."""
+    t0 = time.perf_counter()
+    U = np.unique(X, axis=0)  # distinct rows in lexicographic order (exact comparisons)
+    P = exact_points(U)
+    cycle = _chain(P.ints)
+    if len(cycle) < 3:
+        return safe_kernel(U[cycle], 0)
+    order = sorted(cycle)  # lexicographic order of the vertices, as safe_kernel's
+    where = {c: j for j, c in enumerate(order)}
+    verts = tuple(P.fraction(c) for c in order)
+    facets = []
+    for i, c in enumerate(cycle):
+        (p1, p2), (q1, q2) = P.ints[c], P.ints[cycle[(i + 1) % len(cycle)]]
+        a = (q2 - p2, p1 - q1)
+        facets.append(((Fraction(a[0]), Fraction(a[1])),
+                       Fraction(a[0] * p1 + a[1] * p2, P.scale)))
+    facets = tuple(facets)
+    adjacency = [[] for _ in order]
+    for i, c in enumerate(cycle):
+        adjacency[where[c]] = sorted((where[cycle[i - 1]], where[cycle[(i + 1) % len(cycle)]]))
+    V = U[order]
+    dim, origin, basis, Aeq, beq, _ = _affine_of(verts, 2, True)
+    A, b = _unit_rows(facets, 2)
+
+    def certificate() -> dict[str, Any]:
+        return {"rescon_certificate": 1, "kind": "safe_kernel", "points": V.tolist(), "F": 0,
+                "dim": dim, "vertices": [[fraction_str(v) for v in x] for x in verts],
+                "equalities": [], "facets": halfspaces_json(facets), "adjacency": adjacency,
+                "proof": {"method": "halfspaces"}}
+
+    return SafeKernel(V, 0, dim, V.copy(), A, b, origin, basis, Aeq, beq,
+                      time.perf_counter() - t0, verts, _Exact(verts, facets, (), facets),
+                      certificate, {"edge_ends": (U[cycle], U[np.roll(cycle, -1)])})
+
+
+def _chain(ints: tuple[tuple[int, ...], ...]) -> list[int]:
+    """Andrew's monotone chain on distinct points given in lexicographic order (exact
+    integer coordinates): the indices of the vertices of their convex hull, counter-
+    clockwise from the first point. A point is popped while the last turn is not
+    strictly left — the cross product (b − o) × (c − o) ≤ 0, exact in Python integers
+    — so points on an edge (collinear) and repeated ones are dropped."""
+    def half(indices) -> list[int]:
+        out: list[int] = []
+        for c in indices:
+            cx, cy = ints[c]
+            while len(out) >= 2:
+                (ox, oy), (bx, by) = ints[out[-2]], ints[out[-1]]
+                if (bx - ox) * (cy - oy) - (by - oy) * (cx - ox) > 0:
+                    break
+                out.pop()
+            out.append(c)
+        return out
+
+    n = len(ints)
+    if n == 1:
+        return [0]
+    return half(range(n))[:-1] + half(range(n - 1, -1, -1))[:-1]
+
+
+def _inner_rows(hull) -> tuple[np.ndarray, np.ndarray] | None:
+    """The filter rows (:func:`_filter_rows`) of the exact facets of the polygon of every
+    k-th vertex (in cycle order) of a polygon H from :func:`_exact_polygon` with h >
+    INNER_FACETS vertices, k = ⌈h / INNER_FACETS⌉: conv of vertices of H lies in H, so a
+    state that filter proves inside it is in H — ~64 facets per state instead of h
+    (states in a 10 000-gon away from its boundary). None for other hulls."""
+    ends = hull._cache.get("edge_ends")
+    if ends is None or len(ends[0]) <= INNER_FACETS:
+        return None
+    inner = _exact_polygon(ends[0][::-(-len(ends[0]) // INNER_FACETS)])
+    return _filter_rows(inner._exact.facets) if inner.dim == 2 else None
 
 
 def _rows_outside(hull, X: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -363,7 +470,9 @@ def _polygon_edges(hull) -> tuple[np.ndarray, np.ndarray] | None:
     a·x ≤ β (its two exact vertices with a·v = β); None if they do not fit in floats.
     The vertices are tried in the order of their float slack β − a·v, so each facet
     takes ~2 exact tests instead of one per vertex (h² Fraction products: 8 s for a
-    1000-gon)."""
+    1000-gon); a hull from :func:`_exact_polygon` carries its edges (facet order)."""
+    if "edge_ends" in hull._cache:
+        return hull._cache["edge_ends"]
     V = hull.exact_vertices
     try:
         Vf = np.array([[float(c) for c in v] for v in V])
