@@ -207,6 +207,8 @@ class ValidityMonitor:
         if self._inner is not None:
             S, bound = _slacks(*self._inner, states)
             sure = (S < -bound).all(axis=1)
+            todo = np.flatnonzero(~sure)
+            sure[todo] = self._in_fan(states[todo])
         todo = np.flatnonzero(~sure)
         block = max(1, BLOCK // len(self._rows[1]))
         for s in range(0, todo.size, block):
@@ -242,6 +244,31 @@ class ValidityMonitor:
         for i in rest:
             out[i] = self.distance(states[i])
         return out
+
+    def _in_fan(self, X: np.ndarray) -> np.ndarray:
+        """Rows of X (n, 2) a float filter proves inside the polygon H of many edges
+        through its fan from v₀ = C₀ (cycle C, the lexicographically least vertex, so
+        the rays v₀→C_j turn left as j grows, angles in (−π/2, π/2]): the float angle
+        of x − v₀ names a triangle T_j = (v₀, C_j, C_{j+1}) (1 ≤ j ≤ h − 2, a guess),
+        and x ∈ T_j ⊆ H is proven by orient(v₀, C_j, x) > 0, orient(v₀, C_{j+1}, x) < 0
+        (float determinants beyond 8u(|l| + |r|) + 4·2^-1074, Shewchuk's bound 3u + 16u²
+        with room for gradual underflow; only for max |coordinate| ≤ 1e150, where no
+        product overflows) and facet j (edge C_j C_{j+1}) by the filter of
+        :meth:`surely_inside`. A wrong guess leaves x unproven, never wrongly inside."""
+        C = self._edges[0]
+        A, b = self._rows
+        v0 = C[0]
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            rays = np.arctan2(C[1:, 1] - v0[1], C[1:, 0] - v0[0])
+            phi = np.arctan2(X[:, 1] - v0[1], X[:, 0] - v0[0])
+            j = np.clip(np.searchsorted(rays, phi), 1, len(C) - 2)
+            ok = _orient_sign(v0, C[j], X) > 0
+            ok &= _orient_sign(v0, C[j + 1], X) < 0
+            S = (X * A[j]).sum(axis=1) - b[j]
+            bound = (8 * UNIT_ROUNDOFF * ((np.abs(X) * np.abs(A[j])).sum(axis=1) + np.abs(b[j]))
+                     + 4 * MIN_SUBNORMAL * (np.abs(X).max(axis=1) + 1))
+        big = np.maximum(np.abs(X).max(axis=1), np.abs(C).max()) > 1e150
+        return ok & (S < -bound) & ~big
 
     def _initial_rows(self, states: np.ndarray) -> np.ndarray:
         """Rows of ``states`` equal to the initial state of the same row (they generate
@@ -401,6 +428,16 @@ def _chain(ints: tuple[tuple[int, ...], ...]) -> list[int]:
     if n == 1:
         return [0]
     return half(range(n))[:-1] + half(range(n - 1, -1, -1))[:-1]
+
+
+def _orient_sign(a: np.ndarray, B: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Per row: +1 / −1 when the float (b − a) × (x − a) proves that sign (beyond
+    8u(|l| + |r|) + 4·2^-1074, :meth:`ValidityMonitor._in_fan`), else 0."""
+    left = (B[:, 0] - a[0]) * (X[:, 1] - a[1])
+    right = (B[:, 1] - a[1]) * (X[:, 0] - a[0])
+    det = left - right
+    bound = 8 * UNIT_ROUNDOFF * (np.abs(left) + np.abs(right)) + 4 * MIN_SUBNORMAL
+    return np.where(det > bound, 1, np.where(det < -bound, -1, 0))
 
 
 def _inner_rows(hull) -> tuple[np.ndarray, np.ndarray] | None:
