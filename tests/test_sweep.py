@@ -557,3 +557,18 @@ def test_dotted_axis_keys_reach_nested_tables():
     assert [s["graph"]["circulant"] for s in specs] == [{"k": 2, "directed": True},
                                                         {"k": 3, "directed": True}]
     assert specs[0]["initial"]["random"] == {"low": 0.0, "high": 1.0, "d": 3}
+
+
+def test_without_matplotlib_the_rows_are_written_and_no_summary(tmp_path, monkeypatch):
+    """summary.png goes through rescon.plot.pyplot; a missing matplotlib skips only it."""
+    import rescon.plot as plot_mod
+    from rescon.errors import MissingDependency
+
+    def missing() -> None:
+        raise MissingDependency("matplotlib is not installed")
+
+    monkeypatch.setattr(plot_mod, "_require_matplotlib", missing)
+    grid = {**GRID8, "axes": {"scenario.policy": ["hold"]}}
+    rows = rescon.sweep(grid, workers=0, out=tmp_path / "out", progress=False)
+    assert len(rows) == 2 and (tmp_path / "out" / "results.parquet").exists()
+    assert not (tmp_path / "out" / "summary.png").exists()

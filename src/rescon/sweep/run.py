@@ -261,12 +261,12 @@ def _plot(table: Any, axes: Mapping[str, list[Any]], kind: str, folder: Path) ->
     robustness: exact with a valid certificate; kernel: non-empty) and a mean
     (consensus: steps to ε-consensus; robustness, kernel: seconds) against the axis
     values, averaged over the other axes and repetitions (when matplotlib is there)."""
+    from ..plot import pyplot
+
     try:
-        import matplotlib
-    except ImportError:
-        return
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        plt = pyplot(folder / "summary.png")
+    except MissingDependency:
+        return  # the table is the result; the plot is optional
 
     (rate_label, hits), (mean_label, values) = _panels(table, kind)
     values = values.astype("float64")
