@@ -254,7 +254,8 @@ class ValidityMonitor:
         (float determinants beyond 8u(|l| + |r|) + 4·2^-1074, Shewchuk's bound 3u + 16u²
         with room for gradual underflow; only for max |coordinate| ≤ 1e150, where no
         product overflows) and facet j (edge C_j C_{j+1}) by the filter of
-        :meth:`surely_inside`. A wrong guess leaves x unproven, never wrongly inside."""
+        :meth:`surely_inside` (:func:`_slack_bound`). A wrong guess leaves x unproven,
+        never wrongly inside."""
         C = self._edges[0]
         A, b = self._rows
         v0 = C[0]
@@ -265,8 +266,8 @@ class ValidityMonitor:
             ok = _orient_sign(v0, C[j], X) > 0
             ok &= _orient_sign(v0, C[j + 1], X) < 0
             S = (X * A[j]).sum(axis=1) - b[j]
-            bound = (8 * UNIT_ROUNDOFF * ((np.abs(X) * np.abs(A[j])).sum(axis=1) + np.abs(b[j]))
-                     + 4 * MIN_SUBNORMAL * (np.abs(X).max(axis=1) + 1))
+            bound = _slack_bound(2, (np.abs(X) * np.abs(A[j])).sum(axis=1), np.abs(b[j]),
+                                 np.abs(X).max(axis=1))
         big = np.maximum(np.abs(X).max(axis=1), np.abs(C).max()) > 1e150
         return ok & (S < -bound) & ~big
 
@@ -494,12 +495,20 @@ def _proposed_rows(X: np.ndarray) -> np.ndarray:
 def _slacks(A: np.ndarray, b: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """fl(Â x − b̂) per row of ``states`` and facet (Â, b̂), and its error bound
     (:meth:`ValidityMonitor.surely_inside`)."""
-    d = states.shape[1]
     with np.errstate(over="ignore", invalid="ignore"):
         S = states @ A.T - b
-        bound = (2 * (d + 2) * UNIT_ROUNDOFF * (np.abs(states) @ np.abs(A).T + np.abs(b))
-                 + (d + 2) * MIN_SUBNORMAL * (np.abs(states).max(axis=1) + 1)[:, None])
+        bound = _slack_bound(states.shape[1], np.abs(states) @ np.abs(A).T, np.abs(b),
+                             np.abs(states).max(axis=1)[:, None])
     return S, bound
+
+
+def _slack_bound(d: int, abs_dot: np.ndarray, abs_b: np.ndarray,
+                 top: np.ndarray) -> np.ndarray:
+    """Error bound of fl(â·x − b̂) in R^d from |â|·|x| (``abs_dot``), |b̂| and
+    max |x_p| (``top``): 2(d+2)u(|â|·|x| + |b̂|) + (d+2)·2^-1074·(max |x_p| + 1), the
+    last term for gradual underflow (one rule for :func:`_slacks` and the fan test)."""
+    return (2 * (d + 2) * UNIT_ROUNDOFF * (abs_dot + abs_b)
+            + (d + 2) * MIN_SUBNORMAL * (top + 1))
 
 
 def _polygon_edges(hull) -> tuple[np.ndarray, np.ndarray] | None:
