@@ -135,3 +135,32 @@ def test_spectral_bound_is_sound_and_checked_exactly():
         assert not rescon.check_certificate(bad).valid
     directed = nx.gnp_random_graph(12, 0.9, directed=True, seed=1)
     assert spectral_r(index_graph(directed)) == (0, None)
+
+
+@settings(max_examples=60, deadline=None)
+@given(digraphs(), st.data())
+def test_root_split_parts_compose_to_the_whole_search(G, data):
+    """Both searches split by roots: the parts' trees concatenate to the whole tree, a
+    part is "robust" iff no witness starts in its roots, and s*(r) is the parts' least."""
+    ig = index_graph(G)
+    n = ig.n
+    cut = data.draw(st.integers(0, n))
+    parts = [range(0, cut), range(cut, n)]
+    for r in range(1, (n + 1) // 2 + 2):
+        whole = decide_r_robust(ig, r)
+        outs = [decide_r_robust(ig, r, roots=p) for p in parts]
+        if whole.status == "robust":
+            assert all(o.status == "robust" for o in outs)
+            assert sum((o.tree for o in outs), ()) == whole.tree
+        else:
+            assert any(o.status == "not_robust" for o in outs)
+        cost = min_cost_pair(ig, r, n)
+        assert min(min_cost_pair(ig, r, n, roots=p).best for p in parts) == cost.best
+
+
+def test_root_range_must_lie_in_the_search_order():
+    ig = index_graph(nx.complete_graph(4, create_using=nx.DiGraph))
+    with pytest.raises(ValueError, match="consecutive range"):
+        decide_r_robust(ig, 1, roots=range(2, 6))
+    with pytest.raises(ValueError, match="consecutive range"):
+        min_cost_pair(ig, 1, 4, roots=range(0, 4, 2))

@@ -17,8 +17,9 @@ ZERO = np.uint64(0)
 # status codes of the decision search (state[ST_STATUS])
 RUNNING, SAT, UNSAT, NEED_ROOM = 0, 1, 2, 3
 # indices into the int64 state array
-ST_SP, ST_ROOT, ST_NTOK, ST_STATUS, ST_NODES = 0, 1, 2, 3, 4
-STATE_LEN = 5
+# (ST_END: one past the last root to search — n for the whole search, less for a part)
+ST_SP, ST_ROOT, ST_NTOK, ST_STATUS, ST_NODES, ST_END = 0, 1, 2, 3, 4, 5
+STATE_LEN = 6
 # indices into the uint64 buffer: current B, witness S1, witness S2
 UB_B, UB_W1, UB_W2 = 0, 1, 2
 UBUF_LEN = 3
@@ -209,7 +210,7 @@ def decide_step(
             state[ST_STATUS] = NEED_ROOM
             break
         if sp == 0:
-            if root >= n:
+            if root >= state[ST_END]:
                 state[ST_STATUS] = UNSAT
                 break
             B = prefix_mask(order, root)
@@ -427,8 +428,8 @@ def cheapest_side(U: np.uint64, least: int, budget: int, inmask: np.ndarray, r: 
 CK_S, CK_X, CK_C, CK_M = 0, 1, 2, 3
 COST_STACK_WIDTH = 4
 # indices into the int64 state of the cost search
-CS_SP, CS_ROOT, CS_STATUS, CS_NODES, CS_BEST = 0, 1, 2, 3, 4
-COST_STATE_LEN = 5
+CS_SP, CS_ROOT, CS_STATUS, CS_NODES, CS_BEST, CS_END = 0, 1, 2, 3, 4, 5
+COST_STATE_LEN = 6
 # uint64 buffer: current B, best S1, best S2
 CB_B, CB_W1, CB_W2 = 0, 1, 2
 
@@ -480,7 +481,7 @@ def min_cost_step(
     side = np.zeros(2, dtype=np.uint64)
     while done < max_nodes:
         if sp == 0:
-            if root >= n or state[CS_BEST] <= lower:
+            if root >= state[CS_END] or state[CS_BEST] <= lower:
                 state[CS_STATUS] = UNSAT
                 break
             B = prefix_mask(order, root)

@@ -75,6 +75,15 @@ def _kernel_inputs(ig: IndexedGraph):
     return _kernels, _mask_array(ig), _out_mask_array(ig), search_order(ig)
 
 
+def _root_range(roots: range | None, n: int) -> tuple[int, int]:
+    """(first root, one past the last) of a search over ``roots`` ⊆ range(n)."""
+    if roots is None:
+        return 0, n
+    if roots.step != 1 or not 0 <= roots.start <= roots.stop <= n:
+        raise ValueError(f"roots must be a consecutive range within range({n}); got {roots}")
+    return roots.start, roots.stop
+
+
 def _mask_array(ig: IndexedGraph) -> np.ndarray:
     return np.array(ig.in_masks(), dtype=np.uint64)
 
@@ -100,6 +109,7 @@ def decide_r_robust(
     deadline: float | None = None,
     on_progress: Callable[[float, int], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    roots: range | None = None,
 ) -> SearchOutcome:
     """Decide whether ``ig`` is r-robust, exactly.
 
@@ -114,12 +124,17 @@ def decide_r_robust(
         of search nodes so far.
     should_stop : polled between slices; True abandons the search ("stopped"),
         e.g. when a racing MILP has answered.
+    roots : search only the subtrees of these roots (positions in the search order;
+        default all n). The subtrees are independent: the trees of a split of
+        range(n) into consecutive parts, concatenated in root order, are the tree of
+        the whole search, and "robust" from every part means robust.
     """
     K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
     stack = np.zeros((2 * n + 2, K.STACK_WIDTH), dtype=np.uint64)
     stack_depth = np.zeros(2 * n + 2, dtype=np.int64)
     state = np.zeros(K.STATE_LEN, dtype=np.int64)
+    state[K.ST_ROOT], state[K.ST_END] = _root_range(roots, n)
     ubuf = np.zeros(K.UBUF_LEN, dtype=np.uint64)
     progress = np.zeros(1, dtype=np.float64)
     tokens = np.empty(1 << 12 if record else 1, dtype=np.int32)
@@ -178,19 +193,23 @@ def min_cost_pair(
     deadline: float | None = None,
     should_stop: Callable[[], bool] | None = None,
     on_progress: Callable[[float, int], None] | None = None,
+    roots: range | None = None,
 ) -> CostOutcome:
     """s*(r) = min |reach_r(S1)| + |reach_r(S2)| over pairs whose sets both keep an
     r-closed member, searched below ``upper`` (a known pair's cost, or n); the search
     ends early when it finds a pair of cost ``lower`` (a proven lower bound).
 
     Exact branch and bound over S1 with charged members (see
-    ``_kernels.min_cost_step``); n ≤ 64. ``on_progress`` as in :func:`decide_r_robust`.
+    ``_kernels.min_cost_step``); n ≤ 64. ``on_progress`` and ``roots`` as in
+    :func:`decide_r_robust` (a part's ``best`` bounds only the pairs whose first node
+    lies in its roots; s*(r) is the least over the parts).
     """
     K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
     stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
     depth = np.zeros(3 * n + 3, dtype=np.int64)
     state = np.zeros(K.COST_STATE_LEN, dtype=np.int64)
+    state[K.CS_ROOT], state[K.CS_END] = _root_range(roots, n)
     state[K.CS_BEST] = upper
     ubuf = np.zeros(3, dtype=np.uint64)
     progress = np.zeros(1, dtype=np.float64)
