@@ -256,9 +256,9 @@ def test_a_scheduler_without_workers_is_a_clear_error_not_a_hang(tmp_path, monke
     import subprocess
     import sys
 
-    from rescon.sweep import run as run_mod
+    from rescon import _dask
 
-    monkeypatch.setattr(run_mod, "WORKER_SECONDS", 2)
+    monkeypatch.setattr(_dask, "WORKER_SECONDS", 2)
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]

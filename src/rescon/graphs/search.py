@@ -101,6 +101,107 @@ def _bits(mask: int) -> frozenset[int]:
     return frozenset(i for i in range(int(mask).bit_length()) if (int(mask) >> i) & 1)
 
 
+@dataclass(frozen=True)
+class SearchPart:
+    """An independent piece of the decision search: the subtrees of ``frames`` (rows of
+    the kernel's stack, bottom first, ``depths`` their depths in the search tree),
+    the top one first, then the subtrees of the roots ``root``, ..., ``end`` − 1.
+
+    The kernel only ever pops the top frame and pushes its children, and a frame's
+    subtree depends on the frame alone; so a run from any stack explores, in preorder,
+    the top frame's subtree, then the next one's, ..., then the roots' — and its tree
+    is the concatenation of the trees of the runs from each frame alone and from the
+    roots alone (:func:`split_part`).
+    """
+
+    frames: np.ndarray
+    depths: np.ndarray
+    root: int
+    end: int
+
+
+def whole_part(n: int, roots: range | None = None) -> SearchPart:
+    """The part of the search over ``roots`` (default all n): no pending frame."""
+    from ._kernels import STACK_WIDTH
+
+    first, end = _root_range(roots, n)
+    return SearchPart(np.zeros((0, STACK_WIDTH), dtype=np.uint64), np.zeros(0, dtype=np.int64),
+                      first, end)
+
+
+def split_part(part: SearchPart, singles: int) -> list[SearchPart]:
+    """``part`` as consecutive parts whose trees, concatenated in list order, are its
+    tree: the top frames above the ``singles`` bottom ones together, each of those alone
+    (the bottom frames are the shallowest: they hold most of the work), then the roots.
+    Empty parts are left out."""
+    k = part.frames.shape[0]
+    cut = max(k - singles, 0)
+    pieces = [(cut, k)] + [(i, i + 1) for i in range(cut - 1, -1, -1)]
+    parts = [SearchPart(part.frames[a:b], part.depths[a:b], part.end, part.end)
+             for a, b in pieces if b > a]
+    if part.root < part.end:
+        parts.append(SearchPart(part.frames[:0], part.depths[:0], part.root, part.end))
+    return parts
+
+
+class PartRun:
+    """A resumable run of ``_kernels.decide_step`` over one :class:`SearchPart`: the
+    stack, state, witness and token arrays it advances, slice by slice."""
+
+    def __init__(self, inputs: tuple, r: int, part: SearchPart, record: bool) -> None:
+        self.K, self.inmask, self.outmask, self.order = inputs
+        self.r, self.record = r, record
+        K, n = self.K, self.inmask.shape[0]
+        k = part.frames.shape[0]
+        self.stack = np.zeros((2 * n + 2 + k, K.STACK_WIDTH), dtype=np.uint64)
+        self.stack[:k] = part.frames
+        self.depth = np.zeros(2 * n + 2 + k, dtype=np.int64)
+        self.depth[:k] = part.depths
+        self.state = np.zeros(K.STATE_LEN, dtype=np.int64)
+        self.state[K.ST_SP], self.state[K.ST_ROOT], self.state[K.ST_END] = k, part.root, part.end
+        self.ubuf = np.zeros(K.UBUF_LEN, dtype=np.uint64)
+        self.progress = np.zeros(1, dtype=np.float64)
+        self.buffer = np.empty(1 << 12 if record else 1, dtype=np.int32)
+
+    def advance(self, max_nodes: int) -> int:
+        """Expand up to ``max_nodes`` more states; the kernel's status (RUNNING: not
+        finished). A full token buffer doubles, up to ``MAX_TREE_TOKENS``; beyond, the
+        tree is dropped (``record`` becomes False)."""
+        K = self.K
+        while True:
+            self.state[K.ST_STATUS] = K.RUNNING
+            K.decide_step(self.inmask, self.outmask, self.order, self.r, self.stack,
+                          self.depth, self.state, self.ubuf, self.buffer, self.record,
+                          max_nodes, self.progress)
+            if self.state[K.ST_STATUS] != K.NEED_ROOM:
+                return int(self.state[K.ST_STATUS])
+            size = self.buffer.shape[0]
+            if size >= MAX_TREE_TOKENS:
+                self.record, self.buffer = False, np.empty(1, dtype=np.int32)
+            else:
+                grown = np.empty(min(2 * size, MAX_TREE_TOKENS), dtype=np.int32)
+                grown[:size] = self.buffer
+                self.buffer = grown
+
+    @property
+    def nodes(self) -> int:
+        return int(self.state[self.K.ST_NODES])
+
+    def tokens(self) -> np.ndarray | None:
+        """The tree tokens written so far (None when the tree was dropped)."""
+        return self.buffer[: self.state[self.K.ST_NTOK]].copy() if self.record else None
+
+    def witness(self) -> tuple[frozenset[int], frozenset[int]]:
+        """(S1, S2) after status SAT."""
+        return _bits(self.ubuf[self.K.UB_W1]), _bits(self.ubuf[self.K.UB_W2])
+
+    def rest(self) -> SearchPart:
+        """What is left of the part: the pending frames and roots."""
+        sp = int(self.state[self.K.ST_SP])
+        return SearchPart(self.stack[:sp].copy(), self.depth[:sp].copy(),
+                          int(self.state[self.K.ST_ROOT]), int(self.state[self.K.ST_END]))
+
+
 def decide_r_robust(
     ig: IndexedGraph,
     r: int,
@@ -128,45 +229,37 @@ def decide_r_robust(
         default all n). The subtrees are independent: the trees of a split of
         range(n) into consecutive parts, concatenated in root order, are the tree of
         the whole search, and "robust" from every part means robust.
+
+    Inside ``distributed.searches_on(...)``, a search still running after
+    ``distributed.LOCAL_NODES`` nodes is finished on the Dask cluster
+    (:func:`rescon.graphs.distributed.finish_on_cluster`): same answer, same tree.
     """
-    K, inmask, outmask, order = _kernel_inputs(ig)
-    n = ig.n
-    stack = np.zeros((2 * n + 2, K.STACK_WIDTH), dtype=np.uint64)
-    stack_depth = np.zeros(2 * n + 2, dtype=np.int64)
-    state = np.zeros(K.STATE_LEN, dtype=np.int64)
-    state[K.ST_ROOT], state[K.ST_END] = _root_range(roots, n)
-    ubuf = np.zeros(K.UBUF_LEN, dtype=np.uint64)
-    progress = np.zeros(1, dtype=np.float64)
-    tokens = np.empty(1 << 12 if record else 1, dtype=np.int32)
+    from . import distributed
+
+    inputs = _kernel_inputs(ig)
+    K, order = inputs[0], tuple(inputs[3].tolist())
+    run = PartRun(inputs, r, whole_part(ig.n, roots), record)
+    cluster = distributed.active()
     while True:
-        state[K.ST_STATUS] = K.RUNNING
-        K.decide_step(inmask, outmask, order, r, stack, stack_depth, state, ubuf,
-                      tokens, record, _SLICE, progress)
-        status = state[K.ST_STATUS]
-        if status == K.NEED_ROOM:
-            if tokens.shape[0] >= MAX_TREE_TOKENS:
-                record = False
-                tokens = np.empty(1, dtype=np.int32)
-            else:
-                grown = np.empty(min(2 * tokens.shape[0], MAX_TREE_TOKENS), dtype=np.int32)
-                grown[: tokens.shape[0]] = tokens
-                tokens = grown
-            continue
+        status = run.advance(_SLICE)
         if on_progress is not None:
-            on_progress(float(progress[0]), int(state[K.ST_NODES]))
+            on_progress(float(run.progress[0]), run.nodes)
         if status != K.RUNNING:
             break
         if (deadline is not None and time.perf_counter() > deadline) or (
             should_stop is not None and should_stop()
         ):
-            return SearchOutcome("stopped", r, tuple(order.tolist()), None, None,
-                                 int(state[K.ST_NODES]), float(progress[0]))
-    nodes = int(state[K.ST_NODES])
+            return SearchOutcome("stopped", r, order, None, None, run.nodes,
+                                 float(run.progress[0]))
+        if cluster is not None and run.nodes >= distributed.LOCAL_NODES:
+            return distributed.finish_on_cluster(cluster, run, deadline=deadline,
+                                                 on_progress=on_progress,
+                                                 should_stop=should_stop)
     if status == K.SAT:
-        witness = (_bits(ubuf[K.UB_W1]), _bits(ubuf[K.UB_W2]))
-        return SearchOutcome("not_robust", r, tuple(order.tolist()), witness, None, nodes, 1.0)
-    tree = tuple(tokens[: state[K.ST_NTOK]].tolist()) if record else None
-    return SearchOutcome("robust", r, tuple(order.tolist()), None, tree, nodes, 1.0)
+        return SearchOutcome("not_robust", r, order, run.witness(), None, run.nodes, 1.0)
+    tokens = run.tokens()
+    tree = None if tokens is None else tuple(tokens.tolist())
+    return SearchOutcome("robust", r, order, None, tree, run.nodes, 1.0)
 
 
 @dataclass(frozen=True)

@@ -11,22 +11,17 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+from .._dask import check_workers, client
 from .._progress import progress_bar
 from ..errors import InputError, MissingDependency
 from .cell import METRICS, failed_row, run_cell
 from .grid import Grid, read_grid
 
 __all__ = ["sweep"]
-
-#: seconds to reach a scheduler given by address before giving up
-CONNECT_SECONDS = 5
-#: seconds to wait for a first worker on a scheduler that has none (else: no task runs)
-WORKER_SECONDS = 30
 
 
 def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
@@ -52,11 +47,7 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     progress : a bar on stderr (default: when stderr is a terminal).
     """
     g = read_grid(grid)
-    if scheduler is not None and workers is not None:
-        raise InputError("workers: give either scheduler (an existing cluster) or workers")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 0):
-        raise InputError(f"workers must be an integer >= 0; got {workers!r}")
+    check_workers(scheduler, workers)
     pd = _pandas()
     folder = _prepare(out, g) if out is not None else None
     cells = g.cells()
@@ -94,10 +85,10 @@ def _execute(cells: list[dict[str, Any]], scheduler: str | None,
         for c in cells:
             yield {"cell": c["cell"], **run_cell(c)}
         return
-    with _client(scheduler, workers) as client:
+    with client(scheduler, workers) as connected:
         from distributed import as_completed
 
-        futures = client.map(run_cell, cells, pure=False)
+        futures = connected.map(run_cell, cells, pure=False)
         index = {f.key: c for f, c in zip(futures, cells, strict=True)}
         for fut in as_completed(futures):
             cell = index[fut.key]
@@ -107,52 +98,6 @@ def _execute(cells: list[dict[str, Any]], scheduler: str | None,
                 row = failed_row(cell, exc)
             yield {"cell": cell["cell"], **row}
             fut.release()
-
-
-def _client(scheduler: str | None, workers: int | None) -> Any:
-    """A distributed.Client on ``scheduler`` (refused within CONNECT_SECONDS when
-    unreachable, within WORKER_SECONDS when no worker joins it: its tasks would wait
-    forever) or on an embedded LocalCluster of processes (closed with the client)."""
-    try:
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise MissingDependency("rescon sweep needs dask[distributed]: install "
-                                "rescon[dask]") from None
-    if scheduler is not None:
-        if not isinstance(scheduler, str) or not scheduler:
-            raise InputError(f"scheduler must be an address such as tcp://host:8786; got "
-                             f"{scheduler!r}")
-        try:
-            client = Client(scheduler, timeout=CONNECT_SECONDS)
-        except Exception as exc:  # noqa: BLE001 (whatever answers there may be no Dask
-            # scheduler: an HTTP reply read as a frame length is a MemoryError)
-            raise InputError(f"scheduler {scheduler}: cannot connect ({type(exc).__name__}: "
-                             f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
-        try:
-            client.wait_for_workers(1, timeout=WORKER_SECONDS)
-        except TimeoutError:
-            client.close()
-            raise InputError(f"scheduler {scheduler}: no worker joined in {WORKER_SECONDS} s "
-                             f"(start one: dask worker {scheduler})") from None
-        return client
-    n = workers if workers is not None else (os.cpu_count() or 1)
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None)
-    return _Owned(Client(cluster), cluster)
-
-
-class _Owned:
-    """A client with the LocalCluster it owns: both closed on exit."""
-
-    def __init__(self, client: Any, cluster: Any) -> None:
-        self.client, self.cluster = client, cluster
-
-    def __enter__(self) -> Any:
-        return self.client
-
-    def __exit__(self, *exc: Any) -> None:
-        self.client.close()
-        self.cluster.close()
 
 
 def _prepare(out: str | Path, g: Grid) -> Path:

@@ -1,0 +1,239 @@
+"""The exact decision search "is G r-robust?" split into independent subtrees on Dask.
+
+The search (:func:`rescon.graphs.search.decide_r_robust`) is a depth-first
+branch and bound whose whole state is a stack of pending frames and the next root.
+Its tree T, written in preorder, is the certificate (certificates/FORMAT.md, method
+``search``). Split and compose:
+
+**Claim.** Let a run of the kernel over a part P (frames f_1 … f_k, top first, then the
+roots a … b − 1) expand some states, writing tokens t, and stop with pending frames
+g_1 … g_m (top first) and roots a' … b − 1. Then
+
+    T(P) = t + T(g_1) + … + T(g_m) + T(roots a' … b − 1),
+
+where T(g) is the tree of a run from the stack [g] alone; the status of P is SAT iff
+some run on the right finds a pair, and every pair such a run finds is a witness.
+
+*Proof.* The kernel pops the top frame, and either closes it (a leaf token) or writes
+its branch token and pushes its two children; what it does with a frame depends on
+the frame alone (S, X, P, Q, the pending peelings and the depth), never on the frames
+below it, and a new root starts only on an empty stack. By induction on the size of
+g_1's subtree, a run from [g_1, g_2, …] writes all of T(g_1) before it pops g_2, and
+leaves g_2, … untouched meanwhile; the same holds for g_2, …, g_m and then the roots.
+So the continued serial run writes exactly the right-hand side, and the search space
+(pairs whose first node is order[k] placed in S1, refined by the branch decisions)
+is partitioned among the frames and the roots: a pair exists in P iff it exists in
+one of them, and a pair found from a frame is closed, disjoint and nonempty by the
+same leaf test as in the serial run. Each part also counts its own states and its
+own refuted share 2^−depth / n, so their sums are the serial counts. ∎
+
+Hence a part run on a worker for at most ``TASK_NODES`` states returns its tokens and,
+when not finished, its rest split into parts again (:func:`search.split_part`); the
+driver assembles T by the claim, part by part in preorder: the same tree as the
+serial search, checkable as one certificate. Work stays balanced however unbalanced
+the subtrees are (the first roots hold most of the work): a part never runs longer
+than one task before its rest is shared out again.
+
+The cluster is the one sweeps use (rescon._dask): an embedded LocalCluster of
+``workers`` processes or a running scheduler's address, opened only when a search
+outlasts ``LOCAL_NODES`` states in this process, inside :func:`searches_on`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import _dask
+from .search import MAX_TREE_TOKENS, PartRun, SearchOutcome, SearchPart, split_part
+
+__all__ = ["LOCAL_NODES", "TASK_NODES", "finish_on_cluster", "searches_on", "active"]
+
+#: states a search expands in this process before it goes to the cluster (~0.1 s)
+LOCAL_NODES = 500_000
+#: states one task expands before it returns the rest of its part (~0.3–0.5 s)
+TASK_NODES = 2_000_000
+#: frames of a stopped part that become parts of their own (the bottom, shallowest ones)
+SPLIT_SINGLES = 4
+#: seconds between checks of the deadline and ``should_stop`` while tasks run
+POLL_SECONDS = 0.2
+
+
+class _Cluster:
+    """A Dask client for the searches of one :func:`searches_on` block, opened on first
+    use (a search that ends locally never starts a cluster) and closed with the block."""
+
+    def __init__(self, scheduler: str | None, workers: int | None) -> None:
+        self.scheduler, self.workers = scheduler, workers
+        self._context: Any = None
+        self._client: Any = None
+
+    def client(self) -> Any:
+        if self._client is None:
+            self._context = _dask.client(self.scheduler, self.workers)
+            self._client = self._context.__enter__()
+        return self._client
+
+    def close(self) -> None:
+        if self._context is not None:
+            self._context.__exit__(None, None, None)
+            self._context = self._client = None
+
+
+_ACTIVE: ContextVar[_Cluster | None] = ContextVar("rescon_search_cluster", default=None)
+
+
+def active() -> _Cluster | None:
+    """The cluster of the enclosing :func:`searches_on` block, if any."""
+    return _ACTIVE.get()
+
+
+@contextmanager
+def searches_on(scheduler: str | None = None, workers: int | None = None) -> Iterator[None]:
+    """Within the block, decision searches that outlast ``LOCAL_NODES`` states finish
+    on Dask: the scheduler at address ``scheduler``, or an embedded LocalCluster of
+    ``workers`` processes. Neither given, or ``workers=0``: nothing changes (serial).
+
+    Raises InputError for both given or a bad count, MissingDependency without dask
+    (checked on entry, not when a search first needs the cluster)."""
+    _dask.check_workers(scheduler, workers)
+    if scheduler is None and not workers:
+        yield
+        return
+    _dask.require()  # now, not mid-search
+    cluster = _Cluster(scheduler, workers)
+    if scheduler is not None:
+        cluster.client()  # a bad address is refused on entry
+    token = _ACTIVE.set(cluster)
+    try:
+        yield
+    finally:
+        _ACTIVE.reset(token)
+        cluster.close()
+
+
+@dataclass(frozen=True)
+class PartResult:
+    """What a task returns: the kernel status, the part's tokens (None when not
+    recorded), its states and refuted share, the witness after SAT, and the rest of
+    the part (None when it finished)."""
+
+    status: int
+    tokens: np.ndarray | None
+    nodes: int
+    progress: float
+    witness: tuple[frozenset[int], frozenset[int]] | None
+    rest: SearchPart | None
+
+
+def run_part(masks: tuple[np.ndarray, np.ndarray, np.ndarray], r: int, part: SearchPart,
+             record: bool, max_nodes: int) -> PartResult:
+    """Run the decision kernel over ``part`` for at most ``max_nodes`` states (on a
+    worker: numba and the compiled kernels load there on first use)."""
+    from . import _kernels as K
+
+    run = PartRun((K, *masks), r, part, record)
+    status = run.advance(max_nodes)
+    return PartResult(status, run.tokens(), run.nodes, float(run.progress[0]),
+                      run.witness() if status == K.SAT else None,
+                      run.rest() if status == K.RUNNING else None)
+
+
+class _Tree:
+    """The tree of a split search, assembled by the claim: each part's tokens, then
+    its children's trees in order. Dropped (``record`` False) past MAX_TREE_TOKENS
+    tokens, as the serial search drops its own."""
+
+    def __init__(self, record: bool) -> None:
+        self.record = record
+        self.tokens: dict[int, np.ndarray] = {}
+        self.children: dict[int, list[int]] = {}
+        self.size = 0
+
+    def add(self, pid: int, tokens: np.ndarray | None, children: list[int]) -> None:
+        self.children[pid] = children
+        if not self.record:
+            return
+        if tokens is None or self.size + tokens.shape[0] > MAX_TREE_TOKENS:
+            self.record, self.tokens = False, {}
+            return
+        self.tokens[pid] = tokens
+        self.size += tokens.shape[0]
+
+    def assemble(self) -> tuple[int, ...] | None:
+        """Preorder concatenation from part 0 (None when dropped)."""
+        if not self.record:
+            return None
+        out: list[int] = []
+        todo = [0]
+        while todo:
+            pid = todo.pop()
+            out.extend(self.tokens[pid].tolist())
+            todo.extend(reversed(self.children[pid]))
+        return tuple(out)
+
+
+def finish_on_cluster(
+    cluster: _Cluster,
+    run: PartRun,
+    *,
+    deadline: float | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> SearchOutcome:
+    """Finish the decision search ``run`` (started in this process, not finished) on the
+    cluster; the outcome is the serial search's, tree included (module docstring);
+    after "not_robust" the witness is the first one a task found."""
+    from distributed import wait
+
+    client = cluster.client()
+    K = run.K
+    masks = (run.inmask, run.outmask, run.order)
+    order = tuple(run.order.tolist())
+    r = run.r
+    tree = _Tree(run.record)
+    nodes, progress = run.nodes, float(run.progress[0])
+    running: dict[Any, int] = {}
+
+    ids = itertools.count(1)
+
+    def share(pid: int, tokens: np.ndarray | None, rest: SearchPart | None) -> None:
+        parts = [] if rest is None else split_part(rest, SPLIT_SINGLES)
+        children = [next(ids) for _ in parts]
+        tree.add(pid, tokens, children)
+        for cid, part in zip(children, parts, strict=True):
+            running[client.submit(run_part, masks, r, part, tree.record, TASK_NODES,
+                                  pure=False)] = cid
+
+    try:
+        share(0, run.tokens(), run.rest())
+        while running:
+            try:
+                done = wait(list(running), timeout=POLL_SECONDS,
+                            return_when="FIRST_COMPLETED").done
+            except TimeoutError:  # none finished: check the deadline
+                done = set()
+            for fut in done:
+                pid = running.pop(fut)
+                res = fut.result()
+                nodes += res.nodes
+                progress += res.progress
+                if res.status == K.SAT:
+                    return SearchOutcome("not_robust", r, order, res.witness, None, nodes, 1.0)
+                share(pid, res.tokens, res.rest)
+            if on_progress is not None:
+                on_progress(progress, nodes)
+            if (deadline is not None and time.perf_counter() > deadline) or (
+                should_stop is not None and should_stop()
+            ):
+                return SearchOutcome("stopped", r, order, None, None, nodes, progress)
+    finally:
+        client.cancel(list(running))
+    return SearchOutcome("robust", r, order, None, tree.assemble(), nodes, 1.0)
