@@ -78,7 +78,8 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         raise RESCONError("--s needs --r")
     cert_path = _output(args.certificate, "--certificate")
     G = read_graph(args.graph, undirected=args.undirected)
-    kw = {"time_limit": args.time_limit, "method": args.method}
+    kw = {"time_limit": args.time_limit, "method": args.method,
+          "scheduler": args.scheduler, "workers": args.workers}
     if args.r is None:
         rep = robustness(G, progress=_progress(args), **kw)
         _write_certificate(rep.certificate, cert_path)
@@ -113,7 +114,8 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         left = None if args.time_limit is None else args.time_limit - res.seconds
         if res.holds and (left is None or left > 0):
             try:
-                s_max = max_s(G, args.r, method=args.method, time_limit=left)
+                s_max = max_s(G, args.r, method=args.method, time_limit=left,
+                              scheduler=args.scheduler, workers=args.workers)
             except TimeLimitReached:
                 s_max = None
         out = {"r": args.r, "r_robust": res.holds, "s_max": s_max,
@@ -444,6 +446,12 @@ def _parser() -> argparse.ArgumentParser:
     rob.add_argument("--method", default="auto", type=_robustness_method,
                      help="exact method when the bounds do not meet: auto (default), "
                           "search, milp or dp")
+    rob.add_argument("--scheduler", metavar="ADDRESS",
+                     help="finish long exact searches on this Dask scheduler, e.g. "
+                          "tcp://host:8786 (split into subtrees; same answer and certificate)")
+    rob.add_argument("--workers", type=int, metavar="N",
+                     help="finish long exact searches on a local Dask cluster of N worker "
+                          "processes (default: serial)")
     rob.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")
     rob.add_argument("--json", action="store_true", help="one JSON object on stdout")
     rob.set_defaults(func=_cmd_robustness)

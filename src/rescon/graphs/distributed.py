@@ -49,12 +49,22 @@ from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Any
 
+import networkx as nx
 import numpy as np
 
 from .. import _dask
-from .search import MAX_TREE_TOKENS, PartRun, SearchOutcome, SearchPart, split_part
+from ..errors import InputError
+from .search import (
+    MAX_SEARCH_NODES,
+    MAX_TREE_TOKENS,
+    PartRun,
+    SearchOutcome,
+    SearchPart,
+    split_part,
+)
 
-__all__ = ["LOCAL_NODES", "TASK_NODES", "finish_on_cluster", "searches_on", "active"]
+__all__ = ["LOCAL_NODES", "TASK_NODES", "active", "finish_on_cluster", "searches_for",
+           "searches_on"]
 
 #: states a search expands in this process before it goes to the cluster (~0.1 s)
 LOCAL_NODES = 500_000
@@ -117,6 +127,16 @@ def searches_on(scheduler: str | None = None, workers: int | None = None) -> Ite
     finally:
         _ACTIVE.reset(token)
         cluster.close()
+
+
+def searches_for(G: Any, scheduler: str | None, workers: int | None) -> Any:
+    """:func:`searches_on` for the searches on graph ``G``, refused (InputError) when G
+    has more nodes than the bitmask search takes: nothing else splits."""
+    if (scheduler is not None or workers) and isinstance(G, nx.Graph) and (
+            G.number_of_nodes() > MAX_SEARCH_NODES):
+        raise InputError(f"scheduler/workers: only the exact search (n ≤ {MAX_SEARCH_NODES}) "
+                         f"runs on a cluster; got n = {G.number_of_nodes()}")
+    return searches_on(scheduler, workers)
 
 
 @dataclass(frozen=True)

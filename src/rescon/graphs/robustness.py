@@ -31,6 +31,7 @@ from .._progress import progress_bar
 from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
+from .distributed import searches_for
 from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
 from .milp import MilpOutcome, RobustnessMilp, milp_min_cost
@@ -601,6 +602,8 @@ def robustness(
     time_limit: float | None = None,
     undirected: bool | None = None,
     progress: bool | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
 ) -> RobustnessReport:
     """ρ(G) and s*(ρ(G)), exactly, with a certificate.
 
@@ -613,6 +616,10 @@ def robustness(
     time_limit : seconds; when reached, returns proven bounds with ``exact=False``.
     undirected : treat the edges of a DiGraph as undirected.
     progress : show a progress bar (default: when stderr is a terminal).
+    scheduler, workers : finish the exact decision searches that outlast a fraction
+        of a second on Dask, split into independent subtrees (graphs/distributed.py;
+        same answers, same certificate): the scheduler at this address, or an
+        embedded LocalCluster of ``workers`` processes (0: serial). n ≤ 64.
 
     Returns
     -------
@@ -635,6 +642,13 @@ def robustness(
     >>> rescon.check_certificate(rep.certificate).valid
     True
     """
+    with searches_for(G, scheduler, workers):
+        return _robustness(G, method, time_limit, undirected, progress)
+
+
+def _robustness(G: Any, method: str, time_limit: float | None, undirected: bool | None,
+                progress: bool | None) -> RobustnessReport:
+    """:func:`robustness` (its searches where the caller put them)."""
     t0 = time.perf_counter()
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
@@ -730,18 +744,28 @@ def is_rs_robust(
     method: str = "auto",
     time_limit: float | None = None,
     undirected: bool | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
 ) -> RobustnessCheck:
     """Is G (r, s)-robust? With a witness pair when not, a proof when it is.
 
     Parameters
     ----------
     r : int ≥ 0.  s : int, 1 ≤ s ≤ n.
+    scheduler, workers : the decision searches on Dask, as in :func:`robustness`.
 
     Raises
     ------
     InputError
         For r < 0, s < 1, s > n, non-integer r or s, fewer than 2 nodes.
     """
+    with searches_for(G, scheduler, workers):
+        return _is_rs_robust(G, r, s, method, time_limit, undirected)
+
+
+def _is_rs_robust(G: Any, r: int, s: int, method: str, time_limit: float | None,
+                  undirected: bool | None) -> RobustnessCheck:
+    """:func:`is_rs_robust` (its searches where the caller put them)."""
     t0 = time.perf_counter()
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
@@ -813,9 +837,12 @@ def is_r_robust(
     method: str = "auto",
     time_limit: float | None = None,
     undirected: bool | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
 ) -> RobustnessCheck:
     """Is G r-robust (= (r, 1)-robust)? See :func:`is_rs_robust`."""
-    return is_rs_robust(G, r, 1, method=method, time_limit=time_limit, undirected=undirected)
+    return is_rs_robust(G, r, 1, method=method, time_limit=time_limit, undirected=undirected,
+                        scheduler=scheduler, workers=workers)
 
 
 def max_s(
@@ -825,8 +852,11 @@ def max_s(
     method: str = "auto",
     time_limit: float | None = None,
     undirected: bool | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
 ) -> int:
     """s*(r) = max s such that G is (r, s)-robust; 0 when G is not r-robust.
+    ``scheduler``, ``workers``: the decision searches on Dask, as in :func:`robustness`.
 
     Raises
     ------
@@ -836,6 +866,13 @@ def max_s(
         The time limit stopped the search before s*(r) was settled (the message
         gives the proven bounds).
     """
+    with searches_for(G, scheduler, workers):
+        return _max_s(G, r, method, time_limit, undirected)
+
+
+def _max_s(G: Any, r: int, method: str, time_limit: float | None,
+           undirected: bool | None) -> int:
+    """:func:`max_s` (its searches where the caller put them)."""
     deadline = _check_options(method, time_limit)
     ig = index_graph(G, undirected=undirected)
     _check_method_size(method, ig.n)
