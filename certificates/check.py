@@ -47,7 +47,7 @@ FORMAT_VERSION = 1
 MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
 MAX_N = 1_000_000  # resource limit on graph / matrix size
 MAX_GRAPH_WORK = 20_000_000  # (n + #edges) * ceil(n / 1024): reading a graph or support
-MAX_SEARCH_WORK = 12_000_000  # mask operations (1024-bit units) replaying a search tree
+MAX_SEARCH_WORK = 25_000_000  # steps replaying a search tree (_Replay; ~5 s)
 
 
 VERDICTS = ("valid", "invalid", "unchecked")
@@ -556,81 +556,229 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
     _info(p, where)
     if s != 1:
         raise Invalid(f"{where}: method 'search' proves r-robustness only (s = 1), got s = {s}")
-    n = g.n
-    order = _perm(p["order"], f"{where}.order", n)
+    order = _perm(p["order"], f"{where}.order", g.n)
     if p["tree"] is None:  # tree too large to record
         return _enumerate_or_trust("search", where, g, r, s, ctx)
-    tree = _array(p["tree"], f"{where}.tree")
-    for k, t in enumerate(tree):
-        if not _is_int(t) or not -3 <= t < n:
-            raise Invalid(f"{where}.tree[{k}] = {t!r} is not a token (-3..-1 or a node 0..{n - 1})")
-    full = g.full
-    pos = 0
-    ntok = len(tree)
-    meter = [0]  # mask operations spent replaying the tree (_mask_cost units)
-    B = 0
-    for k in range(n):
-        stack = [(1 << order[k], B)]  # (S, X) with X = B at the root
-        while stack:
-            if meter[0] > MAX_SEARCH_WORK:
-                return _enumerate_or_trust(
-                    "search", where, g, r, s, ctx,
-                    f"replaying its tree needs more than {MAX_SEARCH_WORK} mask operations "
-                    f"(the checker's work limit; stopped at token {pos} of {ntok})")
-            S, X = stack.pop()
-            if pos >= ntok:
-                raise Invalid(f"{where}: search tree ends early (in the subtree of root {k})")
-            t = tree[pos]
-            if t >= 0:
-                bit = 1 << t
-                if (S | X) & bit:
-                    side = "S" if S & bit else "X"
-                    raise Invalid(f"{where}: search tree branches at token {pos} on node {t}, "
-                                  f"which is already in {side} = {_fmt(S if S & bit else X)}")
-                stack.append((S, X | bit))  # second: u forced out of S1
-                stack.append((S | bit, X))  # first: u in S1
-            elif t == -1:
-                c = core(g, full & ~S & ~B, r, meter)
-                if c:
-                    raise Invalid(f"{where}: search tree leaf -1 at token {pos} is not justified: "
-                                  f"core(V \\ S \\ B) = {_fmt(c)} is nonempty "
-                                  f"(S = {_fmt(S)}, B = {_fmt(B)})")
-            elif t == -2:
-                c = core(g, full & ~X, r, meter)
-                if not S & ~c:
-                    raise Invalid(f"{where}: search tree leaf -2 at token {pos} is not justified: "
-                                  f"S = {_fmt(S)} is inside core(V \\ X) = {_fmt(c)} "
-                                  f"(X = {_fmt(X)})")
-            else:  # t == -3
-                fits = _sizes_fit(g, S, X, B, r, meter)
-                if fits:
-                    raise Invalid(f"{where}: search tree leaf -3 at token {pos} is not justified: "
-                                  f"{fits}")
-            pos += 1
-        B |= 1 << order[k]
-    if pos != ntok:
-        raise Invalid(f"{where}: search tree has {ntok - pos} unused tokens after the {n} roots")
+    tree = _tokens(p["tree"], f"{where}.tree", g.n)
+    stopped = _Replay(g, r, where).run(order, tree)
+    if stopped:
+        return _enumerate_or_trust("search", where, g, r, s, ctx, stopped)
     return "search"
 
 
-def _sizes_fit(g: Graph, S: int, X: int, B: int, r: int, meter: list[int]) -> str:
-    """'' when a closed S1 ⊇ S avoiding X and a closed nonempty S2 ⊆ core(V \\ S \\ B)
-    provably cannot fit together; otherwise the reason they might.
+def _tokens(x: Any, where: str, n: int) -> list[int] | tuple[int, ...]:
+    """The token list of a search tree: integers in -3..n-1 (checked in C when they are)."""
+    tree = _array(x, where)
+    if tree and ({type(t) for t in tree} != {int} or min(tree) < -3 or max(tree) >= n):
+        k, t = next((k, t) for k, t in enumerate(tree) if not _is_int(t) or not -3 <= t < n)
+        raise Invalid(f"{where}[{k}] = {t!r} is not a token (-3..-1 or a node 0..{n - 1})")
+    return tree
 
-    |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺ and |S2| ≥ min_{j∈Q} max(1, d_j − r + 2),
-    while S1 ⊆ P = core(V \\ X), S2 ⊆ Q = core(V \\ S \\ B) are disjoint: |S1| + |S2| ≤ |P ∪ Q|.
+
+class _Replay:
+    """Replays a ``search`` tree (FORMAT.md) and checks every leaf exactly.
+
+    Each state (S, X) under root k (B = order[:k]) needs P = core_r(V \\ X) and
+    Q = core_r(V \\ S \\ B). A child differs from its parent by one node u, removed from
+    Q (u into S) or from P (u into X); as core_r(U') = core_r(core_r(U) ∩ U') for
+    U' ⊆ U, the child's set is its parent's minus u, re-peeled (:meth:`shrink`). A
+    stack entry keeps its parent's P and Q: a closed superset of the exact set, with
+    core_r(P \\ X) = core_r(V \\ X) and core_r(Q \\ S) = core_r(V \\ S \\ B), so a set is
+    brought up to date (removing at most u) only when the state needs it: a -1 leaf
+    needs only Q, a -2 leaf only P, branches and -3 leaves both. Between roots,
+    P_{k+1} = core_r(P_k \\ {order[k]}) and Q_k = core_r(P_k \\ {order[k]}).
+
+    **Packed sets.** Nodes are ranked by in-degree (ties by index), node[p] the p-th;
+    it owns the w-bit field p of an integer, w = bitlength(n) + 1, and a node set is
+    the integer with the top (guard) bits of its nodes' fields set (:meth:`pack`), so
+    the lowest bit of a set is its member of least in-degree. A closed set U comes
+    with D, whose field holds 2^(w−1) + δ_j for a member j, δ_j = min(r, n) − 1 −
+    |N(j) \\ U| ≥ 0 (its deficit; r ≥ n never peels), and 2^w − 1 for a non-member.
+    Subtracting from D the fields of the out-neighbours of removed nodes lowers every
+    deficit at once; no field borrows from the next (0 ≤ δ_j, at most n − 1 < 2^(w−1)
+    decrements; a non-member absorbs n − 1), and the members whose guard bit is
+    cleared are those now with r in-neighbours outside.
+
+    ``work`` counts steps, each a few operations on packed sets of n·w bits and
+    weighted by ⌈n·w / 1024⌉: one per token, per round of :meth:`shrink` and per node
+    whose out-neighbours it subtracts, per member of S at a -3 leaf, and n to set up
+    the first root (plus the mask operations of its :func:`core`).
     """
-    full = g.full
-    Q = core(g, full & ~S & ~B, r, meter)
-    P = core(g, full & ~X, r, meter)
-    meter[0] += _mask_cost(g, S.bit_count() + Q.bit_count())
-    need1 = S.bit_count() + max([0] + [(g.inmask[i] & ~S).bit_count() - r + 1 for i in _bits(S)])
-    need2 = min([g.n + 1] + [max(1, g.inmask[j].bit_count() - r + 2) for j in _bits(Q)])
-    room = (P | Q).bit_count()
-    if need1 + need2 > room:
+
+    def __init__(self, g: Graph, r: int, where: str) -> None:
+        n = g.n
+        self.g, self.r, self.where = g, r, where
+        self.w = w = n.bit_length() + 1
+        self.ones = (1 << w) - 1
+        deg = [mk.bit_count() for mk in g.inmask]
+        self.node = sorted(range(n), key=lambda v: (deg[v], v))
+        field = [0] * n
+        for p, v in enumerate(self.node):
+            field[v] = p
+        self.field = field
+        self.guard = [1 << (w * field[v] + w - 1) for v in range(n)]
+        out = g.outmask()
+        # indexed by w (p + 1), the bit length of the guard bit of field p (node v):
+        # less = the lowest bits of the fields of v's out-neighbours;
+        # least = max(1, d_v - r + 2), the least size of a closed set holding v
+        self.less = [0] * (w * (n + 1))
+        self.least = [1] * (w * (n + 1))
+        for v in range(n):
+            L = w * (field[v] + 1)
+            self.less[L] = sum(1 << (w * field[j]) for j in _bits(out[v]))
+            self.least[L] = max(1, deg[v] - r + 2)
+        self.inpack = [self.pack(g.inmask[v]) for v in self.node]  # by field
+        self.unit = max(1, -(-n * w // 1024))
+        self.work = 0
+
+    def pack(self, mask: int) -> int:
+        """The packed form of the node set ``mask`` (a bitmask)."""
+        return sum(self.guard[v] for v in _bits(mask))
+
+    def unpack(self, packed: int) -> int:
+        """The node-set bitmask of a packed set."""
+        return sum(1 << self.node[b // self.w] for b in _bits(packed))
+
+    def deficits(self, U: int) -> int:
+        """D of the closed node set U (a bitmask), as in the class docstring."""
+        g, w = self.g, self.w
+        rr = min(self.r, g.n)
+        D = 0
+        for j in range(g.n):
+            if U >> j & 1:
+                value = (1 << (w - 1)) + rr - 1 - (g.inmask[j] & ~U).bit_count()
+            else:
+                value = self.ones
+            D |= value << (w * self.field[j])
+        self.work += g.n * self.unit
+        return D
+
+    def shrink(self, U: int, D: int, gone: int) -> tuple[int, int]:
+        """core_r(U \\ gone) and its D, for a closed U with D (packed sets).
+
+        Each round removes ``todo`` from U, makes their fields all ones and subtracts
+        the fields of their out-neighbours; the members whose guard bit is then cleared
+        have r in-neighbours outside, and are the next round's ``todo``. Every removed
+        node had r in-neighbours outside a superset of the result, which is closed:
+        the result is the core. A nonempty closed C ⊆ U holds some j with at most r − 1
+        in-neighbours outside C, so |C| ≥ max(1, d_j − r + 2) ≥ that bound for the
+        member of U of least in-degree (U's lowest bit): when U is smaller, the core
+        is empty (and D is not used again). Work: one step per round and per node
+        whose out-neighbours are subtracted."""
+        less, least, ones, shift = self.less, self.least, self.ones, self.w - 1
+        todo = gone & U
+        steps = 0
+        while todo:
+            U ^= todo
+            if U.bit_count() < least[(U & -U).bit_length()]:
+                U = 0
+                steps += 1
+                break
+            D |= (todo >> shift) * ones
+            steps += 1 + todo.bit_count()
+            while todo:
+                low = todo & -todo
+                todo ^= low
+                D -= less[low.bit_length()]
+            todo = U & ~D
+        self.work += steps * self.unit
+        return U, D
+
+    def run(self, order: list[int], tree: list[int] | tuple[int, ...]) -> str:
+        """Check every leaf of ``tree``; '' when all are justified, raise Invalid on
+        the first that is not, or say why the replay stopped (beyond MAX_SEARCH_WORK)."""
+        g, shrink, guard = self.g, self.shrink, self.guard
+        ntok = len(tree)
+        meter = [0]
+        core0 = core(g, g.full, self.r, meter)  # P = core_r(V \ B), B = order[:k]
+        self.work += meter[0] + ntok * self.unit
+        P, PD = self.pack(core0), self.deficits(core0)
+        pos = 0
+        B = 0
+        for k in range(g.n):
+            S0 = guard[order[k]]
+            Q, QD = shrink(P, PD, S0)
+            stack = [(S0, B, P, PD, Q, QD)]
+            while stack:
+                if self.work > MAX_SEARCH_WORK:
+                    return (f"replaying its tree needs more than {MAX_SEARCH_WORK} mask "
+                            f"operations (the checker's work limit; stopped at token {pos} "
+                            f"of {ntok})")
+                if pos >= ntok:
+                    raise Invalid(f"{self.where}: search tree ends early (in the subtree of "
+                                  f"root {k})")
+                S, X, P1, PD1, Q1, QD1 = stack.pop()
+                t = tree[pos]
+                if t >= 0:
+                    bit = guard[t]
+                    if (S | X) & bit:
+                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
+                    if P1 & X:
+                        P1, PD1 = shrink(P1, PD1, X)
+                    if Q1 & S:
+                        Q1, QD1 = shrink(Q1, QD1, S)
+                    stack.append((S, X | bit, P1, PD1, Q1, QD1))  # second: u out of S1
+                    stack.append((S | bit, X, P1, PD1, Q1, QD1))  # first: u in S1
+                elif t == -1:
+                    if Q1 & S:
+                        Q1 = shrink(Q1, QD1, S)[0]
+                    if Q1:
+                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
+                elif t == -2:
+                    if P1 & X:
+                        P1 = shrink(P1, PD1, X)[0]
+                    if not S & ~P1:
+                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
+                else:
+                    if Q1 & S:
+                        Q1 = shrink(Q1, QD1, S)[0]
+                    if P1 & X:
+                        P1 = shrink(P1, PD1, X)[0]
+                    if sum(self.sizes(S, Q1)) <= (P1 | Q1).bit_count():
+                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
+                pos += 1
+            B |= S0
+            P, PD = shrink(P, PD, S0)
+        if pos != ntok:
+            raise Invalid(f"{self.where}: search tree has {ntok - pos} unused tokens after "
+                          f"the {g.n} roots")
         return ""
-    return (f"|S1| >= {need1} and |S2| >= {need2} fit in |P u Q| = {room} "
-            f"(S = {_fmt(S)}, X = {_fmt(X)}, B = {_fmt(B)})")
+
+    def sizes(self, S: int, Q: int) -> tuple[int, int]:
+        """(need1, need2) for packed S, Q: the sizes of a closed S1 ⊇ S and of a closed
+        nonempty S2 ⊆ Q are at least these.
+
+        |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺ (each i ∈ S keeps ≤ r − 1 of its
+        in-neighbours outside) and |S2| ≥ min_{j∈Q} max(1, d_j − r + 2) (n + 1 when
+        Q = ∅), the bound of Q's lowest field."""
+        inpack, r, w = self.inpack, self.r, self.w
+        self.work += S.bit_count() * self.unit
+        need1 = S.bit_count() + max(
+            [0] + [(inpack[b // w] & ~S).bit_count() - r + 1 for b in _bits(S)])
+        need2 = self.least[(Q & -Q).bit_length()] if Q else self.g.n + 1
+        return need1, need2
+
+    def why(self, t: int, pos: int, S: int, X: int, B: int, P: int, Q: int) -> str:
+        """Why token ``t`` at ``pos`` is wrong at the state (S, X) of root B, with the
+        exact P = core_r(V \\ X) for a -2 or -3 leaf and Q = core_r(V \\ S \\ B) for a
+        -1 or -3 leaf (packed sets)."""
+        fmt = self.fmt
+        if t >= 0:
+            side = "S" if S & self.guard[t] else "X"
+            return (f"{self.where}: search tree branches at token {pos} on node {t}, which "
+                    f"is already in {side} = {fmt(S if side == 'S' else X)}")
+        head = f"{self.where}: search tree leaf {t} at token {pos} is not justified"
+        if t == -1:
+            return f"{head}: core(V \\ S \\ B) = {fmt(Q)} is nonempty (S = {fmt(S)}, B = {fmt(B)})"
+        if t == -2:
+            return f"{head}: S = {fmt(S)} is inside core(V \\ X) = {fmt(P)} (X = {fmt(X)})"
+        need1, need2 = self.sizes(S, Q)
+        return (f"{head}: |S1| >= {need1} and |S2| >= {need2} fit in |P u Q| = "
+                f"{(P | Q).bit_count()} (S = {fmt(S)}, X = {fmt(X)}, B = {fmt(B)})")
+
+    def fmt(self, packed: int) -> str:
+        """A packed set as {i, j, ...} in node indices."""
+        return _fmt(self.unpack(packed))
 
 
 def _proof_implied(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
