@@ -168,8 +168,9 @@ def run_part(masks: tuple[np.ndarray, np.ndarray, np.ndarray], r: int, part: Sea
 
 class _Tree:
     """The tree of a split search, assembled by the claim: each part's tokens, then
-    its children's trees in order. Dropped (``record`` False) past MAX_TREE_TOKENS
-    tokens, as the serial search drops its own."""
+    its children's trees in order. Dropped (``record`` False) when it reaches
+    MAX_TREE_TOKENS tokens, as the serial search drops its own (a full buffer drops the
+    tree)."""
 
     def __init__(self, record: bool) -> None:
         self.record = record
@@ -181,7 +182,7 @@ class _Tree:
         self.children[pid] = children
         if not self.record:
             return
-        if tokens is None or self.size + tokens.shape[0] > MAX_TREE_TOKENS:
+        if tokens is None or self.size + tokens.shape[0] >= MAX_TREE_TOKENS:
             self.record, self.tokens = False, {}
             return
         self.tokens[pid] = tokens
