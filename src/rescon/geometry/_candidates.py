@@ -48,6 +48,12 @@ def _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols):
         Cabs[1] = abs(a2 * b0) + abs(a0 * b2)
         Cabs[2] = abs(a0 * b1) + abs(a1 * b0)
         return
+    if k == 4:
+        _cofactors4(D, C, Cabs)
+        return
+    if k == 5:
+        _cofactors5(D, C, Cabs)
+        return
     for j in range(k):
         c = 0
         for t in range(k):
@@ -67,6 +73,83 @@ def _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols):
             per += aprod
         sign = 1.0 if (k - 1 + j) % 2 == 0 else -1.0
         C[j] = sign * det
+        Cabs[j] = per
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _minor2(D, r, a, b):
+    """det and permanent of |·| of rows r, r + 1 and columns a, b of D."""
+    x, y = D[r, a] * D[r + 1, b], D[r, b] * D[r + 1, a]
+    return x - y, abs(x) + abs(y)
+
+
+@njit(cache=True, nogil=True)
+def _cofactors4(D, C, Cabs):
+    """_cofactors for k = 4: each 3 × 3 minor of D (3 × 4) expanded along its first
+    row over the 2 × 2 minors of rows 1, 2 (24 products instead of 4 · 3! · 2; every
+    product of the expansion still passes through fewer roundings than c_err allows)."""
+    m = np.empty((4, 4))
+    p = np.empty((4, 4))
+    for a in range(4):
+        for b in range(a + 1, 4):
+            m[a, b], p[a, b] = _minor2(D, 1, a, b)
+    for j in range(4):
+        det = 0.0
+        per = 0.0
+        sign = 1.0
+        for i in range(4):
+            if i == j:
+                continue
+            a, b = -1, -1
+            for t in range(4):
+                if t != i and t != j:
+                    if a < 0:
+                        a = t
+                    else:
+                        b = t
+            det += sign * D[0, i] * m[a, b]
+            per += abs(D[0, i]) * p[a, b]
+            sign = -sign
+        C[j] = det if (3 + j) % 2 == 0 else -det
+        Cabs[j] = per
+
+
+@njit(cache=True, nogil=True)
+def _cofactors5(D, C, Cabs):
+    """_cofactors for k = 5: each 4 × 4 minor of D (4 × 5) by the Laplace expansion
+    along rows 0, 1 — Σ over column pairs S of (−1)^(1 + s₁ + s₂) (its 2 × 2 minor on
+    rows 0, 1 and S) (the complementary one on rows 2, 3), the permanents likewise
+    unsigned: 70 products instead of 5 · 4! · 3."""
+    m01 = np.empty((5, 5))
+    p01 = np.empty((5, 5))
+    m23 = np.empty((5, 5))
+    p23 = np.empty((5, 5))
+    for a in range(5):
+        for b in range(a + 1, 5):
+            m01[a, b], p01[a, b] = _minor2(D, 0, a, b)
+            m23[a, b], p23[a, b] = _minor2(D, 2, a, b)
+    cols = np.empty(4, dtype=np.int64)
+    for j in range(5):
+        c = 0
+        for t in range(5):
+            if t != j:
+                cols[c] = t
+                c += 1
+        det = 0.0
+        per = 0.0
+        for u in range(4):
+            for v in range(u + 1, 4):
+                w0, w1 = -1, -1
+                for t in range(4):
+                    if t != u and t != v:
+                        if w0 < 0:
+                            w0 = t
+                        else:
+                            w1 = t
+                term = m01[cols[u], cols[v]] * m23[cols[w0], cols[w1]]
+                det += term if (1 + u + v) % 2 == 0 else -term
+                per += p01[cols[u], cols[v]] * p23[cols[w0], cols[w1]]
+        C[j] = det if (4 + j) % 2 == 0 else -det
         Cabs[j] = per
 
 
@@ -331,33 +414,174 @@ def sweep_pairs_2d(Y, W, subsets):
     return plus, minus, unc, degenerate, cof, cof_abs
 
 
+def ball_chunks(V: np.ndarray, leaf: int = 32
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The rows of V grouped into chunks of ≤ ``leaf`` nearby points (a k-d split at the
+    median of the widest coordinate): (order, starts, centres, radii) — chunk c is
+    V[order[starts[c]:starts[c+1]]], within ``radii[c]`` (the float max of ‖v − centre‖,
+    a few ulps from the exact one) of ``centres[c]`` (its mean)."""
+    order = np.arange(len(V))
+    todo, cuts = [(0, len(V))], []
+    while todo:
+        lo, hi = todo.pop()
+        if hi - lo <= leaf:
+            cuts.append(lo)
+            continue
+        P = V[order[lo:hi]]
+        j = int(np.argmax(P.max(axis=0) - P.min(axis=0)))
+        mid = (hi - lo) // 2
+        order[lo:hi] = order[lo:hi][np.argpartition(P[:, j], mid)]
+        todo += [(lo, lo + mid), (lo + mid, hi)]
+    starts = np.array(sorted(cuts) + [len(V)], dtype=np.int64)
+    W = V[order]
+    counts = np.diff(starts)
+    centres = np.add.reduceat(W, starts[:-1], axis=0) / counts[:, None]
+    gap = ((W - np.repeat(centres, counts, axis=0)) ** 2).sum(axis=1)
+    radii = np.sqrt(np.maximum.reduceat(gap, starts[:-1]))
+    return order, starts, centres, radii
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _chunk_top(A, b, h, centres, radii, norm, c, floor):
+    """An upper bound on a_h·v − b_h over the ball of chunk c (the exact value of
+    a·centre − b + ‖a‖ r, plus 1e-6 of its terms' magnitudes — far above the
+    rounding of these few operations and of ‖a‖, r — and the underflow term)."""
+    k = A.shape[1]
+    s = 0.0
+    mag = 0.0
+    for j in range(k):
+        s += A[h, j] * centres[c, j]
+        mag += abs(A[h, j] * centres[c, j])
+    reach = norm * radii[c]
+    return s - b[h] + reach + 1e-6 * (mag + abs(b[h]) + reach) + floor
+
+
 @njit(cache=True, nogil=True)
-def _row_max_range(A, b, V, h0, h1, out):
+def _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, h0, h1, out):
     k = A.shape[1]
     for h in range(h0, h1):
         best = -np.inf
-        for v in range(V.shape[0]):
-            s = 0.0
-            for j in range(k):
-                s += A[h, j] * V[v, j]
-            best = max(best, s)
-        out[h] = best - b[h]
+        for c in range(len(starts) - 1):
+            top = _chunk_top(A, b, h, centres, radii, norms[h], c, floor)
+            if top < 0.0:  # the whole ball is below: its bound will do
+                best = max(best, top)
+                continue
+            for v in range(starts[c], starts[c + 1]):
+                s = 0.0
+                for j in range(k):
+                    s += A[h, j] * W[v, j]
+                best = max(best, s - b[h])
+        out[h] = best
 
 
 @njit(cache=True, parallel=True)
-def _row_max_parallel(A, b, V, out):
+def _chunked_max_parallel(A, b, W, starts, centres, radii, norms, floor, out):
     m = A.shape[0]
-    chunks = 64
-    for c in prange(chunks):
-        _row_max_range(A, b, V, m * c // chunks, m * (c + 1) // chunks, out)
+    for c in prange(64):
+        _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, m * c // 64,
+                           m * (c + 1) // 64, out)
 
 
-def row_max(A, b, V):
-    """max_v (A_h · v) − b_h for every row h, without the (rows × vertices) matrix
-    (threads only for large inputs)."""
+def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float) -> np.ndarray:
+    """Per row h an upper bound on max_v a_h·v − b_h over the float points V, which is
+    the maximum itself (evaluated in floats) wherever that may be ≥ 0: chunks of V
+    (:func:`ball_chunks`) whose ball lies surely below the hyperplane contribute
+    their ball's bound, the others their points' values. ``floor``: the underflow
+    term of these products."""
+    order, starts, centres, radii = ball_chunks(V)
+    W = np.ascontiguousarray(V[order])
+    A = np.ascontiguousarray(A)
+    b = np.ascontiguousarray(b)
+    norms = np.sqrt((A**2).sum(axis=1))
     out = np.empty(A.shape[0])
-    if A.shape[0] * V.shape[0] >= 200_000:
-        _row_max_parallel(A, b, V, out)
+    if A.shape[0] * (len(starts) - 1) >= 20_000:
+        _chunked_max_parallel(A, b, W, starts, centres, radii, norms, floor, out)
     else:
-        _row_max_range(A, b, V, 0, A.shape[0], out)
+        _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, 0, A.shape[0],
+                           out)
     return out
+
+
+@njit(cache=True, nogil=True)
+def _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
+                floor, h0, h1, fill, offsets, out_r, out_v):
+    """Rows h0 ≤ h < h1 of :func:`near_pairs`: with ``fill`` False, count each row's
+    near pairs into offsets[h] (−1: a pair surely violated); with ``fill`` True, write
+    them from offsets[h] on."""
+    k = A.shape[1]
+    for h in range(h0, h1):
+        at = offsets[h] if fill else 0
+        for cc in range(len(starts) - 1):
+            if _chunk_top(A, b, h, centres, radii, norms[h], cc, floor) < -coarse[h]:
+                continue  # every point of the chunk surely satisfies row h
+            for v in range(starts[cc], starts[cc + 1]):
+                s = 0.0
+                for j in range(k):
+                    s += A[h, j] * W[v, j]
+                s -= b[h]
+                if s > coarse[h]:
+                    at = -1
+                    break
+                if abs(s) > coarse[h]:
+                    continue
+                perm = 0.0
+                mag = 0.0
+                for j in range(k):
+                    perm += A_abs[h, j] * abs(W[v, j])
+                    mag += abs(A[h, j] * W[v, j])
+                bound = c_err * (perm + b_abs[h]) + c * (mag + abs(b[h])) + floor
+                if s > bound:
+                    at = -1
+                    break
+                if not abs(s) > bound:  # NaN stays undecided
+                    if fill:
+                        out_r[at] = h
+                        out_v[at] = v
+                    at += 1
+            if at < 0:
+                break
+        if not fill:
+            offsets[h] = at
+
+
+@njit(cache=True, parallel=True)
+def _near_parallel(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
+                   floor, fill, offsets, out_r, out_v):
+    m = A.shape[0]
+    for t in prange(64):
+        _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
+                    floor, m * t // 64, m * (t + 1) // 64, fill, offsets, out_r, out_v)
+
+
+def near_pairs(A, b, A_abs, b_abs, V, coarse, c_err: float, c: float, floor: float
+               ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The pairs (row, point of V) whose float slack s = a·v − b lies within its
+    rounding bound c_err (A_abs·|v| + b_abs) + c (|a|·|v| + |b|) + floor of 0, or None
+    if some s surely exceeds it (> 0 exactly). ``coarse[h]`` bounds that bound for every
+    point, so only the pairs with |s| ≤ coarse get their own, and chunks of V whose
+    ball lies more than coarse below row h are skipped whole. NaN stays undecided."""
+    order, starts, centres, radii = ball_chunks(V)
+    W = np.ascontiguousarray(V[order])
+    args = [np.ascontiguousarray(x) for x in (A, b, A_abs, b_abs)]
+    norms = np.sqrt((args[0] ** 2).sum(axis=1))
+    common = (*args, W, starts, centres, radii, norms, np.ascontiguousarray(coarse), c_err,
+              c, floor)
+    parallel = len(b) * (len(starts) - 1) >= 20_000
+    counts = np.zeros(len(b), dtype=np.int64)
+    none = np.zeros(0, dtype=np.int64)
+    _near_run(common, parallel, False, counts, none, none)
+    if (counts < 0).any():
+        return None
+    offsets = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    out_r = np.empty(int(counts.sum()), dtype=np.int64)
+    out_v = np.empty_like(out_r)
+    _near_run(common, parallel, True, offsets, out_r, out_v)
+    return out_r, order[out_v]
+
+
+def _near_run(common: tuple, parallel: bool, fill: bool, offsets, out_r, out_v) -> None:
+    """One pass of :func:`near_pairs` over every row (threads for large inputs)."""
+    if parallel:
+        _near_parallel(*common, fill, offsets, out_r, out_v)
+    else:
+        _near_range(*common, 0, len(offsets), fill, offsets, out_r, out_v)

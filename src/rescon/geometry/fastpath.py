@@ -149,22 +149,12 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
 
 def _row_max(H, V: np.ndarray) -> np.ndarray:
     """Per row h, an upper bound on max_v a_h·v − b_h over the float vertices V (the
-    value itself where it may be ≥ 0). With x0 their mean and R ≥ max ‖v − x0‖,
-    a·v − b ≤ a·x0 − b + ‖a‖ R; the bound adds 1e-6 of the magnitudes of its terms (far
-    above the rounding of these few operations), and the rows it does not place
-    below 0 (NaN included) get the maximum over V itself (:func:`._candidates.row_max`)."""
-    from ._candidates import row_max
+    value itself where it may be ≥ 0): :func:`._candidates.row_top` — balls around
+    chunks of nearby vertices bound the rows that pass far from them, only the
+    chunks a row may reach are evaluated vertex by vertex."""
+    from ._candidates import row_top
 
-    x0 = V.mean(axis=0)
-    R = float(np.sqrt(((V - x0) ** 2).sum(axis=1).max()))
-    norm_r = np.sqrt((H.af**2).sum(axis=1)) * R
-    centre = H.af @ x0
-    top = centre - H.bf + norm_r + 1e-6 * (np.abs(H.af) @ np.abs(x0) + np.abs(H.bf) + norm_r)
-    rows = np.flatnonzero(~(top < 0.0))
-    if len(rows):
-        top[rows] = row_max(np.ascontiguousarray(H.af[rows]), np.ascontiguousarray(H.bf[rows]),
-                            np.ascontiguousarray(V))
-    return top
+    return row_top(H.af, H.bf, V, H.floor())
 
 
 def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
@@ -176,29 +166,42 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     another proposed vertex (see the module docstring)."""
     S_set = sorted({int(sel[i]) for f in facets for i in f})
     where = {h: i for i, h in enumerate(S_set)}
-    index: dict[tuple[int, ...], int] = {}
+    Ts = [_basis_of(H, [int(sel[i]) for i in f], k) for f in facets]
+    sols = _solve_all(H, Ts, k)
+    # None: k dependent rows (a zero-volume piece of a triangulated non-simple vertex),
+    # the other proposals or the closure decide
+    kept = [p for p, v in enumerate(sols) if v is not None]
+    if not kept:
+        return None
+    W = _object_rows([sols[p] for p in kept], k + 1)
+    Vk = (W[:, 1:] / (W[:, :1] * scale)).astype(np.float64)
+    # the vertices, merged when equal: equal points have equal correctly rounded floats
+    # (int / int), so only proposals of equal floats are compared exactly
+    index: dict[tuple[float, ...], list[int]] = {}
     verts: list[tuple[int, ...]] = []
     tight: list[int] = []
     of_proposal: list[int] = []
-    kept: list[int] = []  # the proposals whose k rows meet in one point
+    first: list[int] = []  # per vertex: its first proposal (a row of Vk)
     basis: list[list[int]] = []  # per vertex: k independent rows tight at it (positions in S)
-    Ts = [_basis_of(H, [int(sel[i]) for i in f], k) for f in facets]
-    for p, (T, v) in enumerate(zip(Ts, _solve_all(H, Ts, k), strict=True)):
-        if v is None:  # k dependent rows (a zero-volume piece of a triangulated
-            continue   # non-simple vertex): the other proposals or the closure decide
-        kept.append(p)
-        i = index.setdefault(v, len(verts))
+    known: list[int] = []  # h · len(facets) + i: row h tight at vertex i by construction
+    for r, (p, x) in enumerate(zip(kept, Vk.tolist(), strict=True)):
+        v = sols[p]
+        same = index.setdefault(tuple(x), [])
+        i = next((i for i in same if _proportional(v, verts[i])), len(verts))
         of_proposal.append(i)
         if i == len(verts):
+            same.append(i)
             verts.append(v)
             tight.append(0)
-            basis.append([where[h] for h in T])
-        for h in T:
+            first.append(r)
+            basis.append([where[h] for h in Ts[p]])
+        for h in Ts[p]:
             tight[i] |= 1 << where[h]
+            known.append(h * len(facets) + i)
     # exact feasibility, and the complete tight sets within S: floats of the exact
-    # vertices (correctly rounded, int / int) with a rounding bound, plus the underflow
-    # term, decide the clear cases; inf or NaN is never "clear"
-    Vx = np.array([[yi / (v[0] * scale) for yi in v[1:]] for v in verts])
+    # vertices (correctly rounded) with a rounding bound, plus the underflow term,
+    # decide the clear cases; inf or NaN is never "clear"
+    Vx = Vk[first]
     c = 2.0 * (k + 4) * _EPS
     M = np.abs(Vx).max()
     floor = H.floor()
@@ -215,6 +218,8 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     if near is None:
         return None
     near_r, near_v = near
+    fresh = ~np.isin(rows[near_r] * len(facets) + near_v, known)  # not tight by construction
+    near_r, near_v = near_r[fresh], near_v[fresh]
     slacks = _int64_slacks(H, scale, verts, rows[near_r], near_v)
     if slacks is not None:  # small integers: all undecided pairs at once
         if (slacks > 0).any():
@@ -265,7 +270,8 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
         if m == k:
             keys = [t ^ (1 << h) for h in _bits(t)]
         elif m <= MAX_TIGHT:
-            keys = [sum(1 << h for h in sub) for sub in itertools.combinations(_bits(t), k - 1)]
+            keys = [sum(sub) for sub in itertools.combinations([1 << h for h in _bits(t)],
+                                                                k - 1)]
         else:
             continue
         for key in keys:
@@ -301,27 +307,12 @@ def _near_pairs(H, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray, c: floa
 
     The bound of a pair is c_err (|a|_perm·|v| + b_abs) + c (|a|·|v| + |b|) + floor;
     ``coarse`` bounds it per row for every vertex (|v| ≤ max |V|), so only the pairs with
-    |s| ≤ coarse get their own bound; vertices in chunks (memory rows × chunk)."""
-    out_r, out_v = [], []
-    chunk = max(1, 2**22 // max(len(rows), 1))
-    A, b = H.af[rows], H.bf[rows]
-    for lo in range(0, len(Vx), chunk):
-        S = A @ Vx[lo:lo + chunk].T - b[:, None]
-        if (S > coarse[:, None]).any():
-            return None
-        r, v = np.nonzero(~(np.abs(S) > coarse[:, None]))  # NaN stays undecided
-        h, absV = rows[r], np.abs(Vx[lo + v])
-        bound = H.c_err * (np.einsum("ij,ij->i", H.af_abs[h], absV) + H.b_abs[h]) + c * (
-            np.einsum("ij,ij->i", np.abs(H.af[h]), absV) + np.abs(H.bf[h])) + floor
-        s = S[r, v]
-        if (s > bound).any():
-            return None
-        keep = ~(np.abs(s) > bound)
-        out_r.append(r[keep])
-        out_v.append(v[keep] + lo)
-    if not out_r:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    return np.concatenate(out_r), np.concatenate(out_v)
+    |s| ≤ coarse get their own bound (:func:`._candidates.near_pairs`, which skips the
+    chunks of vertices a row surely passes by)."""
+    from ._candidates import near_pairs
+
+    return near_pairs(H.af[rows], H.bf[rows], H.af_abs[rows], H.b_abs[rows], Vx, coarse,
+                      H.c_err, c, floor)
 
 
 def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
@@ -358,24 +349,32 @@ def _basis_of(H, T: list[int], k: int) -> list[int]:
 
 def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     """For each list T of k rows, the point where their hyperplanes meet, homogeneous
-    (w, y) with w > 0 and primitive, or None if they do not meet in one point: (w, y)
-    spans the null space of the k × (k+1) integer matrix with rows (−b_h, a_h)."""
+    (w, y) with w > 0 (not reduced: a gcd of ~1000-bit integers per point costs more
+    than it saves), or None if they do not meet in one point: (w, y) spans the null
+    space of the k × (k+1) integer matrix with rows (−b_h, a_h)."""
     if not Ts:
         return []
-    R = np.empty((len(Ts), k, k + 1), dtype=object)
-    for p, T in enumerate(Ts):
-        for r, h in enumerate(T):
-            a, b = H.exact(h)
-            R[p, r, 0] = -b
-            R[p, r, 1:] = a
+    used = sorted({h for T in Ts for h in T})
+    E = _object_rows([(-b, *a) for a, b in map(H.exact, used)], k + 1)
+    at = {h: i for i, h in enumerate(used)}
     out: list[tuple[int, ...] | None] = []
-    for row in _cross_all(R).tolist():
-        if row[0] == 0:
-            out.append(None)
-            continue
-        g = gcd(*row) if row[0] > 0 else -gcd(*row)
-        out.append(tuple(v // g for v in row))
+    for row in _cross_all(E[np.array([[at[h] for h in T] for T in Ts])]).tolist():
+        out.append(None if row[0] == 0 else tuple(row) if row[0] > 0 else
+                   tuple(-v for v in row))
     return out
+
+
+def _proportional(v: tuple[int, ...], u: tuple[int, ...]) -> bool:
+    """The homogeneous points v, u (first entries > 0) are the same point."""
+    return all(vj * u[0] == uj * v[0] for vj, uj in zip(v[1:], u[1:], strict=True))
+
+
+def _object_rows(rows: list[tuple[int, ...]], width: int) -> np.ndarray:
+    """Rows of Python ints as an object array (len(rows), width) — never a fixed-width
+    integer array, whatever the values' size."""
+    E = np.empty((len(rows), width), dtype=object)
+    E[:] = rows
+    return E
 
 
 def _cross_all(R: np.ndarray) -> np.ndarray:
@@ -406,12 +405,8 @@ def _simplicial_rays(normals: list[tuple[int, ...]], bases: list[list[int]], k: 
     for each h ∈ B the null direction of B − {h}, signed so that a_h·d < 0."""
     if not bases:
         return []
-    R = np.empty((len(bases) * k, k - 1, k), dtype=object)
-    for p, B in enumerate(bases):
-        for j, h in enumerate(B):
-            for r, g in enumerate(g for g in B if g != h):
-                R[p * k + j, r] = normals[g]
-    D = _cross_all(R).tolist()
+    N = _object_rows(normals, k)
+    D = _cross_all(N[np.array([[g for g in B if g != h] for B in bases for h in B])]).tolist()
     out = []
     for p, B in enumerate(bases):
         rays = []

@@ -205,11 +205,11 @@ def _unit_rows(rows: list[tuple[tuple[Fraction, ...], Fraction]], d: int
     the origin does: InputError, as no float row can state it)."""
     if not rows:
         return np.zeros((0, d)), np.zeros(0)
-    rows = [(tuple(v / top for v in a), bb / top)
-            for a, bb in rows for top in (max(map(abs, a)),)]
-    A = np.array([[float(v) for v in a] for a, _ in rows])
+    tops = [max(map(abs, a)) for a, _ in rows]
+    A = _direction_floats([a for a, _ in rows], tops)
     norm = np.linalg.norm(A, axis=1)
-    return A / norm[:, None], _unit_offsets([bb for _, bb in rows], norm, "a facet")
+    return A / norm[:, None], _unit_offsets([bb / top for (_, bb), top in zip(rows, tops)],
+                                            norm, "a facet")
 
 
 def _unit_offsets(offsets: list[Fraction], norms: np.ndarray, what: str) -> np.ndarray:
@@ -217,7 +217,9 @@ def _unit_offsets(offsets: list[Fraction], norms: np.ndarray, what: str) -> np.n
     from the exact quotient: it overflows only when the plane's distance from the
     origin does, and then no float row can state it — InputError naming ``what``."""
     try:
-        return np.array([float(b / Fraction(float(nv))) for b, nv in zip(offsets, norms)],
+        return np.array([b.numerator * den / (b.denominator * num)  # int / int, rounded once
+                         for b, (num, den) in zip(offsets, map(float.as_integer_ratio,
+                                                                norms.tolist()))],
                         dtype=np.float64)
     except OverflowError:
         raise InputError(f"X: {what} of the safe kernel lies farther than 1.8e308 from the "
@@ -273,9 +275,10 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         verts = (P.fraction(0),)
         order: list[int] = []
         constraints: tuple = ()
+        V = np.array([[float(v) for v in verts[0]]])
     else:
         poly = _clip(P, hull, F)
-        verts, order = _lifted_vertices(poly, hull, P)
+        verts, order, V = _lifted_vertices(poly, hull, P)
         incidence = poly.incidence()
         ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
                    for h in sorted(incidence)}
@@ -301,25 +304,56 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
                 "adjacency": _adjacency(poly, order, verts, constraints),
                 "proof": {"method": "halfspaces"}}
 
-    V = np.array([[float(v) for v in x] for x in verts])
     return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq,
                       time.perf_counter() - t0, verts, exact, certificate)
 
 
 def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
-                     ) -> tuple[tuple[tuple[Fraction, ...], ...], list[int]]:
+                     ) -> tuple[tuple[tuple[Fraction, ...], ...], list[int], np.ndarray]:
     """The vertices of Ψ in the original coordinates, exactly (from the homogeneous
     scaled-integer vertices (w, y) of the clipped polytope: x = y / (w · scale)), in
     lexicographic order — independent of how the polytope was built and of a scaling
     of X by 2^j, as is then everything computed from them in floats (origin, basis,
-    the guides' frame). Also ``order``: the polytope's index of each vertex returned."""
+    the guides' frame). Also ``order``: the polytope's index of each vertex returned,
+    and the vertices' correctly rounded floats (in that order)."""
     if hull.dim == len(P.ints[0]):  # the pivot coordinates are all of x
-        pts = [tuple(Fraction(y, w * P.scale) for y in ys) for w, *ys in poly.verts]
-    else:
-        pts = [hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
-               for y in poly.fraction_vertices()]
+        def exact(i: int) -> tuple[Fraction, ...]:
+            w, *ys = poly.verts[i]
+            return tuple(Fraction(y, w * P.scale) for y in ys)
+
+        V = _scaled_floats(poly, P.scale)
+        order = _lex_order(V, exact)
+        return tuple(map(exact, order)), order, V[order]
+    pts = [hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
+           for y in poly.fraction_vertices()]
     order = sorted(range(len(pts)), key=lambda i: _lex_key(pts[i]))
-    return tuple(pts[i] for i in order), order
+    verts = tuple(pts[i] for i in order)
+    return verts, order, np.array([[float(v) for v in x] for x in verts]).reshape(
+        len(verts), -1)
+
+
+def _scaled_floats(poly: ExactPolytope, scale: int) -> np.ndarray:
+    """The vertices y / (w · scale), correctly rounded: the polytope's own float
+    vertices when its unit is ``scale``, else one int / int per coordinate."""
+    if poly.unit == scale:
+        return poly.float_vertices()
+    return np.array([[y / (v[0] * scale) for y in v[1:]] for v in poly.verts],
+                    dtype=np.float64).reshape(len(poly.verts), poly.k)
+
+
+def _lex_order(V: np.ndarray, exact: Callable[[int], tuple[Fraction, ...]]) -> list[int]:
+    """The indices of the rows of V ordered as the exact points they round (``exact(i)``)
+    in lexicographic order: correct rounding is monotone (fl(s) < fl(t) implies
+    s < t), so the floats order all rows but those whose first coordinates round
+    alike, and only those runs are sorted exactly (by :func:`_lex_key`)."""
+    order = np.lexsort(V.T[::-1])
+    first = V[order, 0]
+    cuts = [0, *(np.flatnonzero(first[1:] != first[:-1]) + 1).tolist(), len(order)]
+    out: list[int] = []
+    for lo, hi in zip(cuts[:-1], cuts[1:]):
+        run = order[lo:hi].tolist()
+        out += run if len(run) == 1 else sorted(run, key=lambda i: _lex_key(exact(i)))
+    return out
 
 
 def _adjacency(poly: ExactPolytope | None, order: list[int], verts, constraints
@@ -377,15 +411,17 @@ def _clip(P: ExactPoints, hull: AffineHull, F: int) -> ExactPolytope:
     return poly
 
 
-def _direction_floats(rows) -> np.ndarray:
+def _direction_floats(rows, tops=None) -> np.ndarray:
     """Nonzero rational rows as floats, each divided exactly by its largest |entry|
-    first (entries in [−1, 1]: no overflow, and tiny rows keep their precision) — for
-    rows that stand for directions, whose length is free."""
-    out = []
-    for row in rows:
-        top = max(map(abs, row))
-        out.append([float(v / top) for v in row])
-    return np.array(out, dtype=np.float64)
+    (``tops``, computed when not given) first (entries in [−1, 1]: no overflow, and tiny
+    rows keep their precision) — for rows that stand for directions, whose length is
+    free. Each entry is v / top correctly rounded, as float(v / top), but from one
+    division of integers (Python's int / int) instead of a reduced Fraction."""
+    if tops is None:
+        tops = [max(map(abs, row)) for row in rows]
+    return np.array([[v.numerator * top.denominator / (v.denominator * top.numerator)
+                      for v in row] for row, top in zip(rows, tops, strict=True)],
+                    dtype=np.float64).reshape(len(rows), -1)
 
 
 def _affine_of(verts, d: int, full: bool):
@@ -424,18 +460,30 @@ def _relative_facets(poly: ExactPolytope, incidence: dict, ambient: dict, dim: i
     ``ambient[h]`` (the constraint h in the original coordinates), ordered by their
     directions a / max|a_j| — an order that does not depend on how the polytope was
     built, nor on a scaling of X by 2^j (so neither do the rows A, b, nor the float
-    guides that read them)."""
+    guides that read them).
+
+    A constraint tight at a simple vertex v of a full-dimensional Ψ (exactly dim tight
+    constraints) is a facet: near v, Ψ is v + the simplicial cone {d : a_h·d ≤ 0, h
+    tight at v}, whose face on any one of its rows is (dim − 1)-dimensional."""
     if dim == 0:
         return []
     nv = len(poly.verts)
+    simple = {i for i, t in enumerate(poly.tight) if t.bit_count() == dim} if (
+        dim == poly.k) else set()
     out = []
     for h, members in sorted(incidence.items()):
         # a face tight on h (not on every vertex) has dimension ≤ dim − 1, so it is a
         # facet iff its dimension is at least dim − 1
         if len(members) >= dim and len(members) < nv and (
-                poly.clear_rank(members) >= dim - 1 or poly.face_dim(members) == dim - 1):
+                not simple.isdisjoint(members) or poly.clear_rank(members) >= dim - 1
+                or poly.face_dim(members) == dim - 1):
             out.append(ambient[h])
-    return sorted(out, key=lambda row: tuple(v / max(map(abs, row[0])) for v in row[0]))
+    if not out:
+        return []
+    tops = [max(map(abs, a)) for a, _ in out]
+    order = _lex_order(_direction_floats([a for a, _ in out], tops),
+                       lambda i: tuple(v / tops[i] for v in out[i][0]))
+    return [out[i] for i in order]
 
 
 def _needed_rows(poly: ExactPolytope, incidence: dict, ambient: dict, facets: list) -> tuple:
