@@ -653,7 +653,7 @@ class _Replay:
         self.work += g.n * self.unit
         return D
 
-    def shrink(self, U: int, D: int, gone: int) -> tuple[int, int]:
+    def shrink(self, U: int, D: int, gone: int, watch: int = 0) -> tuple[int, int]:
         """core_r(U \\ gone) and its D, for a closed U with D (packed sets).
 
         Each round removes ``todo`` from U, makes their fields all ones and subtracts
@@ -663,8 +663,10 @@ class _Replay:
         the result is the core. A nonempty closed C ⊆ U holds some j with at most r − 1
         in-neighbours outside C, so |C| ≥ max(1, d_j − r + 2) ≥ that bound for the
         member of U of least in-degree (U's lowest bit): when U is smaller, the core
-        is empty (and D is not used again). Work: one step per round and per node
-        whose out-neighbours are subtracted."""
+        is empty (and D is not used again). With ``watch``, the peeling stops once a
+        member of ``watch`` is peeled: the set returned then lies between the core and
+        U, without that member (enough to show watch ⊄ core; D is not used again).
+        Work: one step per round and per node whose out-neighbours are subtracted."""
         less, least, ones, shift = self.less, self.least, self.ones, self.w - 1
         todo = gone & U
         steps = 0
@@ -681,6 +683,9 @@ class _Replay:
                 todo ^= low
                 D -= less[low.bit_length()]
             todo = U & ~D
+            if todo & watch:
+                U ^= todo
+                break
         self.work += steps * self.unit
         return U, D
 
@@ -726,7 +731,7 @@ class _Replay:
                         raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
                 elif t == -2:
                     if P1 & X:
-                        P1 = shrink(P1, PD1, X)[0]
+                        P1 = shrink(P1, PD1, X, S)[0]
                     if not S & ~P1:
                         raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
                 else:

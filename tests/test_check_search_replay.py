@@ -220,7 +220,16 @@ def test_shrink_is_the_core(seed, n, r):
     packed, D = R.pack(U), R.deficits(U)
     while U:
         gone = 1 << rng.choice(bits(U) + bits(((1 << n) - 1) & ~U))
-        U = peel(inm, U & ~gone, r)
+        # with a watched set: the core when it keeps the whole set, else a set between
+        # the core and U \ gone that misses a watched node
+        watch = rng.getrandbits(n)
+        core = peel(inm, U & ~gone, r)
+        seen = R.unpack(R.shrink(packed, D, R.pack(gone), R.pack(watch))[0])
+        if watch & ~core:
+            assert core & ~seen == 0 and seen & ~(U & ~gone) == 0 and watch & ~seen
+        else:
+            assert seen == core
+        U = core
         packed, D = R.shrink(packed, D, R.pack(gone))
         assert R.unpack(packed) == U
 
