@@ -601,8 +601,9 @@ class _Replay:
 
     ``work`` counts steps, each a few operations on packed sets of n·w bits and
     weighted by ⌈n·w / 1024⌉: one per token, per round of :meth:`shrink` and per node
-    whose out-neighbours it subtracts, per member of S at a -3 leaf, and n to set up
-    the first root (plus the mask operations of its :func:`core`).
+    whose out-neighbours it subtracts, per member of S at a -3 leaf, and n + |E| + n
+    to set up the tables and the first root (plus the mask operations of its
+    :func:`core`).
     """
 
     def __init__(self, g: Graph, r: int, where: str) -> None:
@@ -616,7 +617,7 @@ class _Replay:
         for p, v in enumerate(self.node):
             field[v] = p
         self.field = field
-        self.guard = [1 << (w * field[v] + w - 1) for v in range(n)]
+        self.top = [w * field[v] + w - 1 for v in range(n)]  # v's guard bit
         out = g.outmask()
         # indexed by w (p + 1), the bit length of the guard bit of field p (node v):
         # less = the lowest bits of the fields of v's out-neighbours;
@@ -627,13 +628,12 @@ class _Replay:
             L = w * (field[v] + 1)
             self.less[L] = sum(1 << (w * field[j]) for j in _bits(out[v]))
             self.least[L] = max(1, deg[v] - r + 2)
-        self.inpack = [self.pack(g.inmask[v]) for v in self.node]  # by field
         self.unit = max(1, -(-n * w // 1024))
-        self.work = 0
+        self.work = (n + g.m) * self.unit
 
     def pack(self, mask: int) -> int:
         """The packed form of the node set ``mask`` (a bitmask)."""
-        return sum(self.guard[v] for v in _bits(mask))
+        return sum(1 << self.top[v] for v in _bits(mask))
 
     def unpack(self, packed: int) -> int:
         """The node-set bitmask of a packed set."""
@@ -692,7 +692,7 @@ class _Replay:
     def run(self, order: list[int], tree: list[int] | tuple[int, ...]) -> str:
         """Check every leaf of ``tree``; '' when all are justified, raise Invalid on
         the first that is not, or say why the replay stopped (beyond MAX_SEARCH_WORK)."""
-        g, shrink, guard = self.g, self.shrink, self.guard
+        g, shrink, top = self.g, self.shrink, self.top
         ntok = len(tree)
         meter = [0]
         core0 = core(g, g.full, self.r, meter)  # P = core_r(V \ B), B = order[:k]
@@ -701,7 +701,7 @@ class _Replay:
         pos = 0
         B = 0
         for k in range(g.n):
-            S0 = guard[order[k]]
+            S0 = 1 << top[order[k]]
             Q, QD = shrink(P, PD, S0)
             stack = [(S0, B, P, PD, Q, QD)]
             while stack:
@@ -715,7 +715,7 @@ class _Replay:
                 S, X, P1, PD1, Q1, QD1 = stack.pop()
                 t = tree[pos]
                 if t >= 0:
-                    bit = guard[t]
+                    bit = 1 << top[t]
                     if (S | X) & bit:
                         raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
                     if P1 & X:
@@ -756,10 +756,11 @@ class _Replay:
         |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺ (each i ∈ S keeps ≤ r − 1 of its
         in-neighbours outside) and |S2| ≥ min_{j∈Q} max(1, d_j − r + 2) (n + 1 when
         Q = ∅), the bound of Q's lowest field."""
-        inpack, r, w = self.inpack, self.r, self.w
+        inmask, r = self.g.inmask, self.r
         self.work += S.bit_count() * self.unit
+        S = self.unpack(S)
         need1 = S.bit_count() + max(
-            [0] + [(inpack[b // w] & ~S).bit_count() - r + 1 for b in _bits(S)])
+            [0] + [(inmask[i] & ~S).bit_count() - r + 1 for i in _bits(S)])
         need2 = self.least[(Q & -Q).bit_length()] if Q else self.g.n + 1
         return need1, need2
 
@@ -769,7 +770,7 @@ class _Replay:
         -1 or -3 leaf (packed sets)."""
         fmt = self.fmt
         if t >= 0:
-            side = "S" if S & self.guard[t] else "X"
+            side = "S" if S >> self.top[t] & 1 else "X"
             return (f"{self.where}: search tree branches at token {pos} on node {t}, which "
                     f"is already in {side} = {fmt(S if side == 'S' else X)}")
         head = f"{self.where}: search tree leaf {t} at token {pos} is not justified"
