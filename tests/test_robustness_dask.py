@@ -34,7 +34,7 @@ def _split_run(inputs, r, part, budgets, singles):
     """Run ``part`` for the next budget, then its rest's parts recursively, in the order
     of :func:`split_part`; stop at the first part that finds a pair. Returns (tokens,
     nodes, witness or None)."""
-    run = PartRun(inputs, r, part, True)
+    run = PartRun(inputs, r, part, search.MAX_TREE_TOKENS)
     status = run.advance(next(budgets))
     tokens, nodes = list(run.tokens()), run.nodes
     if status == K.SAT:
@@ -71,7 +71,7 @@ def test_split_parts_compose_to_the_serial_search(G, budgets, singles):
 
 def test_split_part_keeps_the_order_and_every_frame():
     ig = index_graph(nx.gnp_random_graph(14, 0.6, seed=3, directed=True))
-    run = PartRun(_inputs(ig), 4, whole_part(ig.n), True)
+    run = PartRun(_inputs(ig), 4, whole_part(ig.n), search.MAX_TREE_TOKENS)
     assert run.advance(15) == K.RUNNING
     rest = run.rest()
     k = rest.frames.shape[0]

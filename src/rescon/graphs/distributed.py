@@ -154,12 +154,13 @@ class PartResult:
 
 
 def run_part(masks: tuple[np.ndarray, np.ndarray, np.ndarray], r: int, part: SearchPart,
-             record: bool, max_nodes: int) -> PartResult:
-    """Run the decision kernel over ``part`` for at most ``max_nodes`` states (on a
-    worker: numba and the compiled kernels load there on first use)."""
+             room: int, max_nodes: int) -> PartResult:
+    """Run the decision kernel over ``part`` for at most ``max_nodes`` states, recording
+    fewer than ``room`` tokens (on a worker: numba and the compiled kernels load there on
+    first use)."""
     from . import _kernels as K
 
-    run = PartRun((K, *masks), r, part, record)
+    run = PartRun((K, *masks), r, part, room)
     status = run.advance(max_nodes)
     return PartResult(status, run.tokens(), run.nodes, float(run.progress[0]),
                       run.witness() if status == K.SAT else None,
@@ -187,6 +188,11 @@ class _Tree:
             return
         self.tokens[pid] = tokens
         self.size += tokens.shape[0]
+
+    def room(self) -> int:
+        """Tokens a part may record before the whole tree would reach the cap (0: the
+        tree is dropped; then no task ships tokens)."""
+        return MAX_TREE_TOKENS - self.size if self.record else 0
 
     def assemble(self) -> tuple[int, ...] | None:
         """Preorder concatenation from part 0 (None when dropped)."""
@@ -230,7 +236,7 @@ def finish_on_cluster(
         children = [next(ids) for _ in parts]
         tree.add(pid, tokens, children)
         for cid, part in zip(children, parts, strict=True):
-            running[client.submit(run_part, masks, r, part, tree.record, TASK_NODES,
+            running[client.submit(run_part, masks, r, part, tree.room(), TASK_NODES,
                                   pure=False)] = cid
 
     try:

@@ -146,11 +146,12 @@ def split_part(part: SearchPart, singles: int) -> list[SearchPart]:
 
 class PartRun:
     """A resumable run of ``_kernels.decide_step`` over one :class:`SearchPart`: the
-    stack, state, witness and token arrays it advances, slice by slice."""
+    stack, state, witness and token arrays it advances, slice by slice. The tree is
+    recorded while it has fewer than ``room`` tokens (0: not recorded)."""
 
-    def __init__(self, inputs: tuple, r: int, part: SearchPart, record: bool) -> None:
+    def __init__(self, inputs: tuple, r: int, part: SearchPart, room: int) -> None:
         self.K, self.inmask, self.outmask, self.order = inputs
-        self.r, self.record = r, record
+        self.r, self.room, self.record = r, room, room > 0
         K, n = self.K, self.inmask.shape[0]
         k = part.frames.shape[0]
         self.stack = np.zeros((2 * n + 2 + k, K.STACK_WIDTH), dtype=np.uint64)
@@ -161,12 +162,12 @@ class PartRun:
         self.state[K.ST_SP], self.state[K.ST_ROOT], self.state[K.ST_END] = k, part.root, part.end
         self.ubuf = np.zeros(K.UBUF_LEN, dtype=np.uint64)
         self.progress = np.zeros(1, dtype=np.float64)
-        self.buffer = np.empty(1 << 12 if record else 1, dtype=np.int32)
+        self.buffer = np.empty(min(1 << 12, room) if room > 0 else 1, dtype=np.int32)
 
     def advance(self, max_nodes: int) -> int:
         """Expand up to ``max_nodes`` more states; the kernel's status (RUNNING: not
-        finished). A full token buffer doubles, up to ``MAX_TREE_TOKENS``; beyond, the
-        tree is dropped (``record`` becomes False)."""
+        finished). A full token buffer doubles, up to ``room``; a full buffer of that
+        size drops the tree (``record`` becomes False)."""
         K = self.K
         while True:
             self.state[K.ST_STATUS] = K.RUNNING
@@ -176,10 +177,10 @@ class PartRun:
             if self.state[K.ST_STATUS] != K.NEED_ROOM:
                 return int(self.state[K.ST_STATUS])
             size = self.buffer.shape[0]
-            if size >= MAX_TREE_TOKENS:
+            if size >= self.room:
                 self.record, self.buffer = False, np.empty(1, dtype=np.int32)
             else:
-                grown = np.empty(min(2 * size, MAX_TREE_TOKENS), dtype=np.int32)
+                grown = np.empty(min(2 * size, self.room), dtype=np.int32)
                 grown[:size] = self.buffer
                 self.buffer = grown
 
@@ -238,7 +239,7 @@ def decide_r_robust(
 
     inputs = _kernel_inputs(ig)
     K, order = inputs[0], tuple(inputs[3].tolist())
-    run = PartRun(inputs, r, whole_part(ig.n, roots), record)
+    run = PartRun(inputs, r, whole_part(ig.n, roots), MAX_TREE_TOKENS if record else 0)
     cluster = distributed.active()
     while True:
         status = run.advance(_SLICE)
