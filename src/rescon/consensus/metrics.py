@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import math
+import operator
 import time
 from fractions import Fraction
 from typing import Any
@@ -83,8 +84,10 @@ def diameter(states: np.ndarray) -> float:
     is ≤ 1e-100 after scaling (converged rows: their float mean is off by a rounding,
     so R alone does not see it) or a row is not finite, the distinct rows are compared
     pairwise by chained hypot (no square underflows). In the plane, when more than
-    ANGULAR_MIN rows are kept (states on a circle), only near-antipodal pairs are
-    compared (:func:`_antipodal_max`). Memory O(n·d) (pairs in blocks); time O(n·kept)."""
+    ANGULAR_MIN rows are kept (states on a circle), only near-antipodal pairs about
+    the midpoint of an exact diametral pair are compared (:func:`_caliper_pair`,
+    :func:`_antipodal_max`). Memory O(n·d) (pairs in blocks); time O(n·kept), in the
+    plane O(n log n) for states on a circle."""
     X = np.asarray(states, dtype=float)
     if len(X) < 2:
         return _pairwise_max(X, X)
@@ -101,7 +104,9 @@ def diameter(states: np.ndarray) -> float:
                 keep = r + r.max() >= far * (1 - 4 * (X.shape[1] + 2) * UNIT_ROUNDOFF)
                 K = np.unique(X[keep], axis=0)  # states at a few values: all ends
                 if X.shape[1] == 2 and len(K) > ANGULAR_MIN:
-                    return math.ldexp(_antipodal_max(K, X.mean(axis=0), far), scale)
+                    p, q = K[list(_caliper_pair(K))]
+                    L = float(np.sqrt(((p - q) ** 2).sum()))
+                    return math.ldexp(_antipodal_max(K, (p + q) / 2, L), scale)
                 return math.ldexp(_pairwise_max(K, X), scale)
     distinct = np.unique(X, axis=0)
     return math.ldexp(_pairwise_max(distinct, distinct, hypot=True), scale)
@@ -145,6 +150,39 @@ def _antipodal_max(K: np.ndarray, c: np.ndarray, L: float) -> float:
     return float(np.sqrt((diff**2).sum(axis=1)).max())
 
 
+def _caliper_pair(K: np.ndarray) -> tuple[int, int]:
+    """Rows (i, j) of K (distinct, in lexicographic order, (n, 2)) at the exact
+    diameter: rotating calipers (Shamos) on the exact hull of K (:func:`_chain`,
+    counter-clockwise, no three vertices collinear), in integers. For each edge
+    (v_i, v_{i+1}), the vertex v_j farthest from its line — reached by advancing j while
+    (v_{i+1} − v_i) × (v_{j+1} − v_j) > 0, and j only advances as i does — is paired
+    with both ends of the edge, and v_{j+1} too when that cross product is 0 (an edge
+    parallel to it). Every antipodal pair (u, v) (parallel supporting lines through u
+    and v) appears: turn the lines about u and v until one lies along an edge; that
+    edge ends at u or v and the other is farthest from it. A diametral pair is
+    antipodal (the lines through its ends perpendicular to it support the set)."""
+    ints = exact_points(K).ints
+    cycle = _chain(ints)
+    V = [ints[c] for c in cycle]
+    h = len(V)
+    best, pair = -1, (cycle[0], cycle[-1])
+    j = 1 % h
+    for i in range(h if h > 2 else 0):
+        (p0, p1), (q0, q1) = V[i], V[(i + 1) % h]
+        while True:
+            (r0, r1), (s0, s1) = V[j], V[(j + 1) % h]
+            turn = (q0 - p0) * (s1 - r1) - (q1 - p1) * (s0 - r0)
+            if turn <= 0:
+                break
+            j = (j + 1) % h
+        for k in (j, (j + 1) % h) if turn == 0 else (j,):
+            for e in (i, (i + 1) % h):
+                dist = (V[e][0] - V[k][0]) ** 2 + (V[e][1] - V[k][1]) ** 2
+                if dist > best:
+                    best, pair = dist, (cycle[e], cycle[k])
+    return pair
+
+
 def _pairwise_max(P: np.ndarray, X: np.ndarray, chunk: int = 256, hypot: bool = False
                   ) -> float:
     """max ‖p − x‖₂ over rows p of ``P`` and x of ``X``, in blocks of ``chunk`` rows;
@@ -181,6 +219,7 @@ class ValidityMonitor:
         self._edges = _polygon_edges(self.hull) if full and initial.shape[1] == 2 else None
         self._triangles = _hull_triangles(self.hull) if full and initial.shape[1] == 3 else None
         self._inner = _inner_rows(self.hull) if self._edges is not None else None
+        self._cones = _cone_filter(self.hull) if full and initial.shape[1] == 3 else None
 
     def distance(self, x: np.ndarray) -> float:
         """dist(x, H): 0 iff x ∈ H (exact test); else ‖x − y‖ for the exact projection y
@@ -200,7 +239,9 @@ class ValidityMonitor:
         the dot product) plus (d + 2)(‖x‖∞ + 1)·2^-1074 for gradual underflow; twice
         the first term covers the rounding of the bound itself. Overflow makes the
         bound inf or the value NaN, and the row unproven. A polygon of many edges first
-        tries its inner polygon (:func:`_inner_rows`), then its own facets in blocks."""
+        tries its inner polygon (:func:`_inner_rows`) and its fan (:meth:`_in_fan`), a
+        polytope from :func:`_exact_polytope` the cones of its triangles
+        (:meth:`_in_cones`), then its own facets in blocks."""
         sure = np.zeros(len(states), dtype=bool)
         if self._rows is None:
             return sure
@@ -209,6 +250,9 @@ class ValidityMonitor:
             sure = (S < -bound).all(axis=1)
             todo = np.flatnonzero(~sure)
             sure[todo] = self._in_fan(states[todo])
+        if self._cones is not None:
+            todo = np.flatnonzero(~sure)
+            sure[todo] = self._in_cones(states[todo])
         todo = np.flatnonzero(~sure)
         block = max(1, BLOCK // len(self._rows[1]))
         for s in range(0, todo.size, block):
@@ -270,6 +314,25 @@ class ValidityMonitor:
                                  np.abs(X).max(axis=1))
         big = np.maximum(np.abs(X).max(axis=1), np.abs(C).max()) > 1e150
         return ok & (S < -bound) & ~big
+
+    def _in_cones(self, X: np.ndarray) -> np.ndarray:
+        """Rows of X (n, 3) a float filter proves inside the polytope H from
+        :func:`_exact_polytope`, through the tetrahedra conv(o, T_f) of its certified
+        boundary triangles T_f (each lies in H): a walk guesses the triangle
+        (:func:`_cone_guesses`), and x is proven strictly on the
+        inner side of the three planes (o, edge) and of T_f's plane by
+        :func:`_orient3_float`, on X scaled by the hull's power of two (rows that
+        scaling rounds are left unproven). A wrong guess leaves x unproven, never
+        wrongly inside."""
+        corners, o, mate, e, tree = self._cones
+        Y = np.ldexp(X, -e)
+        rows = np.flatnonzero((np.ldexp(Y, e) == X).all(axis=1))
+        sure = np.zeros(len(X), dtype=bool)
+        for guess in _cone_guesses(tree, corners, mate, o, Y[rows]).T:
+            left = ~sure[rows]
+            A, B, C = corners[guess[left]].transpose(1, 0, 2)
+            sure[rows[left]] = _surely_in_tetra(o, A, B, C, Y[rows[left]])
+        return sure
 
     def _initial_rows(self, states: np.ndarray) -> np.ndarray:
         """Rows of ``states`` equal to the initial state of the same row (they generate
@@ -349,12 +412,18 @@ def certified_hull(X: np.ndarray):
     facets, :meth:`ValidityMonitor.surely_inside`, and the exact test where the filter
     is unsure); rows that are not are added to V and conv X[V] is rebuilt. The hull of
     n points costs one Qhull call, the exact kernel of its h vertices and O(n·facets)
-    float work, instead of the O(n^d) candidates of safe_kernel(X, 0). In the plane
-    (n > PROPOSE_MIN) the exact monotone chain builds it (:func:`_exact_polygon`):
-    initial states that are all vertices (a circle) cost O(n log n), not O(h³)."""
+    float work, instead of the O(n^d) candidates of safe_kernel(X, 0). For n >
+    PROPOSE_MIN the plane's hull comes from an exact monotone chain
+    (:func:`_exact_polygon`) and R³'s from Qhull's triangulated boundary certified
+    exactly (:func:`_exact_polytope`): initial states that are all vertices (a circle,
+    a sphere) cost O(n log n), not O(h³) or O(h⁴)."""
     X = np.asarray(X, dtype=np.float64)
-    if X.ndim == 2 and X.shape[1] == 2 and len(X) > PROPOSE_MIN and np.isfinite(X).all():
-        return _exact_polygon(X)
+    if X.ndim == 2 and len(X) > PROPOSE_MIN and np.isfinite(X).all():
+        if X.shape[1] == 2:
+            return _exact_polygon(X)
+        hull = _exact_polytope(X) if X.shape[1] == 3 else None
+        if hull is not None:
+            return hull
     rows = _proposed_rows(X)
     while True:
         hull = safe_kernel(X[rows], 0)
@@ -431,6 +500,336 @@ def _chain(ints: tuple[tuple[int, ...], ...]) -> list[int]:
     return half(range(n))[:-1] + half(range(n - 1, -1, -1))[:-1]
 
 
+def _exact_polytope(X: np.ndarray):
+    """conv X in R³ (rows of X finite, (n, 3)) as the exact polytope that
+    safe_kernel(X, 0) returns, from Qhull's triangulated boundary of the distinct rows
+    U, certified exactly (:func:`_certified_surface`); its facets are the distinct
+    planes of the triangles, its vertices the triangle corners on ≥ 3 of them
+    (:func:`_polytope_of`). O(n log n) floats and O(n) filtered orientation tests,
+    instead of safe_kernel's O(n⁴) side tests; None when no proposal (Qhull's
+    default, then joggled) is certified — a flat X, or one Qhull fails on."""
+    t0 = time.perf_counter()
+    U = np.unique(X, axis=0)  # distinct rows in lexicographic order (exact comparisons)
+    Z = _principal(U)
+    if Z.shape[1] < 3:
+        return None
+    for options in QHULL_OPTIONS:
+        found = _qhull(Z, options)
+        surface = None if found is None else _certified_surface(U, found.simplices)
+        if surface is not None:
+            return _polytope_of(U, *surface, time.perf_counter() - t0)
+    return None
+
+
+class _Orient3:
+    """Exact signs of orient(a, b, c, q) = det[b − a, c − a, q − a] for rows of a point
+    array R: a float filter (:func:`_orient3_float`) on R·2^-e (max |entry| < 1; rows
+    that scaling rounds are never decided by it), exact integers where it is unsure."""
+
+    def __init__(self, R: np.ndarray) -> None:
+        self.R = R
+        self.e = int(np.frexp(np.abs(R).max())[1])
+        self.Y = np.ldexp(R, -self.e)
+        self.ok = (np.ldexp(self.Y, self.e) == R).all(axis=1)
+        self.P = exact_points(R)
+
+    def __call__(self, a: np.ndarray, b: np.ndarray, c: np.ndarray,
+                 q: np.ndarray) -> np.ndarray:
+        Y = self.Y
+        det, bound = _orient3_float(Y[a], Y[b], Y[c], Y[q])
+        bound[~(self.ok[a] & self.ok[b] & self.ok[c] & self.ok[q])] = np.inf
+        sign = np.where(det > bound, 1, np.where(det < -bound, -1, 0))
+        ints = self.P.ints
+        for r in np.flatnonzero(sign == 0):
+            sign[r] = _orient3_exact(ints[a[r]], ints[b[r]], ints[c[r]], ints[q[r]])
+        return sign
+
+
+def _orient3_float(A: np.ndarray, B: np.ndarray, C: np.ndarray, Q: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Per row, fl(orient(a, b, c, q)) = −fl(det[a − q, b − q, c − q]) and a bound on
+    its error: Shewchuk's 7u + 56u² times the permanent (taken as 8u), plus
+    8(M + 1)·2^-1074 for gradual underflow (each of the 9 products may lose 2^-1075,
+    the inner ones then multiplied by at most M = the largest |difference|).
+    Overflow makes the value or the bound inf or NaN: undecided."""
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        a, b, c = A - Q, B - Q, C - Q
+        m0 = b[:, 1] * c[:, 2] - b[:, 2] * c[:, 1]
+        m1 = b[:, 2] * c[:, 0] - b[:, 0] * c[:, 2]
+        m2 = b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0]
+        det = -(a[:, 0] * m0 + a[:, 1] * m1 + a[:, 2] * m2)
+        ab, ac = np.abs(b), np.abs(c)
+        perm = (np.abs(a[:, 0]) * (ab[:, 1] * ac[:, 2] + ab[:, 2] * ac[:, 1])
+                + np.abs(a[:, 1]) * (ab[:, 2] * ac[:, 0] + ab[:, 0] * ac[:, 2])
+                + np.abs(a[:, 2]) * (ab[:, 0] * ac[:, 1] + ab[:, 1] * ac[:, 0]))
+        top = np.maximum(np.abs(a).max(axis=1), np.maximum(ab.max(axis=1), ac.max(axis=1)))
+        bound = 8 * UNIT_ROUNDOFF * perm + 8 * MIN_SUBNORMAL * (top + 1)
+    return det, np.where(np.isnan(bound), np.inf, bound)
+
+
+def _orient3_exact(a, b, c, q) -> int:
+    """The sign of det[b − a, c − a, q − a] for integer points."""
+    u = [y - x for x, y in zip(a, b)]
+    v = [y - x for x, y in zip(a, c)]
+    w = [y - x for x, y in zip(a, q)]
+    det = (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+           + u[2] * (v[0] * w[1] - v[1] * w[0]))
+    return (det > 0) - (det < 0)
+
+
+def _certified_surface(U: np.ndarray, simplices: np.ndarray):
+    """Certify that the triangles ``simplices`` (rows of U, (T, 3)) bound conv U:
+    (orient, T, mate) with the triangles oriented outwards and mate[f, r] the
+    triangle across edge r of triangle f, or None. With o a float point (the mean of
+    the corners) and exact orientation tests (:class:`_Orient3`), it checks
+
+    1. o lies strictly on one side of each triangle's plane (the triangle is then
+       ordered so that o is on its negative side);
+    2. closed: every directed edge (i, j) occurs once, and (j, i) once;
+    3. locally convex: across each edge, the far corner of the other triangle is not
+       on the positive side of this one's plane;
+    4. one ray: the ray from o through a point c strictly inside the cone of one
+       triangle f₀ (its float centroid) meets no other closed cone {o + t(y − o) :
+       y ∈ T_g, t ≥ 0};
+    5. every row of U not a corner lies in conv(o, T_f) for some f (three cone sides
+       and f's plane, :func:`_located`).
+
+    Proof that then conv U = K := ⋃_f conv(o, T_f) = ⋂_f {a_f·x ≤ β_f}: by 1 the
+    radial projection from o maps each triangle onto a spherical triangle with
+    positive orientation, and by 2 these form a 2-cycle on the sphere, so every
+    direction off their edges is covered the same number of times — once, by 4. The
+    surface S = ⋃ T_f is thus a closed surface star-shaped about o, and with 3 it is
+    the boundary of a convex polytope (Mehlhorn, Näher, Schilz, Schirra, Seel, Seidel,
+    Uhrig, "Checking geometric programs or verification of geometric structures",
+    Comput. Geom. 12 (1999), §3: a closed oriented surface locally convex at every
+    edge, a point on the negative side of every facet and a ray from it meeting one
+    facet only); that polytope is K, the intersection of the triangles' halfspaces
+    (a point beyond S on a ray from o is beyond the plane of the triangle the ray
+    crosses). Its boundary S lies in conv U (each T_f does) and so does K = conv S;
+    the corners lie on S and, by 5, every other row in K: conv U ⊆ K ⊆ conv U."""
+    m, T = len(U), np.asarray(simplices, dtype=np.int64)
+    corners = np.unique(T)
+    scale = int(np.frexp(np.abs(U).max())[1])
+    tri = np.ldexp(U, -scale)[T]
+    f0 = int(np.argmax(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                      axis=1)))
+    o = np.ldexp(np.ldexp(U[corners], -scale).mean(axis=0), scale)
+    c = np.ldexp(tri[f0].mean(axis=0), scale)
+    orient = _Orient3(np.vstack([U, o, c]))
+    a, b, cc = T.T
+    side = orient(a, b, cc, np.full(len(T), m))
+    if not side.all():
+        return None
+    T = np.stack([a, np.where(side > 0, cc, b), np.where(side > 0, b, cc)], axis=1)
+    mate = _closed_convex(orient, T)
+    if mate is None or not _one_ray(orient, T, f0, m, m + 1):
+        return None
+    rest = np.setdiff1d(np.arange(m), corners)
+    if rest.size and not _located(orient, T, mate, m, rest).all():
+        return None
+    return orient, T, mate
+
+
+def _closed_convex(orient: _Orient3, T: np.ndarray) -> np.ndarray | None:
+    """Conditions 2 and 3 of :func:`_certified_surface`: mate (T, 3), mate[f, r] the
+    triangle across edge r (T[f, r] → T[f, r + 1]) of triangle f, or None."""
+    n = len(orient.Y)
+    head, tail, third = T.ravel(), T[:, [1, 2, 0]].ravel(), T[:, [2, 0, 1]].ravel()
+    key = head * n + tail
+    order = np.argsort(key, kind="stable")
+    ordered = key[order]
+    if (ordered[1:] == ordered[:-1]).any():
+        return None
+    pos = np.minimum(np.searchsorted(ordered, tail * n + head), len(key) - 1)
+    if not (ordered[pos] == tail * n + head).all():
+        return None
+    across = order[pos]
+    once = head < tail
+    if (orient(head[once], tail[once], third[once], third[across][once]) > 0).any():
+        return None
+    return (across // 3).reshape(-1, 3)
+
+
+def _one_ray(orient: _Orient3, T: np.ndarray, f0: int, o: int, c: int) -> bool:
+    """Condition 4 of :func:`_certified_surface`: the direction c − o is strictly
+    inside the cone of triangle f0 from o and in no other triangle's closed cone."""
+    sides = _cone_sides(orient, T, np.full(len(T), o), np.full(len(T), c))
+    inside = (sides >= 0).all(axis=0)
+    return bool((sides[:, f0] > 0).all() and inside.sum() == 1)
+
+
+def _cone_sides(orient: _Orient3, T: np.ndarray, o: np.ndarray, q: np.ndarray
+                ) -> np.ndarray:
+    """(3, len(T)): the signs of orient(o, a, b, q), orient(o, b, c, q), orient(o, c,
+    a, q) for triangles (a, b, c) = T and points q (all ≥ 0: q in the closed cone of
+    the triangle from o, when o is on the triangle's negative side)."""
+    a, b, c = T.T
+    return np.stack([orient(o, a, b, q), orient(o, b, c, q), orient(o, c, a, q)])
+
+
+def _located(orient: _Orient3, T: np.ndarray, mate: np.ndarray, o: int, rows: np.ndarray
+             ) -> np.ndarray:
+    """Condition 5 of :func:`_certified_surface`: which ``rows`` are proven in
+    conv(o, T_f) for some triangle f — the closed cone of T_f from o and the closed
+    negative side of its plane. The triangles tried first are those of a walk
+    towards the row (:func:`_cone_guesses`); rows none of them takes are tried against
+    every triangle."""
+    found = np.zeros(len(rows), dtype=bool)
+    Y = orient.Y
+    guesses = _cone_guesses(_cone_tree(Y[T], Y[o]), Y[T], mate, Y[o], Y[rows])
+    for g in guesses.T:
+        todo = np.flatnonzero(~found)
+        found[todo] = _in_tetra(orient, T[g[todo]], o, rows[todo])
+    for i in np.flatnonzero(~found):
+        found[i] = _in_tetra(orient, T, o, np.full(len(T), rows[i])).any()
+    return found
+
+
+def _in_tetra(orient: _Orient3, T: np.ndarray, o: int, q: np.ndarray) -> np.ndarray:
+    """Per row: q ∈ conv(o, T_f) for the triangle T_f in the same row of T (exact)."""
+    inside = (_cone_sides(orient, T, np.full(len(T), o), q) >= 0).all(axis=0)
+    a, b, c = T[inside].T
+    inside[inside] = orient(a, b, c, q[inside]) <= 0
+    return inside
+
+
+#: steps of the walk that guesses a state's cone (:func:`_cone_guesses`)
+CONE_STEPS = 8
+
+
+def _cone_tree(corners: np.ndarray, o: np.ndarray):
+    """A k-d tree of the triangles' centroid directions from o (corners (T, 3, 3))."""
+    from scipy.spatial import cKDTree
+
+    return cKDTree(_directions(corners.mean(axis=1) - o))
+
+
+def _cone_guesses(tree, corners: np.ndarray, mate: np.ndarray, o: np.ndarray,
+                  X: np.ndarray) -> np.ndarray:
+    """(len(X), CONE_STEPS + 1): for each row x, guesses of the triangle whose cone from
+    o holds x (a wrong one only leaves x to a later test): the triangle whose centroid
+    direction is nearest to x's (``tree``, :func:`_cone_tree`), then a walk (Devillers,
+    Pion, Teillaud, "Walking in a triangulation", 2002): each step crosses to the
+    triangle across the side of the current cone that x is most outside of, by the
+    float orientations (mate (T, 3): the triangle across edge r of triangle f)."""
+    f = tree.query(_directions(X - o))[1].reshape(len(X))
+    apex = np.broadcast_to(o, X.shape)
+    visited = [f]
+    for _ in range(CONE_STEPS):
+        A, B, C = corners[f].transpose(1, 0, 2)
+        sides = np.stack([_orient3_float(apex, P, Q, X)[0] for P, Q in ((A, B), (B, C), (C, A))],
+                         axis=1)
+        r = np.argmin(np.where(np.isnan(sides), np.inf, sides), axis=1)
+        f = np.where(sides[np.arange(len(X)), r] < 0, mate[f, r], f)
+        visited.append(f)
+    return np.stack(visited, axis=1)
+
+
+def _cone_filter(hull) -> tuple | None:
+    """(corners, o, mate, e, tree) for :meth:`ValidityMonitor._in_cones`: the certified
+    triangles, their mates and the point o of a hull from :func:`_exact_polytope`
+    scaled by 2^-e
+    (max |corner| ∈ [1/2, 1)), and their :func:`_cone_tree`; None for other hulls or
+    when the scaling rounds a corner or o."""
+    if "cones" not in hull._cache:
+        return None
+    corners, o, mate = hull._cache["cones"]
+    e = int(np.frexp(max(np.abs(corners).max(), np.abs(o).max()))[1])
+    scaled, o_scaled = np.ldexp(corners, -e), np.ldexp(o, -e)
+    if not (np.array_equal(np.ldexp(scaled, e), corners)
+            and np.array_equal(np.ldexp(o_scaled, e), o)):
+        return None
+    return scaled, o_scaled, mate, e, _cone_tree(scaled, o_scaled)
+
+
+def _surely_in_tetra(o: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray,
+                     X: np.ndarray) -> np.ndarray:
+    """Per row: x strictly inside conv(o, T) for the triangle T = (a, b, c) of the same
+    row, o on its negative side — orient(o, a, b, x), orient(o, b, c, x), orient(o, c,
+    a, x) > 0 and orient(a, b, c, x) < 0, each proven by :func:`_orient3_float`."""
+    apex = np.broadcast_to(o, X.shape)
+    sure = np.ones(len(X), dtype=bool)
+    for P, Q in ((A, B), (B, C), (C, A)):
+        det, bound = _orient3_float(apex, P, Q, X)
+        sure &= det > bound
+    det, bound = _orient3_float(A, B, C, X)
+    return sure & (det < -bound)
+
+
+def _directions(V: np.ndarray) -> np.ndarray:
+    """Rows of V divided by their norms (rows of norm 0 or not finite: (1, 0, 0))."""
+    with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+        D = V / np.linalg.norm(V, axis=1)[:, None]
+    D[~np.isfinite(D).all(axis=1)] = (1.0, 0.0, 0.0)
+    return D
+
+
+def _polytope_of(U: np.ndarray, orient: _Orient3, T: np.ndarray, mate: np.ndarray,
+                 seconds: float):
+    """The SafeKernel of conv U from a certified surface (:func:`_certified_surface`):
+    facets a·x ≤ β from the distinct planes of the triangles (a = the primitive
+    integer normal (b − a) × (c − a) / gcd, outward; β = a·a_f / scale), vertices the
+    corners on ≥ 3 distinct planes (a corner on 1 lies inside a facet, on 2 inside an
+    edge), the certificate's adjacency from the chains of crease edges
+    (:func:`_crease_adjacency`); its cache keeps the triangles and o for the
+    validity monitor's cone filter."""
+    P = orient.P
+    planes: dict[tuple[int, ...], int] = {}
+    facets = []
+    plane_of = np.empty(len(T), dtype=np.int64)
+    for f, (i, j, k) in enumerate(T.tolist()):
+        p, q, r = P.ints[i], P.ints[j], P.ints[k]
+        u = [y - x for x, y in zip(p, q)]
+        v = [y - x for x, y in zip(p, r)]
+        n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+        g = math.gcd(*n)
+        n = tuple(t // g for t in n)
+        plane_of[f] = planes.setdefault(n, len(planes))
+        if plane_of[f] == len(facets):
+            facets.append((tuple(map(Fraction, n)),
+                           Fraction(sum(map(operator.mul, n, p)), P.scale)))
+    facets = tuple(facets)
+    pairs = np.unique(T.ravel() * len(facets) + np.repeat(plane_of, 3))
+    is_vertex = np.bincount(pairs // len(facets), minlength=len(U)) >= 3
+    rows = np.flatnonzero(is_vertex)  # lexicographic order, as safe_kernel's
+    verts = tuple(P.fraction(i) for i in rows)
+    V = U[rows]
+    dim, origin, basis, Aeq, beq, _ = _affine_of(verts, 3, True)
+    A, b = _unit_rows(facets, 3)
+    crease = (plane_of[mate] != plane_of[:, None]).ravel()
+
+    def certificate() -> dict[str, Any]:
+        return {"rescon_certificate": 1, "kind": "safe_kernel", "points": V.tolist(), "F": 0,
+                "dim": dim, "vertices": [[fraction_str(v) for v in x] for x in verts],
+                "equalities": [], "facets": halfspaces_json(facets),
+                "adjacency": _crease_adjacency(T, crease, is_vertex),
+                "proof": {"method": "halfspaces"}}
+
+    return SafeKernel(V, 0, dim, V.copy(), A, b, origin, basis, Aeq, beq, seconds, verts,
+                      _Exact(verts, facets, (), facets), certificate,
+                      {"cones": (U[T], orient.R[len(U)], mate)})
+
+
+def _crease_adjacency(T: np.ndarray, crease: np.ndarray, is_vertex: np.ndarray
+                      ) -> list[list[int]]:
+    """The polytope's edges between its vertices (numbered in order): an edge of the
+    polytope is a chain of crease edges (the two triangles across lie on distinct
+    planes) whose inner corners lie on 2 planes, each with exactly two crease edges."""
+    head, tail = T.ravel()[crease], T[:, [1, 2, 0]].ravel()[crease]
+    links: dict[int, list[int]] = {}
+    for i, j in zip(head.tolist(), tail.tolist()):
+        links.setdefault(i, []).append(j)
+    where = {int(v): k for k, v in enumerate(np.flatnonzero(is_vertex))}
+    adjacency: list[list[int]] = [[] for _ in where]
+    for v, k in where.items():
+        for w in links.get(v, ()):
+            prev = v
+            while not is_vertex[w]:
+                prev, w = w, next(x for x in links[w] if x != prev)
+            adjacency[k].append(where[w])
+    return [sorted(a) for a in adjacency]
+
+
 def _orient_sign(a: np.ndarray, B: np.ndarray, X: np.ndarray) -> np.ndarray:
     """Per row: +1 / −1 when the float (b − a) × (x − a) proves that sign (beyond
     8u(|l| + |r|) + 4·2^-1074, :meth:`ValidityMonitor._in_fan`), else 0."""
@@ -467,29 +866,45 @@ def _rows_outside(hull, X: np.ndarray, rows: np.ndarray) -> np.ndarray:
 def _proposed_rows(X: np.ndarray) -> np.ndarray:
     """Row indices that Qhull finds to be the vertices of conv X (a proposal: rounding
     may add or miss some; :func:`certified_hull` decides). All rows for small n or
-    d > 3. X is first put on its principal axes, each scaled to unit width (an affine
-    map keeps the vertices): a thin or flat X (an axis of width ~0) becomes a fat one,
-    axes of width exactly 0 are dropped; Qhull's own degeneracy failure is retried
-    joggled ("QJ"), then every row is proposed."""
+    d > 3; Qhull on X's principal axes (:func:`_principal`), its own degeneracy
+    failure retried joggled ("QJ"), then every row is proposed."""
     n, d = X.shape
     if n <= PROPOSE_MIN or d > 3:
         return np.arange(n)
+    Z = _principal(X)
+    if Z.shape[1] <= 1:
+        return np.unique([0, *(np.argmin(Z, axis=0)), *(np.argmax(Z, axis=0))])
+    for options in QHULL_OPTIONS:
+        found = _qhull(Z, options)
+        if found is not None:
+            return np.sort(found.vertices)
+    return np.arange(n)  # too few points for Qhull
+
+
+#: Qhull's options, tried in turn: its default (merged facets, triangulated), joggled
+QHULL_OPTIONS = (None, "QJ")
+
+
+def _principal(X: np.ndarray) -> np.ndarray:
+    """X put on its principal axes, each scaled to unit width (an affine map keeps the
+    vertices and the facets: a thin or flat X becomes a fat one), axes of width
+    exactly 0 dropped; X first scaled by a power of two to max |x| ∈ [1/2, 1)."""
     top = np.abs(X).max()
     Y = np.ldexp(X, -int(np.frexp(top)[1])) if top > 0 else X
     Y = Y - Y.mean(axis=0)
     Z = Y @ np.linalg.svd(Y, full_matrices=False)[2].T
     width = Z.max(axis=0) - Z.min(axis=0)
-    Z = Z[:, width > 0] / width[width > 0]
-    if Z.shape[1] <= 1:
-        return np.unique([0, *(np.argmin(Z, axis=0)), *(np.argmax(Z, axis=0))])
+    return Z[:, width > 0] / width[width > 0]
+
+
+def _qhull(Z: np.ndarray, options: str | None):
+    """scipy's ConvexHull of Z (triangulated facets), or None where Qhull fails."""
     from scipy.spatial import ConvexHull, QhullError
 
-    for options in (None, "QJ"):
-        try:
-            return np.sort(ConvexHull(Z, qhull_options=options).vertices)
-        except QhullError:
-            continue
-    return np.arange(n)  # too few points for Qhull
+    try:
+        return ConvexHull(Z, qhull_options=options)
+    except QhullError:
+        return None
 
 
 def _slacks(A: np.ndarray, b: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -540,12 +955,15 @@ def _polygon_edges(hull) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _hull_triangles(hull) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """(A, B, C) (T, 3) each: a triangulation of the boundary of conv V̂ (Qhull on the
-    rounded vertices V̂; any triangles of points of conv V̂ serve, their quality only
-    tightens :meth:`ValidityMonitor.triangle_distances`' bound); None if Qhull fails."""
+    """(A, B, C) (T, 3) each: a triangulation of the boundary of conv V̂ (the certified
+    triangles of a hull from :func:`_exact_polytope`, else Qhull on the rounded
+    vertices V̂; any triangles of points of conv V̂ serve, their quality only tightens
+    :meth:`ValidityMonitor.triangle_distances`' bound); None if Qhull fails."""
     from scipy.spatial import ConvexHull, QhullError
 
     V = hull.vertices
+    if "cones" in hull._cache:  # the certified boundary triangles
+        return tuple(hull._cache["cones"][0].transpose(1, 0, 2))
     if len(V) < 4 or not np.isfinite(V).all():
         return None
     try:
@@ -587,11 +1005,12 @@ def _closest_on_triangles(X: np.ndarray, A: np.ndarray, B: np.ndarray,
 
 def _filter_rows(facets) -> tuple[np.ndarray, np.ndarray]:
     """Floats of the exact facets a·x ≤ β, each divided exactly by max|a_j| (so the
-    entries of Â are in [−1, 1]; b̂ is ±inf beyond the float range)."""
-    rows = [(tuple(v / top for v in a), beta / top)
-            for a, beta in facets for top in (max(map(abs, a)),)]
-    A = np.array([[float(v) for v in a] for a, _ in rows])
-    return A, np.array([_float(beta) for _, beta in rows])
+    entries of Â are in [−1, 1]; b̂ is ±inf beyond the float range), each quotient
+    rounded once (:func:`_quotient`)."""
+    tops = [max(map(abs, a)) for a, _ in facets]
+    A = np.array([[_quotient(v, top) for v in a] for (a, _), top in zip(facets, tops)])
+    return A, np.array(
+        [_quotient(beta, top) for (_, beta), top in zip(facets, tops)], dtype=np.float64)
 
 
 def _norm(v: list[Fraction]) -> float:
@@ -608,9 +1027,11 @@ def _norm(v: list[Fraction]) -> float:
         return math.inf
 
 
-def _float(v: Fraction) -> float:
-    """v rounded to a float, ±inf beyond the float range."""
+def _quotient(v: Fraction, w: Fraction) -> float:
+    """v / w (w > 0) correctly rounded (Python's int / int, no Fraction built: 20 000
+    facets took 1.3 s), ±inf beyond the float range."""
+    num, den = v.numerator * w.denominator, v.denominator * w.numerator
     try:
-        return float(v)
+        return num / den
     except OverflowError:
-        return math.copysign(math.inf, v)
+        return math.inf if num > 0 else -math.inf
