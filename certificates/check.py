@@ -628,6 +628,9 @@ class _Replay:
             L = w * (field[v] + 1)
             self.less[L] = sum(1 << (w * field[j]) for j in _bits(out[v]))
             self.least[L] = max(1, deg[v] - r + 2)
+        # fit[k]: the fields p (a prefix: least grows with p) with least ≤ k
+        self.fit = [sum(1 << (w * p + w - 1) for p in range(n) if self.least[w * (p + 1)] <= k)
+                    for k in range(n + 1)]
         self.unit = max(1, -(-n * w // 1024))
         self.work = (n + g.m) * self.unit
 
@@ -660,19 +663,27 @@ class _Replay:
         the fields of their out-neighbours; the members whose guard bit is then cleared
         have r in-neighbours outside, and are the next round's ``todo``. Every removed
         node had r in-neighbours outside a superset of the result, which is closed:
-        the result is the core. A nonempty closed C ⊆ U holds some j with at most r − 1
-        in-neighbours outside C, so |C| ≥ max(1, d_j − r + 2) ≥ that bound for the
-        member of U of least in-degree (U's lowest bit): when U is smaller, the core
-        is empty (and D is not used again). With ``watch``, the peeling stops once a
+        the result is the core. Every member j of a nonempty closed C ⊆ U has at most
+        r − 1 in-neighbours outside C, so |C| ≥ m_j = max(1, d_j − r + 2) ("least"):
+        C ⊆ U' = {j ∈ U : m_j ≤ |U|}, then C ⊆ {j ∈ U' : m_j ≤ |U'|}, and so on (each
+        is U cut to a prefix of the fields, ``fit``); when this reaches ∅, the core is
+        empty (and D is not used again). With ``watch``, the peeling stops once a
         member of ``watch`` is peeled: the set returned then lies between the core and
         U, without that member (enough to show watch ⊄ core; D is not used again).
-        Work: one step per round and per node whose out-neighbours are subtracted."""
-        less, least, ones, shift = self.less, self.least, self.ones, self.w - 1
+        Work: one step per round, per cut and per node whose out-neighbours are
+        subtracted."""
+        less, fit, ones, shift = self.less, self.fit, self.ones, self.w - 1
         todo = gone & U
         steps = 0
         while todo:
             U ^= todo
-            if U.bit_count() < least[(U & -U).bit_length()]:
+            k = U.bit_count()
+            C = U & fit[k]
+            while C.bit_count() < k:
+                k = C.bit_count()
+                C &= fit[k]
+                steps += 1
+            if not C:
                 U = 0
                 steps += 1
                 break
