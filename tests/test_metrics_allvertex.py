@@ -244,3 +244,22 @@ def test_caliper_diameter_is_the_float_of_all_pairs(n, seed, scale):
     with mock.patch.object(metrics, "ANGULAR_MIN", 0):
         D = diameter(X)
     assert D == math.ldexp(metrics._pairwise_max(Y, Y), e)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e300, 2.0**-1000])
+def test_monitor_at_every_magnitude(scale):
+    """Initial states on a sphere (with duplicates) at 1e-300, 1e300 and 2^-1000;
+    states converged to one point (the centre, or beside a vertex), repeated initial
+    states and states outside: the same zeros and distances as the monitor built from
+    the safe kernel of every initial state (beyond 1e±100 both take the exact
+    projection)."""
+    X = _sphere(120, scale, seed=2)
+    X = np.r_[X, X[:30]]
+    new = ValidityMonitor(X)
+    with mock.patch.object(metrics, "PROPOSE_MIN", 10**9):
+        old = ValidityMonitor(X)
+    assert _facet_set(new.hull) == _facet_set(old.hull)
+    S = np.r_[np.zeros((4, 3)), np.repeat(X[:1] * 0.999, 4, axis=0), X[::7] * 1.5, X[40:60]]
+    dist = new.distances(S)
+    assert np.array_equal(dist, old.distances(S))
+    assert np.array_equal(dist == 0, np.array([new.hull.contains(x) for x in S]))
