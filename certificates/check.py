@@ -717,9 +717,8 @@ class _Replay:
             stack = [(S0, B, P, PD, Q, QD)]
             while stack:
                 if self.work > MAX_SEARCH_WORK:
-                    return (f"replaying its tree needs more than {MAX_SEARCH_WORK} mask "
-                            f"operations (the checker's work limit; stopped at token {pos} "
-                            f"of {ntok})")
+                    return (f"replaying its tree needs more than {MAX_SEARCH_WORK} steps "
+                            f"(the checker's work limit; stopped at token {pos} of {ntok})")
                 if pos >= ntok:
                     raise Invalid(f"{self.where}: search tree ends early (in the subtree of "
                                   f"root {k})")
