@@ -74,7 +74,7 @@ def test_fast_path_refuses_a_missing_non_simple_vertex():
     target = P.verts[vi]
     bases = [fastpath._basis_of(H, [int(first[i]) for i in f], 4) for f in facets]
     keep = [f for f, v in zip(facets, fastpath._solve_all(H, bases, 4), strict=True)
-            if v is None or not fastpath._proportional(v, target)]
+            if v != target]
     assert len(keep) < len(facets)
     assert fastpath._certify(H, 4, unit, first, keep) is None
 
@@ -170,12 +170,15 @@ def test_fast_path_adjacency_equals_the_incidence_one(d, n, F):
 
 @pytest.mark.slow
 def test_joggled_proposals_when_qhull_merging_fails(monkeypatch):
-    """gaussian(d=5, n=20, F=3) of the benchmark: qhull's facet merging stops with a
-    topology error (dupridge) or proposes an uncertifiable set; the joggled proposals
-    are certified and equal the exact clipping."""
+    """gaussian(d=5, n=20, F=3) of the benchmark: qhull's facet merging can stop with a
+    topology error (dupridge) or propose an uncertifiable set on its near-coincident
+    hyperplanes (whether it does depends on the last bits of the float rows); the
+    joggled proposals alone are certified and equal the exact clipping."""
     X = np.random.default_rng([0, 10_000_000 * 5 + 1000 * 20 + 3]).normal(size=(20, 5))
     fast, slow, H, unit, first = _both_paths(X, 3)
     assert fast is not None
     assert set(fast.fraction_vertices()) == set(slow.fraction_vertices())
-    monkeypatch.setattr(fastpath, "QHULL_OPTIONS", (None,))
-    assert fastpath.certified_kernel(H, 5, unit, first) is None
+    monkeypatch.setattr(fastpath, "QHULL_OPTIONS", ("QJ",))
+    joggled = fastpath.certified_kernel(H, 5, unit, first)
+    assert joggled is not None
+    assert set(joggled.fraction_vertices()) == set(slow.fraction_vertices())
