@@ -153,7 +153,8 @@ def scale_runs(quick: bool, shape: str = "box") -> list[dict]:
     """Each SCALE_RUNS case timed after its answer is checked (:func:`check_monitors` on
     CHECK_N agents in the same family); met if >= 2 steps/s with every monitor on and
     the states stayed in the benign hull. ``shape`` "sphere": initial states on a
-    circle / sphere, all of them hull vertices. The 1-minute load average is recorded."""
+    circle / sphere, all of them hull vertices. Also timed with no monitor (csv
+    ``bare_s``: what the monitors add) and the 1-minute load average recorded."""
     import os
 
     rows = []
@@ -163,13 +164,14 @@ def scale_runs(quick: bool, shape: str = "box") -> list[dict]:
         sc = case(N, d, 1, steps, shape=shape)
         load = os.getloadavg()[0]
         sec, tr = timed(lambda sc=sc: simulate(sc))
+        bare, _ = timed(lambda sc=sc: simulate(sc, metrics=()))
         ok = float(tr.metrics["validity"].max()) == 0.0
         name = "scale" if shape == "box" else f"all-vertex ({'circle' if d == 2 else 'sphere'})"
         rows.append({"case": f"{name}: N={N}, d={d}, F=1, every monitor", "steps": steps,
                      "engine_s": sec, "engine_steps_per_s": steps / sec,
                      "naive_steps_per_s": None, "ratio": None,
                      "target": ">= 2 steps/s", "met": ok and steps / sec >= 2,
-                     "load1": load})
+                     "load1": load, "bare_s": bare})
     return rows
 
 
@@ -267,7 +269,10 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
          "(every state a hull vertex), the same runs; the hull in R³ from Qhull's "
          "triangulated boundary certified exactly, the plane's diameter about an exact "
          "rotating-calipers pair; checked first against the safe kernel of every state "
-         "(N = 300 circle, N = 150 sphere). 1-minute load average of the shared 2-core "
+         "(N = 300 circle, N = 150 sphere). Scale and all-vertex runs with no monitor "
+         "(csv `bare_s`): "
+         + ", ".join(f"{r['bare_s']:.2f} s" for r in rows if "bare_s" in r)
+         + ". 1-minute load average of the shared 2-core "
          "machine at each start (csv `load1`): "
          + ", ".join(f"{r['load1']:.1f}" for r in rows if "load1" in r) + ".")],
         rows, out)

@@ -5,7 +5,8 @@
 * δ-validity: dist(x_i(t), conv{x_j(0) : j ∈ B}) for every benign i (validity: it stays
   ≤ δ). The hull is computed exactly once: Qhull proposes its vertices V, the exact
   polytope conv V (the safe kernel of V with F = 0) is built and every initial state is
-  proven in it (:func:`certified_hull`; in the plane an exact monotone chain); a state
+  proven in it (:func:`certified_hull`; in the plane an exact monotone chain, in R³
+  Qhull's triangulated boundary certified exactly); a state
   inside it (decided exactly) is at distance 0, one outside gets a certified float
   distance or the exact projection.
 
@@ -727,10 +728,9 @@ def _cone_guesses(tree, corners: np.ndarray, mate: np.ndarray, o: np.ndarray,
 
 def _cone_filter(hull) -> tuple | None:
     """(corners, o, mate, e, tree) for :meth:`ValidityMonitor._in_cones`: the certified
-    triangles, their mates and the point o of a hull from :func:`_exact_polytope`
-    scaled by 2^-e
-    (max |corner| ∈ [1/2, 1)), and their :func:`_cone_tree`; None for other hulls or
-    when the scaling rounds a corner or o."""
+    triangles of a hull from :func:`_exact_polytope` and its point o, scaled by 2^-e
+    (max |entry| ∈ [1/2, 1)), the triangles' mates and their :func:`_cone_tree`; None
+    for other hulls or when the scaling rounds a corner or o."""
     if "cones" not in hull._cache:
         return None
     corners, o, mate = hull._cache["cones"]
