@@ -189,13 +189,12 @@ def main() -> None:
     ap.add_argument("--out", default="benchmarks/results")
     args = ap.parse_args()
     t0 = time.perf_counter()
-    rows = []
-    for spec in args.instances:
-        rows.append(bench(spec, args.repeats))
-        print(rows[-1], flush=True)
     argv = "python -m benchmarks.robustness_dask_bench " + " ".join(
         ["--instances", *args.instances, "--repeats", str(args.repeats)])
-    _write(rows, Path(args.out), argv, time.perf_counter() - t0)
+    rows = []
+    for spec in args.instances:  # the files are rewritten after each instance
+        rows.append(bench(spec, args.repeats))
+        _write(rows, Path(args.out), argv, time.perf_counter() - t0)
 
 
 if __name__ == "__main__":

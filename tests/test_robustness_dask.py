@@ -10,6 +10,7 @@ import socket
 import sys
 
 import networkx as nx
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -22,7 +23,13 @@ from rescon.graphs import bounds as bd
 from rescon.graphs import distributed, search
 from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
-from rescon.graphs.search import PartRun, decide_r_robust, split_part, whole_part
+from rescon.graphs.search import (
+    PartRun,
+    SearchPart,
+    decide_r_robust,
+    split_part,
+    whole_part,
+)
 from tests.test_robustness_exact import digraphs
 
 
@@ -170,6 +177,20 @@ def test_a_time_limit_stops_the_split_search(cluster):
         out = decide_r_robust(ig, 15, deadline=t0 + 1.5)  # ~100 s of work
     assert out.status == "stopped" and 0 < out.progress < 1
     assert time.perf_counter() - t0 < 6
+
+
+def test_a_failed_task_is_a_one_line_solver_error(cluster):
+    """A task that raises on its worker (here: a pending frame of the wrong width)."""
+    from rescon.errors import SolverError
+
+    ig = index_graph(nx.gnp_random_graph(22, 0.7, seed=0, directed=True))
+    run = PartRun(_inputs(ig), 8, whole_part(ig.n), 0)
+    assert run.advance(100) == K.RUNNING
+    run.rest = lambda: SearchPart(np.zeros((1, K.STACK_WIDTH - 1), dtype=np.uint64),
+                                  np.zeros(1, dtype=np.int64), ig.n, ig.n)
+    with distributed.searches_on(scheduler=cluster), pytest.raises(SolverError) as info:
+        distributed.finish_on_cluster(distributed.active(), run)
+    assert "failed on the Dask cluster" in str(info.value) and "\n" not in str(info.value)
 
 
 def test_a_search_that_ends_locally_starts_no_cluster():

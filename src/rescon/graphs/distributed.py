@@ -53,7 +53,7 @@ import networkx as nx
 import numpy as np
 
 from .. import _dask
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from .search import (
     MAX_SEARCH_NODES,
     MAX_TREE_TOKENS,
@@ -207,6 +207,16 @@ class _Tree:
         return tuple(out)
 
 
+def _result(fut: Any) -> PartResult:
+    """A task's result; its failure (a worker died, a lost connection) in one line."""
+    try:
+        return fut.result()
+    except Exception as exc:  # noqa: BLE001 (whatever the cluster raised)
+        first = str(exc).splitlines()[0] if str(exc) else ""
+        raise SolverError(f"a search task failed on the Dask cluster "
+                          f"({type(exc).__name__}: {first})") from exc
+
+
 def finish_on_cluster(
     cluster: _Cluster,
     run: PartRun,
@@ -249,7 +259,7 @@ def finish_on_cluster(
                 done = set()
             for fut in done:
                 pid = running.pop(fut)
-                res = fut.result()
+                res = _result(fut)
                 nodes += res.nodes
                 progress += res.progress
                 if res.status == K.SAT:
