@@ -47,6 +47,42 @@ __all__ = ["SafeKernel", "kernel_point", "kernel_points", "safe_kernel"]
 FAST_PATH_MIN_HALFSPACES = 60
 
 
+class _Deferred:
+    """A value built on its first use, then kept: a kernel's exact vertices (a reduced
+    Fraction — a gcd of 500-1300-bit integers in d = 4-5 — per coordinate, which most
+    callers never read; the floats, the order and the facets come without them)."""
+
+    def __init__(self, make: Callable[[], Any]) -> None:
+        self._make: Callable[[], Any] | None = make
+        self._value: Any = None
+
+    def get(self) -> Any:
+        if self._make is not None:
+            self._value, self._make = self._make(), None
+        return self._value
+
+
+class _Lazy:
+    """Makes a dataclass field accept a _Deferred, built on the field's first read and
+    stored in its place (any other value is stored as given). Installed on the class
+    after @dataclass, so the field keeps its declaration (repr, eq, order); frozen
+    dataclasses set fields through object.__setattr__, which calls __set__."""
+
+    def __init__(self, name: str) -> None:
+        self.slot = f"_{name}_value"
+
+    def __get__(self, obj: Any, objtype: Any = None) -> Any:
+        if obj is None:
+            raise AttributeError(self.slot)
+        value = obj.__dict__[self.slot]
+        if isinstance(value, _Deferred):
+            value = obj.__dict__[self.slot] = value.get()
+        return value
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__[self.slot] = value
+
+
 @dataclass(frozen=True)
 class _Exact:
     """The exact data behind a SafeKernel (ambient coordinates, Fractions)."""
@@ -123,6 +159,8 @@ class SafeKernel:
     def __getstate__(self) -> dict[str, Any]:
         """Pickled with its certificate built (the builder is a closure): a kernel
         computed on a Dask worker travels whole."""
+        self._exact.vertices  # noqa: B018 -- built now: the builders are closures
+        self.exact_vertices  # noqa: B018
         return {**self.__dict__, "_make_certificate": _Given(self.certificate)}
 
     @property
@@ -165,6 +203,10 @@ class SafeKernel:
         if isinstance(ax, (str, PathLike)):
             ax, path = None, ax
         return plot_kernel(self, ax=ax, point=point, path=path, view=view)
+
+
+_Exact.vertices = _Lazy("vertices")  # type: ignore[assignment]
+SafeKernel.exact_vertices = _Lazy("exact_vertices")  # type: ignore[assignment]
 
 
 def _ambient(hull: AffineHull, d: int, a: tuple[int, ...], b: int, scale: int
@@ -272,10 +314,11 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
     eqs = tuple(hull.equalities(P))
     if hull.dim == 0:
         poly = None
-        verts = (P.fraction(0),)
+        point = P.fraction(0)
+        verts = _Deferred(lambda: (point,))
         order: list[int] = []
         constraints: tuple = ()
-        V = np.array([[float(v) for v in verts[0]]])
+        V = np.array([[float(v) for v in point]])
     else:
         poly = _clip(P, hull, F)
         verts, order, V = _lifted_vertices(poly, hull, P)
@@ -283,25 +326,29 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
                    for h in sorted(incidence)}
         constraints = tuple(ambient.values())
-    if not verts:
-        exact = _Exact(verts, constraints, eqs)
+    if not len(V):
+        exact = _Exact((), constraints, eqs)
         return SafeKernel(Xa, F, -1, np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), None,
                           np.zeros((0, d)), np.zeros((0, d)), np.zeros(0),
                           time.perf_counter() - t0, (), exact,
                           lambda: _empty_certificate(Xa, F, hull, poly, P.scale, d))
-    full = poly is not None and hull.dim == d and poly.dim() == d
-    dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts, d, full)
+    if poly is not None and hull.dim == d and poly.dim() == d:  # no exact vertex needed
+        dim, origin, basis, Aeq, beq, kernel_eqs = _full_affine(V[0].copy(), d)
+    else:
+        dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts.get(), d, False)
     facets = _relative_facets(poly, incidence, ambient, dim) if poly is not None else []
     if poly is not None:
         constraints = _needed_rows(poly, incidence, ambient, facets)
-    A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts[0]), d)
+    A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts.get()[0]) if kernel_eqs
+                      else facets, d)
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
 
     def certificate() -> dict[str, Any]:
         return {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(),
-                "F": F, "dim": dim, "vertices": [[fraction_str(v) for v in x] for x in verts],
+                "F": F, "dim": dim,
+                "vertices": [[fraction_str(v) for v in x] for x in verts.get()],
                 "equalities": halfspaces_json(eqs), "facets": halfspaces_json(constraints),
-                "adjacency": _adjacency(poly, order, verts, constraints),
+                "adjacency": _adjacency(poly, order, verts.get(), constraints),
                 "proof": {"method": "halfspaces"}}
 
     return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq,
@@ -309,13 +356,14 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
 
 
 def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
-                     ) -> tuple[tuple[tuple[Fraction, ...], ...], list[int], np.ndarray]:
+                     ) -> tuple[_Deferred, list[int], np.ndarray]:
     """The vertices of Ψ in the original coordinates, exactly (from the homogeneous
     scaled-integer vertices (w, y) of the clipped polytope: x = y / (w · scale)), in
     lexicographic order — independent of how the polytope was built and of a scaling
     of X by 2^j, as is then everything computed from them in floats (origin, basis,
-    the guides' frame). Also ``order``: the polytope's index of each vertex returned,
-    and the vertices' correctly rounded floats (in that order)."""
+    the guides' frame) — built when first read. Also ``order``: the polytope's index
+    of each vertex returned, and the vertices' correctly rounded floats (in that
+    order)."""
     if hull.dim == len(P.ints[0]):  # the pivot coordinates are all of x
         def exact(i: int) -> tuple[Fraction, ...]:
             w, *ys = poly.verts[i]
@@ -323,13 +371,13 @@ def _lifted_vertices(poly: ExactPolytope, hull: AffineHull, P: ExactPoints
 
         V = _scaled_floats(poly, P.scale)
         order = _lex_order(V, exact)
-        return tuple(map(exact, order)), order, V[order]
+        return _Deferred(lambda: tuple(map(exact, order))), order, V[order]
     pts = [hull.lift(P, tuple(Fraction(v, P.scale) for v in y))
            for y in poly.fraction_vertices()]
     order = sorted(range(len(pts)), key=lambda i: _lex_key(pts[i]))
     verts = tuple(pts[i] for i in order)
-    return verts, order, np.array([[float(v) for v in x] for x in verts]).reshape(
-        len(verts), -1)
+    return _Deferred(lambda: verts), order, np.array(
+        [[float(v) for v in x] for x in verts]).reshape(len(verts), len(P.ints[0]))
 
 
 def _scaled_floats(poly: ExactPolytope, scale: int) -> np.ndarray:
@@ -424,13 +472,17 @@ def _direction_floats(rows, tops=None) -> np.ndarray:
                     dtype=np.float64).reshape(len(rows), -1)
 
 
+def _full_affine(origin: np.ndarray, d: int):
+    """:func:`_affine_of` for d-dimensional vertices whose first is ``origin``."""
+    return d, origin, np.eye(d), np.zeros((0, d)), np.zeros(0), ()
+
+
 def _affine_of(verts, d: int, full: bool):
     """dim, origin, orthonormal basis and equalities (floats, and exact) of
     aff(vertices); ``full``: already known to be d-dimensional."""
     v0 = verts[0]
     if full:
-        origin = np.array([float(v) for v in v0])
-        return d, origin, np.eye(d), np.zeros((0, d)), np.zeros(0), ()
+        return _full_affine(np.array([float(v) for v in v0]), d)
     diffs = [[vi - v0i for vi, v0i in zip(v, v0, strict=True)] for v in verts[1:]]
     ns = nullspace_exact(diffs) if diffs else [
         [Fraction(int(i == j)) for i in range(d)] for j in range(d)]
