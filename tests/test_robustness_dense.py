@@ -127,3 +127,133 @@ def test_a_stopped_deepening_keeps_the_bound_its_finished_rounds_proved(monkeypa
     ss = rb._cost_search_result(ig, 3, out, 1, 6, {"method": "degree"}, None)
     assert ss.value is None and (ss.lower, ss.upper) == (2, 6)
     assert ss.proof["method"] == "cost_search"
+
+
+# --------------------------------------------------------------------------- #
+# the two-sided search with fixed set sizes (min_cost_sized_step)
+# --------------------------------------------------------------------------- #
+
+
+def _sized_search(ig, r, upper, roots=None):
+    """Run the sized kernel alone to the end: (best, S1 mask, S2 mask)."""
+    from rescon.graphs import _kernels as K
+    from rescon.graphs import search as se
+
+    _, inmask, _, order = se._kernel_inputs(ig)
+    mmask, mout = K.non_in_masks(inmask)
+    run = se._CostRun(K, ig.n, (0, ig.n) if roots is None else (roots.start, roots.stop), upper)
+    while run.state[K.CS_STATUS] == K.RUNNING:
+        K.min_cost_sized_step(inmask, mmask, mout, order, r, 0, run.stack, run.depth,
+                              run.state, run.ubuf, 10_000, run.progress)
+    return int(run.state[K.CS_BEST]), int(run.ubuf[K.CB_W1]), int(run.ubuf[K.CB_W2])
+
+
+@st.composite
+def dense_digraphs(draw, max_n: int = 14):
+    """Digraphs of density 0.7-0.95 (and a few sparser), n ≤ max_n."""
+    n = draw(st.integers(2, max_n))
+    p = draw(st.sampled_from([0.3, 0.5, 0.7, 0.8, 0.9, 0.95]))
+    return nx.gnp_random_graph(n, p, directed=True, seed=draw(st.integers(0, 10**6)))
+
+
+def _pair_of(mask1, mask2, n):
+    return bd.Pair(frozenset(i for i in range(n) if mask1 >> i & 1),
+                   frozenset(i for i in range(n) if mask2 >> i & 1))
+
+
+@settings(max_examples=120, deadline=None)
+@given(dense_digraphs())
+def test_sized_search_alone_matches_the_dp(G):
+    """The sized kernel on its own (not raced) gives the DP's s*(r) for every r, and
+    its pair costs what it claims."""
+    from rescon.graphs._kernels import min_pair_cost
+
+    ig = index_graph(G)
+    inmask = np.array(ig.in_masks(), dtype=np.uint64)
+    for r in range(1, (ig.n + 1) // 2 + 2):
+        best, w1, w2 = _sized_search(ig, r, ig.n)
+        assert best == int(min_pair_cost(inmask, r)[0])
+        if best < ig.n:
+            assert bd.pair_cost(ig, _pair_of(w1, w2, ig.n), r) == best
+
+
+@settings(max_examples=60, deadline=None)
+@given(dense_digraphs(max_n=10), st.data())
+def test_sized_search_root_parts_compose(G, data):
+    ig = index_graph(G)
+    cut = data.draw(st.integers(0, ig.n))
+    for r in range(1, (ig.n + 1) // 2 + 1):
+        parts = [_sized_search(ig, r, ig.n, roots=p)[0]
+                 for p in (range(0, cut), range(cut, ig.n))]
+        assert min(parts) == leblanc_max_s(G, r)
+
+
+def _completions(n, L1, L2, L0, s1, s2):
+    """Every (S1, S2) with L1 ⊆ S1, L2 ⊆ S2, L0 ∩ (S1 ∪ S2) = ∅, |S_k| = s_k."""
+    free = [i for i in range(n) if not (L1 | L2 | L0) >> i & 1]
+    for labels in itertools.product((0, 1, 2), repeat=len(free)):
+        S1 = L1 | sum(1 << u for u, t in zip(free, labels) if t == 1)
+        S2 = L2 | sum(1 << u for u, t in zip(free, labels) if t == 2)
+        if S1.bit_count() == s1 and S2.bit_count() == s2:
+            yield S1, S2
+
+
+@settings(max_examples=150, deadline=None)
+@given(dense_digraphs(max_n=8), st.data())
+def test_sized_lower_bound_never_exceeds_a_completion(G, data):
+    """The bound of a partial labelling is at most the cost of every completion whose
+    sets both keep a closed member (and n + 1 only when there is none); exact when
+    nothing is left unlabelled."""
+    from rescon.graphs._kernels import non_in_masks, sized_lower_bound
+
+    ig = index_graph(G)
+    n = ig.n
+    inmask = np.array(ig.in_masks(), dtype=np.uint64)
+    mmask, _ = non_in_masks(inmask)
+    labels = data.draw(st.lists(st.integers(0, 3), min_size=n, max_size=n))  # 3: unlabelled
+    L1, L2, L0 = (sum(1 << i for i in range(n) if labels[i] == t) for t in (1, 2, 0))
+    s1 = data.draw(st.integers(1, n))
+    s2 = data.draw(st.integers(1, n))
+    r = data.draw(st.integers(1, 4))
+    bound = sized_lower_bound(np.uint64(L1), np.uint64(L2), np.uint64(L0), s1, s2,
+                              inmask, mmask, r, n)
+    costs = []
+    for S1, S2 in _completions(n, L1, L2, L0, s1, s2):
+        cost = bd.pair_cost(ig, _pair_of(S1, S2, n), r)
+        if cost is not None:
+            costs.append(cost)
+    assert bound <= min(costs, default=n + 1)
+    if labels.count(3) == 0 and costs:
+        assert bound == costs[0]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_sized_search_agrees_with_the_dp_on_dense_n22(seed):
+    """ER(22, 0.85): the sized search alone and the subset DP give the same s*(ρ)."""
+    G = nx.gnp_random_graph(22, 0.85, directed=True, seed=seed)
+    import rescon
+
+    ig = index_graph(G)
+    r = rescon.robustness(G, method="dp").r_max
+    dp, _ = _dp_min_cost(ig, r)
+    assert _sized_search(ig, r, ig.n)[0] == dp
+
+
+@pytest.mark.slow
+def test_dense_er30_s_star_is_exact_within_seconds():
+    """ER(30, 0.8), seed 30000 (BENCHMARKS §1), ρ = 12: the charged-set search alone left
+    2 ≤ s* ≤ 6 after 60 s; with the sized search s*(12) = 5, exact, in seconds, and
+    its pair costs 5."""
+    import time
+
+    import rescon
+
+    G = nx.gnp_random_graph(30, 0.8, directed=True, seed=30000)
+    t0 = time.perf_counter()
+    rep = rescon.robustness(G, time_limit=60)
+    assert rep.exact and (rep.r_max, rep.s_max) == (12, 5)
+    assert time.perf_counter() - t0 < 30
+    ig = index_graph(G)
+    assert list(ig.nodes) == list(range(30))  # labels are the indices
+    assert bd.pair_cost(ig, bd.Pair(*rep.s_witness), 12) == 5

@@ -429,7 +429,9 @@ CK_S, CK_X, CK_C, CK_M = 0, 1, 2, 3
 COST_STACK_WIDTH = 4
 # indices into the int64 state of the cost search
 CS_SP, CS_ROOT, CS_STATUS, CS_NODES, CS_BEST, CS_END = 0, 1, 2, 3, 4, 5
-COST_STATE_LEN = 6
+# the sized search's current size combination (|S1|, |S2|); 0: no root started yet
+CS_S1, CS_S2 = 6, 7
+COST_STATE_LEN = 8
 # uint64 buffer: current B, best S1, best S2
 CB_B, CB_W1, CB_W2 = 0, 1, 2
 
@@ -588,4 +590,222 @@ def min_cost_step(
         progress[0] += 0.5 ** depth / n
     state[CS_SP] = sp
     state[CS_ROOT] = root
+    state[CS_NODES] += done
+
+
+@njit(cache=True, nogil=True)
+def non_in_masks(inmask: np.ndarray):
+    """(mmask, mout): mmask[i] = M(i) = V \\ N(i) \\ {i}, the nodes that do not send
+    to i; mout[u] = {i : u ∈ M(i)}."""
+    n = inmask.shape[0]
+    full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
+    mmask = np.zeros(n, dtype=np.uint64)
+    mout = np.zeros(n, dtype=np.uint64)
+    for i in range(n):
+        mmask[i] = full & ~inmask[i] & ~(U1 << np.uint64(i))
+        m = mmask[i]
+        while m:
+            u = low_index(m)
+            m &= ~(U1 << np.uint64(u))
+            mout[u] |= U1 << np.uint64(i)
+    return mmask, mout
+
+
+@njit(cache=True, nogil=True, inline="always")
+def inside_cap(i: int, L: np.uint64, room: np.uint64, size: int, inmask: np.ndarray,
+               mmask: np.ndarray) -> np.int64:
+    """Upper bound on |N(i) ∩ S| for a set S with L ⊆ S ⊆ L ∪ room, |S| = size, i ∈ S:
+    S's in-neighbours of i lie in L ∪ room, and S \\ {i} has size − 1 nodes of which
+    those of M(i) ∩ L do not send to i."""
+    return min(popcount(inmask[i] & (L | room) & ~(U1 << np.uint64(i))),
+               size - 1 - popcount(mmask[i] & L))
+
+
+@njit(cache=True, nogil=True)
+def sized_lower_bound(L1: np.uint64, L2: np.uint64, L0: np.uint64, s1: int, s2: int,
+                      inmask: np.ndarray, mmask: np.ndarray, r: int, n: int) -> np.int64:
+    """Lower bound on |reach_r(S1)| + |reach_r(S2)| over the completions of a partial
+    labelling — L1 ⊆ S1, L2 ⊆ S2, L0 ⊆ R = V \\ (S1 ∪ S2), the rest A unlabelled —
+    with |S1| = s1, |S2| = s2 and both sets keeping an r-closed member; n + 1 when
+    there is no completion. Exact (the completion's cost) when A = ∅.
+
+    A member i of S_k is uncharged iff |N(i) ∩ S_k| ≥ d_i − r + 1 (fewer than r
+    in-neighbours outside). ``inside_cap`` bounds |N(i) ∩ S_k| from above, so a labelled
+    member whose cap is below d_i − r + 1 is charged in every completion. An
+    unlabelled node u can be uncharged in S_k only when its cap (with u ∈ S_k) reaches
+    d_u − r + 1 and S_k has room left. The unlabelled nodes fill the rooms c1, c2, c0
+    (c1 + c2 + c0 = |A|) exactly; a node placed in S_k where it cannot be uncharged
+    costs 1, in R nothing. The most nodes placed free is a bipartite b-matching of
+    nodes to rooms whose size, by max-flow = min-cut, is
+    min over room sets T of Σ_{b∈T} c_b + #{u : allowed(u) ⊄ T}; every allowed set
+    holds R, so only T ∋ R matter. Charged labelled members plus the |A| − matching
+    unlabelled ones that must be charged bound the cost. Each S_k needs a member that
+    may stay uncharged (labelled or placeable), else there is no completion.
+    """
+    A = ~(L1 | L2 | L0) & ((U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO)
+    c1 = s1 - popcount(L1)
+    c2 = s2 - popcount(L2)
+    c0 = n - s1 - s2 - popcount(L0)
+    if c1 < 0 or c2 < 0 or c0 < 0:
+        return n + 1
+    charged = 0
+    open1 = False
+    open2 = False
+    m = L1 | L2
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        if L1 & (U1 << np.uint64(i)):
+            free = inside_cap(i, L1, A, s1, inmask, mmask) >= popcount(inmask[i]) - r + 1
+            open1 |= free
+        else:
+            free = inside_cap(i, L2, A, s2, inmask, mmask) >= popcount(inmask[i]) - r + 1
+            open2 |= free
+        if not free:
+            charged += 1
+    only1 = 0
+    only2 = 0
+    both = 0
+    m = A
+    while m:
+        u = low_index(m)
+        bu = U1 << np.uint64(u)
+        m &= ~bu
+        need = popcount(inmask[u]) - r + 1
+        h1 = c1 > 0 and inside_cap(u, L1 | bu, A, s1, inmask, mmask) >= need
+        h2 = c2 > 0 and inside_cap(u, L2 | bu, A, s2, inmask, mmask) >= need
+        open1 |= h1
+        open2 |= h2
+        if h1 and h2:
+            both += 1
+        elif h1:
+            only1 += 1
+        elif h2:
+            only2 += 1
+    if not (open1 and open2):
+        return n + 1
+    na = popcount(A)
+    matched = min(na, c0 + only1 + only2 + both, c0 + c1 + only2 + both,
+                  c0 + c2 + only1 + both)
+    return charged + na - matched
+
+
+@njit(cache=True, nogil=True)
+def sized_branch_node(A: np.uint64, L1: np.uint64, L2: np.uint64, mmask: np.ndarray,
+                      mout: np.ndarray) -> np.int64:
+    """The unlabelled node with the most non-arcs to or from the labelled members of
+    S1 ∪ S2 (its label moves their caps soonest); ties: lowest index."""
+    u = -1
+    best = -1
+    L = L1 | L2
+    m = A
+    while m:
+        j = low_index(m)
+        m &= ~(U1 << np.uint64(j))
+        v = popcount(mout[j] & L) + popcount(mmask[j] & L)
+        if v > best:
+            best = v
+            u = j
+    return u
+
+
+@njit(cache=True, nogil=True)
+def next_sizes(state: np.ndarray, order: np.ndarray, n: int, ubuf: np.ndarray) -> bool:
+    """Advance state to the next size combination (s1, s2) — s1, s2 ≥ 1,
+    s1 + s2 ≤ n − |B| — of the current root, else of the next root (whose B goes to
+    ubuf[CB_B]); False when the roots are exhausted."""
+    while True:
+        s1 = state[CS_S1]
+        s2 = state[CS_S2] + 1
+        room = n - state[CS_ROOT] + 1  # nodes outside B = order[:root]
+        if s1 > 0 and s1 + s2 > room:
+            s1 += 1
+            s2 = 1
+        if s1 > 0 and s1 + s2 <= room:
+            state[CS_S1] = s1
+            state[CS_S2] = s2
+            return True
+        if state[CS_ROOT] >= state[CS_END]:
+            return False
+        ubuf[CB_B] = prefix_mask(order, state[CS_ROOT])
+        state[CS_ROOT] += 1
+        state[CS_S1] = 1
+        state[CS_S2] = 0
+
+
+@njit(cache=True, nogil=True)
+def min_cost_sized_step(
+    inmask: np.ndarray,
+    mmask: np.ndarray,
+    mout: np.ndarray,
+    order: np.ndarray,
+    r: int,
+    lower: int,
+    stack: np.ndarray,
+    stack_depth: np.ndarray,
+    state: np.ndarray,
+    ubuf: np.ndarray,
+    max_nodes: int,
+    progress: np.ndarray,
+) -> None:
+    """Advance the two-sided branch and bound for s*(r) with both set sizes fixed
+    (the same problem, state layout and roots as :func:`min_cost_step`, whose
+    incumbent state[CS_BEST] it shares).
+
+    Root k puts order[k] in S1 and B = order[:k] in R (order[k] is the first node of
+    S1 ∪ S2); then every size combination |S1| = s1, |S2| = s2 with
+    s1 + s2 ≤ n − k is searched in turn. A state labels nodes S1 / S2 / R (rows
+    L1, L2, L0 of ``stack``). Knowing the sizes, a member's inside in-neighbours are
+    capped by its non-in-neighbours in its set (``inside_cap``), so on dense graphs,
+    whose non-arcs are few, a label decides its neighbours' charges long before the
+    sets are complete. A state whose ``sized_lower_bound`` reaches the incumbent is
+    pruned; else the node of ``sized_branch_node`` is labelled S1, S2 or R (three
+    children). A state without unlabelled nodes is a pair whose exact cost the bound
+    gives; a cheaper one becomes the incumbent.
+    """
+    n = inmask.shape[0]
+    sp = state[CS_SP]
+    done = 0
+    while done < max_nodes:
+        if sp == 0:
+            if state[CS_BEST] <= lower or not next_sizes(state, order, n, ubuf):
+                state[CS_STATUS] = UNSAT
+                break
+            stack[0, 0] = U1 << np.uint64(order[state[CS_ROOT] - 1])
+            stack[0, 1] = ZERO
+            stack[0, 2] = ubuf[CB_B]
+            stack_depth[0] = 0
+            sp = 1
+        sp -= 1
+        L1 = stack[sp, 0]
+        L2 = stack[sp, 1]
+        L0 = stack[sp, 2]
+        depth = stack_depth[sp]
+        done += 1
+        s1 = state[CS_S1]
+        s2 = state[CS_S2]
+        bound = sized_lower_bound(L1, L2, L0, s1, s2, inmask, mmask, r, n)
+        A = ~(L1 | L2 | L0) & ((U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO)
+        if bound < state[CS_BEST] and A == ZERO:
+            state[CS_BEST] = bound
+            ubuf[CB_W1] = L1
+            ubuf[CB_W2] = L2
+        if bound >= state[CS_BEST] or A == ZERO:
+            room = n - state[CS_ROOT] + 1
+            progress[0] += 3.0 ** -depth / (n * (room * (room - 1) // 2))
+            continue
+        bu = U1 << np.uint64(sized_branch_node(A, L1, L2, mmask, mout))
+        stack[sp, 0] = L1
+        stack[sp, 1] = L2
+        stack[sp, 2] = L0 | bu
+        stack[sp + 1, 0] = L1
+        stack[sp + 1, 1] = L2 | bu
+        stack[sp + 1, 2] = L0
+        stack[sp + 2, 0] = L1 | bu
+        stack[sp + 2, 1] = L2
+        stack[sp + 2, 2] = L0
+        for k in range(3):
+            stack_depth[sp + k] = depth + 1
+        sp += 3
+    state[CS_SP] = sp
     state[CS_NODES] += done

@@ -9,8 +9,9 @@ r-robust).
 Strategy: polynomial bounds first (witness pairs above; degree, complete and
 construction proofs below); only when they do not meet, an exact method: the
 bitmask branch and bound (n ≤ 64, its search tree is the certificate) raced against
-the improved MILP for ρ; for s*, the subset DP (n ≤ 22), else the charged-set branch
-and bound raced against the MILP (n ≤ 64), else the MILP.
+the improved MILP for ρ; for s*, the subset DP (n ≤ 22), else the two s* branch and
+bounds of search.min_cost_pair (charged-set, sized) raced against the MILP (n ≤ 64),
+else the MILP.
 
 Before any search, every fact already proven about the same graph in this process
 (facts.py: a bounded cache keyed by node labels and edges) is used through the
@@ -513,7 +514,7 @@ def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper
 
 def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, upper: int,
                         proof: Proof, pair: bd.Pair | None) -> _SStar:
-    """s*(r) from the charged-set branch and bound (see search.min_cost_pair)."""
+    """s*(r) from the s* branch and bounds (see search.min_cost_pair)."""
     if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
@@ -536,7 +537,7 @@ DEEPEN_CHEAP_SECONDS = 0.1
 def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
                       deadline: float | None, *, should_stop: Callable[[], bool] | None = None,
                       on_progress: Callable[[float, int], None] | None = None) -> CostOutcome:
-    """The charged-set branch and bound below growing caps (at most ``upper``): a search
+    """The s* branch and bounds below growing caps (at most ``upper``): a search
     below a small cap prunes hard, and one that finds no pair proves s*(r) ≥ cap, so the
     search below a weak heuristic ``upper`` runs only when nothing cheaper exists. The
     step from lower to cap doubles while rounds are cheap (< ``DEEPEN_CHEAP_SECONDS``)
@@ -611,7 +612,7 @@ def robustness(
     ----------
     G : networkx.Graph or DiGraph; edge (u, v) means v receives u's state.
     method : "auto" (bounds, then the search raced against the MILP for n ≤ 64, the
-        MILP beyond; s* by the DP for n ≤ 22, else the charged-set search raced
+        MILP beyond; s* by the DP for n ≤ 22, else the s* searches raced
         against the MILP), or force "search" (n ≤ 64), "milp" or "dp" (n ≤ 26).
     time_limit : seconds; when reached, returns proven bounds with ``exact=False``.
     undirected : treat the edges of a DiGraph as undirected.

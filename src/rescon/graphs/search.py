@@ -278,6 +278,21 @@ class CostOutcome:
     floor: int = 0
 
 
+class _CostRun:
+    """The arrays one resumable s* kernel advances (stack, depths, state, witness
+    buffer, refuted share) and the wall time it has used so far."""
+
+    def __init__(self, K, n: int, roots: tuple[int, int], upper: int) -> None:
+        self.stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
+        self.depth = np.zeros(3 * n + 3, dtype=np.int64)
+        self.state = np.zeros(K.COST_STATE_LEN, dtype=np.int64)
+        self.state[K.CS_ROOT], self.state[K.CS_END] = roots
+        self.state[K.CS_BEST] = upper
+        self.ubuf = np.zeros(3, dtype=np.uint64)
+        self.progress = np.zeros(1, dtype=np.float64)
+        self.seconds = 0.0
+
+
 def min_cost_pair(
     ig: IndexedGraph,
     r: int,
@@ -293,35 +308,48 @@ def min_cost_pair(
     r-closed member, searched below ``upper`` (a known pair's cost, or n); the search
     ends early when it finds a pair of cost ``lower`` (a proven lower bound).
 
-    Exact branch and bound over S1 with charged members (see
-    ``_kernels.min_cost_step``); n ≤ 64. ``on_progress`` and ``roots`` as in
+    Two exact branch and bounds share the incumbent and take turns, each in slices
+    while it has used no more wall time than the other; the first to finish answers:
+    over S1 with charged members (``_kernels.min_cost_step``: sparse graphs, small
+    sets) and two-sided with both sizes fixed (``_kernels.min_cost_sized_step``:
+    dense graphs, near-bisections). n ≤ 64. ``on_progress`` and ``roots`` as in
     :func:`decide_r_robust` (a part's ``best`` bounds only the pairs whose first node
     lies in its roots; s*(r) is the least over the parts).
     """
     K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
-    stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
-    depth = np.zeros(3 * n + 3, dtype=np.int64)
-    state = np.zeros(K.COST_STATE_LEN, dtype=np.int64)
-    state[K.CS_ROOT], state[K.CS_END] = _root_range(roots, n)
-    state[K.CS_BEST] = upper
-    ubuf = np.zeros(3, dtype=np.uint64)
-    progress = np.zeros(1, dtype=np.float64)
-    status = "done"
+    mmask, mout = K.non_in_masks(inmask)
+    span = _root_range(roots, n)
+    charged, sized = _CostRun(K, n, span, upper), _CostRun(K, n, span, upper)
+
+    def advance(run: _CostRun) -> None:
+        args = (r, lower, run.stack, run.depth, run.state, run.ubuf, _SLICE, run.progress)
+        if run is sized:
+            K.min_cost_sized_step(inmask, mmask, mout, order, *args)
+        else:
+            K.min_cost_step(inmask, outmask, order, *args)
+
+    best, owner, status = upper, sized, "done"
     while True:
-        K.min_cost_step(inmask, outmask, order, r, lower, stack, depth, state, ubuf, _SLICE,
-                        progress)
+        run = min((sized, charged), key=lambda c: c.seconds)
+        run.state[K.CS_BEST] = best
+        t0 = time.perf_counter()
+        advance(run)
+        run.seconds += time.perf_counter() - t0
+        if run.state[K.CS_BEST] < best:
+            best, owner = int(run.state[K.CS_BEST]), run
         if on_progress is not None:
-            on_progress(float(progress[0]), int(state[K.CS_NODES]))
-        if state[K.CS_STATUS] != K.RUNNING:
+            on_progress(float(max(sized.progress[0], charged.progress[0])),
+                        int(sized.state[K.CS_NODES] + charged.state[K.CS_NODES]))
+        if run.state[K.CS_STATUS] != K.RUNNING:
             break
         if (deadline is not None and time.perf_counter() > deadline) or (
             should_stop is not None and should_stop()
         ):
             status = "stopped"
             break
-    best = int(state[K.CS_BEST])
     pair = None
     if best < upper:
-        pair = (_bits(ubuf[K.CB_W1]), _bits(ubuf[K.CB_W2]))
-    return CostOutcome(status, best, pair, int(state[K.CS_NODES]), tuple(order.tolist()))
+        pair = (_bits(owner.ubuf[K.CB_W1]), _bits(owner.ubuf[K.CB_W2]))
+    nodes = int(sized.state[K.CS_NODES] + charged.state[K.CS_NODES])
+    return CostOutcome(status, best, pair, nodes, tuple(order.tolist()))
