@@ -177,7 +177,8 @@ def _nolimit_run(checker: Path, cert: Path, timeout: float) -> tuple[str, float]
     """(verdict, seconds) of ``checker``'s main on ``cert`` with MAX_SEARCH_WORK lifted."""
     code = ("import importlib.util, sys; spec = importlib.util.spec_from_file_location("
             f"'old_check', {str(checker)!r}); m = importlib.util.module_from_spec(spec); "
-            "spec.loader.exec_module(m); m.MAX_SEARCH_WORK = 10 ** 15; "
+            "sys.modules['old_check'] = m; spec.loader.exec_module(m); "
+            "m.MAX_SEARCH_WORK = 10 ** 15; "
             f"sys.exit(m.main([{str(cert)!r}]))")
     t0 = time.perf_counter()
     try:
@@ -186,6 +187,8 @@ def _nolimit_run(checker: Path, cert: Path, timeout: float) -> tuple[str, float]
     except subprocess.TimeoutExpired:
         return "timeout", time.perf_counter() - t0
     verdict = {0: "valid", 1: "invalid", 3: "unchecked"}.get(res.returncode, "error")
+    if "Traceback" in res.stderr:
+        verdict = "error"
     return verdict, time.perf_counter() - t0
 
 
