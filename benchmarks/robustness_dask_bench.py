@@ -73,12 +73,26 @@ def _certificate(G: nx.DiGraph, out) -> dict:
             "r": out.r, "s": 1, "proof": proof}
 
 
-def _timed(ig, r: int, scheduler: str | None):
+def _cpu(client) -> dict[str, float]:
+    """CPU seconds so far of this process ("driver") and of every worker process."""
+    used = {"driver": time.process_time()}
+    if client is not None:
+        used.update(client.run(time.process_time))
+    return used
+
+
+def _timed(ig, r: int, cluster, client):
+    """(outcome, wall seconds, load before, CPU seconds by process) of one search, serial
+    when ``cluster`` is None."""
     load = os.getloadavg()[0]
+    cpu0 = _cpu(client)
     t0 = time.perf_counter()
-    with distributed.searches_on(scheduler=scheduler):
+    with distributed.searches_on(scheduler=None if cluster is None else
+                                 cluster.scheduler_address):
         out = decide_r_robust(ig, r)
-    return out, time.perf_counter() - t0, load
+    wall = time.perf_counter() - t0
+    cpu1 = _cpu(client)
+    return out, wall, load, {k: cpu1[k] - cpu0[k] for k in cpu0}
 
 
 def _same(a, b, label: str) -> None:
@@ -88,18 +102,18 @@ def _same(a, b, label: str) -> None:
 
 
 def _cluster(workers: int, ig):
-    """A started LocalCluster of ``workers`` processes and its start-up seconds; warmed:
-    every worker has run a part of a search on ig (numba and the kernels loaded)."""
+    """(a started LocalCluster of ``workers`` processes, a client on it, its start-up
+    seconds); warmed: every worker has run a part of a search on ig (numba and the
+    kernels loaded)."""
     from distributed import Client, LocalCluster
 
     t0 = time.perf_counter()
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            dashboard_address=None)
     started = time.perf_counter() - t0
-    masks = _kernel_inputs(ig)[1:]
-    with Client(cluster) as client:
-        client.run(distributed.run_part, masks, 1, whole_part(ig.n), 0, 1000)
-    return cluster, started
+    client = Client(cluster)
+    client.run(distributed.run_part, _kernel_inputs(ig)[1:], 1, whole_part(ig.n), 0, 1000)
+    return cluster, client, started
 
 
 def bench(spec: str, repeats: int) -> dict:
@@ -107,31 +121,44 @@ def bench(spec: str, repeats: int) -> dict:
     ig = index_graph(G)
     decide_r_robust(ig, max(r - 2, 1))  # numba kernels compiled / loaded here too
     clusters = {w: _cluster(w, ig) for w in (1, 2)}
-    runs: dict[str, list[tuple[float, float]]] = {"serial": [], "1 worker": [], "2 workers": []}
+    runs: dict[str, list[tuple[float, float, dict]]] = {"serial": [], "1 worker": [],
+                                                         "2 workers": []}
     try:
         for _ in range(repeats):
-            serial, t, load = _timed(ig, r, None)
-            runs["serial"].append((t, load))
-            for w, (cluster, _) in clusters.items():
-                split, t, load = _timed(ig, r, cluster.scheduler_address)
+            serial, t, load, cpu = _timed(ig, r, None, None)
+            runs["serial"].append((t, load, cpu))
+            for w, (cluster, client, _) in clusters.items():
+                split, t, load, cpu = _timed(ig, r, cluster, client)
                 _same(serial, split, f"{name}, r = {r}, {w} worker(s)")
-                runs[f"{w} worker{'s' if w > 1 else ''}"].append((t, load))
+                runs[f"{w} worker{'s' if w > 1 else ''}"].append((t, load, cpu))
     finally:
-        for cluster, _ in clusters.values():
+        for cluster, client, _ in clusters.values():
+            client.close()
             cluster.close()
     verdicts = {rescon.check_certificate(_certificate(G, o)).verdict for o in (serial, split)}
     if len(verdicts) != 1 or "invalid" in verdicts:
         raise AssertionError(f"{name}: certificate verdicts {verdicts}")
-    med = {k: statistics.median(t for t, _ in v) for k, v in runs.items()}
+    med = {k: statistics.median(t for t, _, _ in v) for k, v in runs.items()}
+    # CPU seconds, median over repeats: the serial search; the workers' sum (the work,
+    # overhead included) and the busiest worker (the wall time on free cores)
+    cpu_serial = statistics.median(c["driver"] for _, _, c in runs["serial"])
+    work = {k: statistics.median(sum(x for p, x in c.items() if p != "driver")
+                                 for _, _, c in runs[k]) for k in ("1 worker", "2 workers")}
+    busiest = statistics.median(max(x for p, x in c.items() if p != "driver")
+                                for _, _, c in runs["2 workers"])
+    driver = statistics.median(c["driver"] for _, _, c in runs["2 workers"])
     return {"instance": name, "n": ig.n, "r": r, "status": serial.status,
             "states": serial.nodes, "certificate": verdicts.pop(),
             "serial_s": med["serial"], "w1_s": med["1 worker"], "w2_s": med["2 workers"],
             "w2_vs_w1": med["1 worker"] / med["2 workers"],
             "w2_vs_serial": med["serial"] / med["2 workers"],
-            "start_w1_s": clusters[1][1], "start_w2_s": clusters[2][1],
-            "loads": "; ".join(f"{k}: " + ", ".join(f"{ld:.1f}" for _, ld in v)
+            "cpu_serial_s": cpu_serial, "cpu_w1_s": work["1 worker"],
+            "cpu_w2_s": work["2 workers"], "cpu_w2_busiest_s": busiest,
+            "cpu_w2_driver_s": driver, "cpu_balance": cpu_serial / busiest,
+            "start_w1_s": clusters[1][2], "start_w2_s": clusters[2][2],
+            "loads": "; ".join(f"{k}: " + ", ".join(f"{ld:.1f}" for _, ld, _ in v)
                                for k, v in runs.items()),
-            "times": "; ".join(f"{k}: " + ", ".join(f"{t:.1f}" for t, _ in v)
+            "times": "; ".join(f"{k}: " + ", ".join(f"{t:.1f}" for t, _, _ in v)
                                for k, v in runs.items())}
 
 
@@ -167,6 +194,17 @@ def _write(rows: list[dict], out: Path, argv: str, seconds: float) -> None:
                      f"{row['serial_s']:.1f} | {row['w1_s']:.1f} | {row['w2_s']:.1f} | "
                      f"{row['w2_vs_w1']:.2f}x | {row['w2_vs_serial']:.2f}x | "
                      f"{row['certificate']} |")
+    lines += ["", "CPU seconds (median over the repeats; unlike wall times, hardly moved by "
+              "the other jobs on the machine): the serial search; the workers' sum (the "
+              "work, task overhead included); with 2 workers, the busiest worker and this "
+              "process (the driver: splitting, assembling). Serial / busiest is the "
+              "speed-up the split reaches when each worker has a core of its own.", "",
+              "| instance | r | serial | 1 worker | 2 workers (sum) | busiest of 2 | driver "
+              "| serial / busiest |",
+              "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    lines += [f"| {row['instance']} | {row['r']} | {row['cpu_serial_s']:.1f} | "
+              f"{row['cpu_w1_s']:.1f} | {row['cpu_w2_s']:.1f} | {row['cpu_w2_busiest_s']:.1f} | "
+              f"{row['cpu_w2_driver_s']:.1f} | {row['cpu_balance']:.2f}x |" for row in rows]
     lines += ["", "Each run (seconds) and the 1-minute load average before it:", ""]
     for row in rows:
         lines.append(f"- {row['instance']}, r = {row['r']}: {row['times']} "
