@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 import rescon
 from rescon.geometry import fastpath
-from rescon.geometry.exact import affine_hull, exact_points, float_view
+from rescon.geometry.exact import affine_hull, cross_all, exact_points, float_view
 from rescon.geometry.halfspaces import valid_halfspaces
 from rescon.geometry.polytope import ExactPolytope, clip_to_fixpoint
 
@@ -85,7 +85,7 @@ def _brute_rays(normals, T, k):
     for sub in itertools.combinations(T, k - 1):
         R = np.empty((1, k - 1, k), dtype=object)
         R[0] = [list(normals[h]) for h in sub]
-        d = tuple(fastpath._cross_all(R)[0])
+        d = tuple(cross_all(R)[0])
         if not any(d):
             continue
         vals = [fastpath._dot(normals[h], d) for h in T]

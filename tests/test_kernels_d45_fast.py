@@ -166,3 +166,23 @@ def test_exact_vertices_are_built_once_on_first_read_and_pickle():
     assert np.array_equal(K.vertices, np.array([[float(v) for v in x] for x in V]))
     assert K.certificate["vertices"] == [[km.fraction_str(v) for v in x] for x in V]
     assert "exact_vertices" not in repr(K)
+
+
+@pytest.mark.parametrize("d,n,F", [(2, 12, 2), (3, 14, 2), (4, 14, 2), (5, 10, 1)])
+def test_exact_rows_at_once_equal_one_by_one(d, n, F):
+    """Halfspaces.exact_all (cross products of object arrays) caches the same primitive
+    rows as Halfspaces.exact (a Bareiss elimination per row), at mixed magnitudes."""
+    from rescon.geometry.exact import affine_hull, exact_points, float_view
+    from rescon.geometry.halfspaces import valid_halfspaces
+
+    rng = np.random.default_rng(d)
+    X = rng.normal(size=(n, d)) * 10.0 ** rng.integers(-3, 3, size=(n, d))
+    P = exact_points(X)
+    hull = affine_hull(P)
+    rows = [tuple(r[c] for c in hull.coords) for r in P.ints]
+    Yf, unit, exact_view = float_view(rows, P.scale)
+    one, many = (valid_halfspaces(Yf, rows, np.ones(n, dtype=np.int64), F, exact_view)
+                 for _ in range(2))
+    many.exact_all(range(len(many)))
+    assert len(one) > 10
+    assert [many._cache[h] for h in range(len(many))] == [one.exact(h) for h in range(len(one))]

@@ -9,6 +9,7 @@ when a rounding-error bound proves the float answer right.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -20,6 +21,7 @@ __all__ = [
     "ExactPoints",
     "affine_hull",
     "bareiss_rank",
+    "cross_all",
     "exact_points",
     "float_view",
     "fraction_str",
@@ -261,3 +263,25 @@ def nullspace_exact(M: list[list[Fraction]]) -> list[list[Fraction]]:
             v[pc] = -A[i][fc]
         basis.append(v)
     return basis
+
+
+def cross_all(R: np.ndarray) -> np.ndarray:
+    """The generalised cross products of the m × (m+1) integer matrices R[p] (an object
+    array (P, m, m+1) of Python ints): x_j = (−1)^j det R_{−j} (R without column j), so
+    R x = 0, and x = 0 iff the rows are dependent. All P at once, by Laplace expansion
+    along the rows — the minors of the first r rows on every r-set of columns from those
+    of the first r − 1: Σ_r r·C(m+1, r) products of arrays, exact."""
+    m = R.shape[1]
+    minors = {(c,): R[:, 0, c] for c in range(m + 1)}
+    for r in range(1, m):
+        nxt = {}
+        for cols in itertools.combinations(range(m + 1), r + 1):
+            acc = 0
+            for i, c in enumerate(cols):
+                term = R[:, r, c] * minors[cols[:i] + cols[i + 1:]]
+                acc = acc + term if (r + i) % 2 == 0 else acc - term
+            nxt[cols] = acc
+        minors = nxt
+    full = tuple(range(m + 1))
+    return np.stack([minors[full[:j] + full[j + 1:]] * (-1) ** j for j in range(m + 1)],
+                    axis=1)

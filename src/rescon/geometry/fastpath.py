@@ -32,6 +32,7 @@ from math import gcd
 import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
+from .exact import cross_all
 from .polytope import ExactPolytope
 
 __all__ = ["certified_kernel"]
@@ -165,6 +166,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     halfspace, and closure: every extreme ray of every vertex's tangent cone leads to
     another proposed vertex (see the module docstring)."""
     S_set = sorted({int(sel[i]) for f in facets for i in f})
+    H.exact_all(S_set)
     where = {h: i for i, h in enumerate(S_set)}
     Ts = [_basis_of(H, [int(sel[i]) for i in f], k) for f in facets]
     sols = _solve_all(H, Ts, k)
@@ -255,42 +257,101 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight along a ray
     have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆ tight[u], and then
     it is the other end of the edge (the line meets P_S in that edge). Found through the
-    (k − 1)-subsets of the tight sets (of at most MAX_TIGHT rows) — a ray whose Z is one
-    of them names its vertices — else among the vertices on Z's rarest row."""
-    on: dict[int, list[int]] = {}
-    for vi, t in enumerate(tight):
-        m = t.bit_count()
-        if m == k:
-            keys = [t ^ (1 << h) for h in _bits(t)]
-        elif m <= MAX_TIGHT:
-            keys = [sum(sub) for sub in itertools.combinations([1 << h for h in _bits(t)],
-                                                                k - 1)]
-        else:
-            continue
-        for key in keys:
-            on.setdefault(key, []).append(vi)
-    members: dict[int, list[int]] = {}
-    for vi, t in enumerate(tight):
-        for h in _bits(t):
-            members.setdefault(h, []).append(vi)
+    (k − 1)-subsets of the tight sets (of at most MAX_TIGHT rows; :class:`_RayIndex`) —
+    a ray whose Z is one of them names its vertices — else among the vertices on Z's
+    rarest row. The simple vertices (most of them) are matched all at once."""
+    index = _RayIndex(tight, len(normals), k)
+    if index.simple_ends is None:
+        return None
     non_simple = [vi for vi, t in enumerate(tight) if t.bit_count() > k]
-    starts = dict(zip(non_simple, _simplicial_rays(normals, [basis[vi] for vi in non_simple], k),
-                      strict=True))
-    edges = []
-    for vi, t in enumerate(tight):
-        rays = ([t ^ (1 << h) for h in _bits(t)] if vi not in starts
-                else _tangent_rays(normals, basis[vi], list(_bits(t)), k, starts[vi]))
+    starts = _simplicial_rays(normals, [basis[vi] for vi in non_simple], k)
+    edges = index.simple_ends
+    for vi, start in zip(non_simple, starts, strict=True):
         ends = set()
-        for Z in rays:
-            u = next((u for u in on.get(Z, ()) if u != vi), None)
+        for Z in _tangent_rays(normals, basis[vi], list(_bits(tight[vi])), k, start):
+            u = index.other_end(vi, Z)
             if u is None:
-                fewest = min((members[h] for h in _bits(Z)), key=len)
-                u = next((u for u in fewest if u != vi and (tight[u] & Z) == Z), None)
-                if u is None:
-                    return None
+                return None
             ends.add(u)
-        edges.append(sorted(ends))
+        edges[vi] = sorted(ends)
     return edges
+
+
+class _RayIndex:
+    """The vertices by the (k − 1)-subsets of their tight sets (of at most MAX_TIGHT
+    rows), each subset a key: its positions p₁ < … < p_{k−1} in base |S| (int64 —
+    sorted, so the vertices sharing a key are a run). ``simple_ends``: for each simple
+    vertex its neighbours, the other vertex on each of its k keys (its rays' Z), found
+    for all at once (None if some ray leads nowhere; [] for the non-simple ones)."""
+
+    def __init__(self, tight: list[int], n_rows: int, k: int) -> None:
+        self.tight, self.k = tight, k
+        self.weights = [n_rows**i for i in range(k - 1)]
+        self._members: dict[int, list[int]] = {}
+        wide = np.int64 if n_rows ** (k - 1) < 2**62 else object  # the keys fit int64?
+        simple = [vi for vi, t in enumerate(tight) if t.bit_count() == k]
+        B = np.array([list(_bits(tight[vi])) for vi in simple], dtype=np.int64).reshape(-1, k)
+        W = np.array(self.weights, dtype=wide)
+        keys = [np.delete(B, j, axis=1) @ W for j in range(k)]  # ray j of each: B_j left out
+        owners = [np.asarray(simple, dtype=np.int64)] * k
+        more_v, more_k = [], []
+        for vi, t in enumerate(tight):
+            if k < t.bit_count() <= MAX_TIGHT:
+                for sub in itertools.combinations(_bits(t), k - 1):
+                    more_v.append(vi)
+                    more_k.append(self._key(sub))
+        K = np.concatenate([*keys, np.array(more_k, dtype=wide)])
+        owner = np.concatenate([*owners, np.array(more_v, dtype=np.int64)])
+        order = np.argsort(K, kind="stable")
+        self.keys, self.owners = K[order], owner[order]
+        edges: list[list[int]] = [[] for _ in tight]
+        self.simple_ends = edges
+        if not simple:
+            return
+        # the run of each simple vertex's key: its other member is the ray's other end
+        lo = np.searchsorted(self.keys, K[:len(simple) * k], side="left")
+        hi = np.searchsorted(self.keys, K[:len(simple) * k], side="right")
+        own = owner[:len(simple) * k]
+        first = self.owners[lo]
+        second = self.owners[np.minimum(lo + 1, len(order) - 1)]
+        other = np.where(first != own, first, np.where(hi - lo >= 2, second, -1))
+        ends = other.reshape(k, len(simple)).T.tolist()
+        for s, (vi, row) in enumerate(zip(simple, ends, strict=True)):
+            for j, u in enumerate(row):
+                if u < 0:  # no other registered vertex on the line: scan
+                    u = self._scan(vi, tight[vi] ^ (1 << int(B[s, j])))
+                    if u is None:
+                        self.simple_ends = None
+                        return
+                    row[j] = u
+            edges[vi] = sorted(set(row))
+
+    def _key(self, positions) -> int:
+        return sum(p * w for p, w in zip(positions, self.weights, strict=True))
+
+    def other_end(self, vi: int, Z: int) -> int | None:
+        """A vertex u ≠ vi with Z ⊆ tight[u], or None."""
+        if Z.bit_count() == self.k - 1:
+            key = self._key(_bits(Z))
+            lo = int(np.searchsorted(self.keys, key, side="left"))
+            hi = int(np.searchsorted(self.keys, key, side="right"))
+            u = next((int(u) for u in self.owners[lo:hi] if u != vi), None)
+            if u is not None:
+                return u
+        return self._scan(vi, Z)
+
+    def _scan(self, vi: int, Z: int) -> int | None:
+        """A vertex u ≠ vi with Z ⊆ tight[u] among those on Z's rarest row."""
+        fewest = min((self._on(h) for h in _bits(Z)), key=len)
+        return next((u for u in fewest if u != vi and (self.tight[u] & Z) == Z), None)
+
+    def _on(self, h: int) -> list[int]:
+        """The vertices tight on row h (all rows' lists built on first use)."""
+        if not self._members:
+            for u, t in enumerate(self.tight):
+                for g in _bits(t):
+                    self._members.setdefault(g, []).append(u)
+        return self._members[h]
 
 
 def _near_pairs(H, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray, c: float,
@@ -353,7 +414,7 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     E = _object_rows([(-b, *a) for a, b in map(H.exact, used)], k + 1)
     at = {h: i for i, h in enumerate(used)}
     out: list[tuple[int, ...] | None] = []
-    for row in _cross_all(E[np.array([[at[h] for h in T] for T in Ts])]).tolist():
+    for row in cross_all(E[np.array([[at[h] for h in T] for T in Ts])]).tolist():
         if row[0] == 0:
             out.append(None)
             continue
@@ -370,28 +431,6 @@ def _object_rows(rows: list[tuple[int, ...]], width: int) -> np.ndarray:
     return E
 
 
-def _cross_all(R: np.ndarray) -> np.ndarray:
-    """The generalised cross products of the m × (m+1) integer matrices R[p] (an object
-    array (P, m, m+1) of Python ints): x_j = (−1)^j det R_{−j} (R without column j), so
-    R x = 0, and x = 0 iff the rows are dependent. All P at once, by Laplace expansion
-    along the rows — the minors of the first r rows on every r-set of columns from those
-    of the first r − 1: Σ_r r·C(m+1, r) products of arrays, exact."""
-    m = R.shape[1]
-    minors = {(c,): R[:, 0, c] for c in range(m + 1)}
-    for r in range(1, m):
-        nxt = {}
-        for cols in itertools.combinations(range(m + 1), r + 1):
-            acc = 0
-            for i, c in enumerate(cols):
-                term = R[:, r, c] * minors[cols[:i] + cols[i + 1:]]
-                acc = acc + term if (r + i) % 2 == 0 else acc - term
-            nxt[cols] = acc
-        minors = nxt
-    full = tuple(range(m + 1))
-    return np.stack([minors[full[:j] + full[j + 1:]] * (-1) ** j for j in range(m + 1)],
-                    axis=1)
-
-
 def _simplicial_rays(normals: list[tuple[int, ...]], bases: list[list[int]], k: int
                      ) -> list[list[tuple[int, ...]]]:
     """For each basis B (k independent rows), the extreme rays of {d : a_h·d ≤ 0, h ∈ B}:
@@ -399,7 +438,7 @@ def _simplicial_rays(normals: list[tuple[int, ...]], bases: list[list[int]], k: 
     if not bases:
         return []
     N = _object_rows(normals, k)
-    D = _cross_all(N[np.array([[g for g in B if g != h] for B in bases for h in B])]).tolist()
+    D = cross_all(N[np.array([[g for g in B if g != h] for B in bases for h in B])]).tolist()
     out = []
     for p, B in enumerate(bases):
         rays = []

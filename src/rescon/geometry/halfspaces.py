@@ -25,6 +25,7 @@ import numpy as np
 from .._rounding import MIN_NORMAL, underflow_floor
 from .._rounding import UNIT_ROUNDOFF as _EPS
 from ._budget import MAX_WORK, PYTHON_STEP, require
+from .exact import cross_all
 
 __all__ = ["MAX_CANDIDATE_COST", "Halfspaces", "candidate_cost", "valid_halfspaces"]
 
@@ -89,11 +90,31 @@ class Halfspaces:
         """(a, b), primitive integers: a·y ≤ b in the scaled integer coordinates."""
         out = self._cache.get(h)
         if out is None:
-            sub = self.through[h]
-            a = tuple(int(self.sign[h]) * c for c in exact_normal(self.Yi, sub))
-            b = sum(ai * pi for ai, pi in zip(a, self.Yi[sub[0]], strict=True))
-            out = self._cache[h] = _primitive(a, b)
+            self._store(h, exact_normal(self.Yi, self.through[h]))
+            out = self._cache[h]
         return out
+
+    def exact_all(self, hs) -> None:
+        """:meth:`exact` for the rows ``hs`` at once (into the cache): their cofactor
+        normals (−1)^(k−1) × the generalised cross products of the difference rows
+        p_i − p_0 (:func:`.exact.cross_all`, one numpy pass of Python ints per
+        minor instead of a Bareiss elimination per row)."""
+        k = len(self.Yi[0])
+        todo = [int(h) for h in dict.fromkeys(hs) if int(h) not in self._cache]
+        if k < 2 or len(todo) < 2:
+            return
+        Y = np.empty((len(self.Yi), k), dtype=object)
+        Y[:] = self.Yi
+        sub = self.through[todo]
+        normals = cross_all(Y[sub[:, 1:]] - Y[sub[:, :1]]) * (-1) ** (k - 1)
+        for h, normal in zip(todo, normals.tolist(), strict=True):
+            self._store(h, normal)
+
+    def _store(self, h: int, normal) -> None:
+        """Cache row h from the cofactor normal of its subset (signed, primitive)."""
+        a = tuple(int(self.sign[h]) * c for c in normal)
+        b = sum(ai * pi for ai, pi in zip(a, self.Yi[self.through[h][0]], strict=True))
+        self._cache[h] = _primitive(a, b)
 
 
 def candidate_cost(n_unique: int, k: int) -> int:
