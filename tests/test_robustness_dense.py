@@ -215,8 +215,9 @@ def test_sized_lower_bound_never_exceeds_a_completion(G, data):
     s1 = data.draw(st.integers(1, n))
     s2 = data.draw(st.integers(1, n))
     r = data.draw(st.integers(1, 4))
+    need = np.array([d - r + 1 for d in ig.in_degrees], dtype=np.int64)
     bound = sized_lower_bound(np.uint64(L1), np.uint64(L2), np.uint64(L0), s1, s2,
-                              inmask, mmask, r, n)
+                              inmask, mmask, need, n + 2, n)
     costs = []
     for S1, S2 in _completions(n, L1, L2, L0, s1, s2):
         cost = bd.pair_cost(ig, _pair_of(S1, S2, n), r)
@@ -257,3 +258,20 @@ def test_dense_er30_s_star_is_exact_within_seconds():
     ig = index_graph(G)
     assert list(ig.nodes) == list(range(30))  # labels are the indices
     assert bd.pair_cost(ig, bd.Pair(*rep.s_witness), 12) == 5
+
+
+@settings(max_examples=40, deadline=None)
+@given(dense_digraphs(max_n=10))
+def test_favoured_engine_changes_the_time_split_not_the_answer(G):
+    ig = index_graph(G)
+    for r in range(1, (ig.n + 1) // 2 + 1):
+        expected = leblanc_max_s(G, r)
+        for favour in (None, "sized", "charged"):
+            out = min_cost_pair(ig, r, ig.n, favour=favour)
+            assert out.best == expected and out.engine in ("sized", "charged")
+
+
+def test_favour_names_an_engine():
+    ig = index_graph(nx.complete_graph(4, create_using=nx.DiGraph))
+    with pytest.raises(ValueError, match="favour must be one of"):
+        min_cost_pair(ig, 1, 4, favour="milp")

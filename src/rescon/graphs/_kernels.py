@@ -614,26 +614,27 @@ def non_in_masks(inmask: np.ndarray):
 @njit(cache=True, nogil=True, inline="always")
 def inside_cap(i: int, L: np.uint64, room: np.uint64, size: int, inmask: np.ndarray,
                mmask: np.ndarray) -> np.int64:
-    """Upper bound on |N(i) ∩ S| for a set S with L ⊆ S ⊆ L ∪ room, |S| = size, i ∈ S:
-    S's in-neighbours of i lie in L ∪ room, and S \\ {i} has size − 1 nodes of which
-    those of M(i) ∩ L do not send to i."""
-    return min(popcount(inmask[i] & (L | room) & ~(U1 << np.uint64(i))),
-               size - 1 - popcount(mmask[i] & L))
+    """Upper bound on |N(i) ∩ S| for a set S with L ⊆ S ⊆ L ∪ room, |S| = size, i ∈ S
+    (no self-loops): S's in-neighbours of i lie in L ∪ room, and S \\ {i} has
+    size − 1 nodes of which those of M(i) ∩ L do not send to i."""
+    return min(popcount(inmask[i] & (L | room)), size - 1 - popcount(mmask[i] & L))
 
 
 @njit(cache=True, nogil=True)
 def sized_lower_bound(L1: np.uint64, L2: np.uint64, L0: np.uint64, s1: int, s2: int,
-                      inmask: np.ndarray, mmask: np.ndarray, r: int, n: int) -> np.int64:
+                      inmask: np.ndarray, mmask: np.ndarray, need: np.ndarray, stop: int,
+                      n: int) -> np.int64:
     """Lower bound on |reach_r(S1)| + |reach_r(S2)| over the completions of a partial
     labelling — L1 ⊆ S1, L2 ⊆ S2, L0 ⊆ R = V \\ (S1 ∪ S2), the rest A unlabelled —
     with |S1| = s1, |S2| = s2 and both sets keeping an r-closed member; n + 1 when
-    there is no completion. Exact (the completion's cost) when A = ∅.
+    there is no completion. Exact (the completion's cost) when A = ∅. Returns as soon
+    as the bound reaches ``stop`` (the incumbent).
 
-    A member i of S_k is uncharged iff |N(i) ∩ S_k| ≥ d_i − r + 1 (fewer than r
-    in-neighbours outside). ``inside_cap`` bounds |N(i) ∩ S_k| from above, so a labelled
-    member whose cap is below d_i − r + 1 is charged in every completion. An
+    A member i of S_k is uncharged iff |N(i) ∩ S_k| ≥ need[i] = d_i − r + 1 (fewer than
+    r in-neighbours outside). ``inside_cap`` bounds |N(i) ∩ S_k| from above, so a
+    labelled member whose cap is below need[i] is charged in every completion. An
     unlabelled node u can be uncharged in S_k only when its cap (with u ∈ S_k) reaches
-    d_u − r + 1 and S_k has room left. The unlabelled nodes fill the rooms c1, c2, c0
+    need[u] and S_k has room left. The unlabelled nodes fill the rooms c1, c2, c0
     (c1 + c2 + c0 = |A|) exactly; a node placed in S_k where it cannot be uncharged
     costs 1, in R nothing. The most nodes placed free is a bipartite b-matching of
     nodes to rooms whose size, by max-flow = min-cut, is
@@ -651,18 +652,24 @@ def sized_lower_bound(L1: np.uint64, L2: np.uint64, L0: np.uint64, s1: int, s2: 
     charged = 0
     open1 = False
     open2 = False
-    m = L1 | L2
+    m = L1
     while m:
         i = low_index(m)
         m &= ~(U1 << np.uint64(i))
-        if L1 & (U1 << np.uint64(i)):
-            free = inside_cap(i, L1, A, s1, inmask, mmask) >= popcount(inmask[i]) - r + 1
-            open1 |= free
+        if inside_cap(i, L1, A, s1, inmask, mmask) >= need[i]:
+            open1 = True
         else:
-            free = inside_cap(i, L2, A, s2, inmask, mmask) >= popcount(inmask[i]) - r + 1
-            open2 |= free
-        if not free:
             charged += 1
+    m = L2
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        if inside_cap(i, L2, A, s2, inmask, mmask) >= need[i]:
+            open2 = True
+        else:
+            charged += 1
+    if charged >= stop:
+        return charged
     only1 = 0
     only2 = 0
     both = 0
@@ -671,9 +678,8 @@ def sized_lower_bound(L1: np.uint64, L2: np.uint64, L0: np.uint64, s1: int, s2: 
         u = low_index(m)
         bu = U1 << np.uint64(u)
         m &= ~bu
-        need = popcount(inmask[u]) - r + 1
-        h1 = c1 > 0 and inside_cap(u, L1 | bu, A, s1, inmask, mmask) >= need
-        h2 = c2 > 0 and inside_cap(u, L2 | bu, A, s2, inmask, mmask) >= need
+        h1 = c1 > 0 and inside_cap(u, L1 | bu, A, s1, inmask, mmask) >= need[u]
+        h2 = c2 > 0 and inside_cap(u, L2 | bu, A, s2, inmask, mmask) >= need[u]
         open1 |= h1
         open2 |= h2
         if h1 and h2:
@@ -764,6 +770,10 @@ def min_cost_sized_step(
     gives; a cheaper one becomes the incumbent.
     """
     n = inmask.shape[0]
+    full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
+    need = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        need[i] = popcount(inmask[i]) - r + 1
     sp = state[CS_SP]
     done = 0
     while done < max_nodes:
@@ -784,8 +794,8 @@ def min_cost_sized_step(
         done += 1
         s1 = state[CS_S1]
         s2 = state[CS_S2]
-        bound = sized_lower_bound(L1, L2, L0, s1, s2, inmask, mmask, r, n)
-        A = ~(L1 | L2 | L0) & ((U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO)
+        bound = sized_lower_bound(L1, L2, L0, s1, s2, inmask, mmask, need, state[CS_BEST], n)
+        A = full & ~(L1 | L2 | L0)
         if bound < state[CS_BEST] and A == ZERO:
             state[CS_BEST] = bound
             ubuf[CB_W1] = L1

@@ -542,14 +542,17 @@ def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
     search below a weak heuristic ``upper`` runs only when nothing cheaper exists. The
     step from lower to cap doubles while rounds are cheap (< ``DEEPEN_CHEAP_SECONDS``)
     and falls back to 1 after an expensive one: the search cost grows steeply with the
-    cap, and a pair of cost = lower ends a search early. Exact: the last search is exact
-    below its cap, and every earlier one proved that nothing is cheaper than its cap."""
-    step, nodes = 1, 0
+    cap, and a pair of cost = lower ends a search early. Each round favours the engine
+    that finished the last one (see search.min_cost_pair). Exact: the last search is
+    exact below its cap, and every earlier one proved that nothing is cheaper than its
+    cap."""
+    step, nodes, favour = 1, 0, None
     while True:
         cap = min(lower + step, upper)
         t0 = time.perf_counter()
         out = min_cost_pair(ig, r, cap, lower=lower, deadline=deadline, should_stop=should_stop,
-                            on_progress=on_progress)
+                            on_progress=on_progress, favour=favour)
+        favour = out.engine
         nodes += out.nodes
         if out.status == "stopped" or out.pair is not None or cap == upper:
             return replace(out, nodes=nodes, best=out.best if out.pair is not None else upper,

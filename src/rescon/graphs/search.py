@@ -35,6 +35,7 @@ __all__ = [
 ]
 
 MAX_SEARCH_NODES = 64
+FAVOURED_SHARE = 0.75  # of the wall time, for min_cost_pair's favoured engine
 MAX_TREE_TOKENS = 4_000_000
 _SLICE = 20_000
 
@@ -268,7 +269,8 @@ class CostOutcome:
     """Result of the s*(r) branch and bound: ``status`` "done" (``best`` = s*(r)
     when < ``upper``, with ``pair`` the cheapest pair; otherwise s*(r) = ``upper``)
     or "stopped" (``best`` is still an upper bound). ``floor``: every pair is proven to
-    cost at least this much (rounds of a deepening search that finished; 0 if none)."""
+    cost at least this much (rounds of a deepening search that finished; 0 if none).
+    ``engine``: the search that finished ("sized" or "charged"; "" when stopped)."""
 
     status: str
     best: int
@@ -276,6 +278,7 @@ class CostOutcome:
     nodes: int
     order: tuple[int, ...]
     floor: int = 0
+    engine: str = ""
 
 
 class _CostRun:
@@ -303,24 +306,36 @@ def min_cost_pair(
     should_stop: Callable[[], bool] | None = None,
     on_progress: Callable[[float, int], None] | None = None,
     roots: range | None = None,
+    favour: str | None = None,
 ) -> CostOutcome:
     """s*(r) = min |reach_r(S1)| + |reach_r(S2)| over pairs whose sets both keep an
     r-closed member, searched below ``upper`` (a known pair's cost, or n); the search
     ends early when it finds a pair of cost ``lower`` (a proven lower bound).
 
-    Two exact branch and bounds share the incumbent and take turns, each in slices
-    while it has used no more wall time than the other; the first to finish answers:
-    over S1 with charged members (``_kernels.min_cost_step``: sparse graphs, small
-    sets) and two-sided with both sizes fixed (``_kernels.min_cost_sized_step``:
-    dense graphs, near-bisections). n ≤ 64. ``on_progress`` and ``roots`` as in
-    :func:`decide_r_robust` (a part's ``best`` bounds only the pairs whose first node
-    lies in its roots; s*(r) is the least over the parts).
+    Two exact branch and bounds share the incumbent and take turns in slices; the
+    first to finish answers: over S1 with charged members (``_kernels.min_cost_step``,
+    "charged": fast on sparse graphs, small sets) and two-sided with both sizes fixed
+    (``_kernels.min_cost_sized_step``, "sized": fast on dense graphs, near-bisections).
+    Each takes the next slice while its share of the wall time is below its due: equal
+    shares, or ``FAVOURED_SHARE`` for the ``favour``-ed engine (the last round's winner
+    in a deepening search: the faster engine stays the faster on the same graph, and
+    the other still has a quarter of the time, so a wrong guess costs at most 4×).
+    n ≤ 64. ``on_progress`` and ``roots`` as in :func:`decide_r_robust` (a part's
+    ``best`` bounds only the pairs whose first node lies in its roots; s*(r) is the
+    least over the parts).
     """
     K, inmask, outmask, order = _kernel_inputs(ig)
     n = ig.n
     mmask, mout = K.non_in_masks(inmask)
     span = _root_range(roots, n)
     charged, sized = _CostRun(K, n, span, upper), _CostRun(K, n, span, upper)
+    engines = {"sized": sized, "charged": charged}
+    due = {run: 0.5 for run in engines.values()}
+    if favour is not None:
+        if favour not in engines:
+            raise ValueError(f"favour must be one of {sorted(engines)} or None; got {favour!r}")
+        due = {run: FAVOURED_SHARE if run is engines[favour] else 1 - FAVOURED_SHARE
+               for run in engines.values()}
 
     def advance(run: _CostRun) -> None:
         args = (r, lower, run.stack, run.depth, run.state, run.ubuf, _SLICE, run.progress)
@@ -331,7 +346,7 @@ def min_cost_pair(
 
     best, owner, status = upper, sized, "done"
     while True:
-        run = min((sized, charged), key=lambda c: c.seconds)
+        run = min((sized, charged), key=lambda c: c.seconds / due[c])
         run.state[K.CS_BEST] = best
         t0 = time.perf_counter()
         advance(run)
@@ -352,4 +367,5 @@ def min_cost_pair(
     if best < upper:
         pair = (_bits(owner.ubuf[K.CB_W1]), _bits(owner.ubuf[K.CB_W2]))
     nodes = int(sized.state[K.CS_NODES] + charged.state[K.CS_NODES])
-    return CostOutcome(status, best, pair, nodes, tuple(order.tolist()))
+    engine = "" if status == "stopped" else "sized" if run is sized else "charged"
+    return CostOutcome(status, best, pair, nodes, tuple(order.tolist()), engine=engine)
