@@ -3,6 +3,7 @@ robustness proofs.
 
     python -m benchmarks.checker_bench [--out benchmarks/results] [--repeat 3]
                                        [--before REV] [--search-before REV] [--timeout 300]
+                                       [--only kernels|robustness]
 
 For gaussian and sphere clouds (benchmarks/kernel_clouds.py, fixed seeds) in d = 2
 (n = 100, 1000) and d = 3 (n = 20, 30, 100), with F = ⌊n/10⌋ (every kernel nonempty;
@@ -36,7 +37,8 @@ s* proofs ``dp`` / ``cost_search`` beyond n = 20).
 
 The load average (1 min) is recorded before and after each case: the machine is shared.
 Writes ``checker.csv`` (one row per case; the columns of the other part left empty)
-and ``checker.md``.
+and ``checker.md``. ``--only`` re-measures one part and keeps the other part's rows of
+the existing ``checker.csv``.
 """
 
 from __future__ import annotations
@@ -259,7 +261,7 @@ def bench_search(repeat: int, before: str, timeout: float) -> list[dict]:
 
 
 def write(rows: list[dict], search_rows: list[dict], out: Path, seconds: float, before: str,
-          search_before: str) -> None:
+          search_before: str, only: str | None = None) -> None:
     out.mkdir(parents=True, exist_ok=True)
     fields = list(rows[0]) + [k for k in search_rows[0] if k not in rows[0]]
     with (out / "checker.csv").open("w", newline="") as fh:
@@ -270,7 +272,9 @@ def write(rows: list[dict], search_rows: list[dict], out: Path, seconds: float, 
         "# Certificate checking (issue 13 §4)", "", "## Safe kernels", "",
         (f"- `python -m benchmarks.checker_bench` in {seconds:.0f} s on {platform.machine()}, "
          f"Python {platform.python_version()}, {os.cpu_count()} cores shared with other jobs "
-         "(load average before/after each case in the table)."),
+         "(load average before/after each case in the table)"
+         + (f"; `--only {only}`: the other part's rows are those of the previous run."
+            if only else ".")),
         ("- Wall time of `python certificates/check.py CERT` (fresh process, median of the "
          "repeats). `after`: today's certificate (safe_kernel: with `adjacency`; "
          "kernel_point: `kernel` proof) and checker, verdict checked to be `valid` before "
@@ -321,6 +325,18 @@ def _search_lines(rows: list[dict], before: str) -> list[str]:
     return lines
 
 
+KERNEL_KINDS = ("safe_kernel", "kernel_point")
+
+
+def _kept(path: Path, kernels: bool) -> list[dict]:
+    """The rows of one part (kernels, or robustness) of an existing checker.csv, typed
+    as :func:`write` expects (booleans, None for empty cells)."""
+    with path.open(newline="") as fh:
+        rows = [row for row in csv.DictReader(fh) if (row["kind"] in KERNEL_KINDS) == kernels]
+    typed = {"True": True, "False": False, "": None}
+    return [{k: typed.get(v, v) for k, v in row.items()} for row in rows]
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
@@ -329,12 +345,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--search-before", default=SEARCH_BEFORE,
                     help="git revision of the 'before' checker for robustness proofs")
     ap.add_argument("--timeout", type=float, default=300.0)
+    ap.add_argument("--only", choices=("kernels", "robustness"),
+                    help="re-measure this part only, keep the other's rows of checker.csv")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    rows = bench(args.repeat, args.before, args.timeout)
-    search_rows = bench_search(args.repeat, args.search_before, args.timeout)
+    if args.only == "robustness":
+        rows = _kept(args.out / "checker.csv", kernels=True)
+    else:
+        rows = bench(args.repeat, args.before, args.timeout)
+    if args.only == "kernels":
+        search_rows = _kept(args.out / "checker.csv", kernels=False)
+    else:
+        search_rows = bench_search(args.repeat, args.search_before, args.timeout)
     write(rows, search_rows, args.out, time.perf_counter() - t0, args.before,
-          args.search_before)
+          args.search_before, args.only)
     # kernels: every target met; robustness: no correct certificate called invalid
     bad = [r for r in search_rows if r["after_verdict"] not in ("valid", "unchecked")]
     return 0 if all(r["met"] for r in rows) and not bad else 1
