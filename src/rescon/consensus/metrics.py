@@ -602,7 +602,7 @@ def _certified_surface(U: np.ndarray, simplices: np.ndarray):
     surface S = ⋃ T_f is thus a closed surface star-shaped about o, and with 3 it is
     the boundary of a convex polytope (Mehlhorn, Näher, Schilz, Schirra, Seel, Seidel,
     Uhrig, "Checking geometric programs or verification of geometric structures",
-    Comput. Geom. 12 (1999), §3: a closed oriented surface locally convex at every
+    Comput. Geom. 12 (1999) 85–103: a closed oriented surface locally convex at every
     edge, a point on the negative side of every facet and a ray from it meeting one
     facet only); that polytope is K, the intersection of the triangles' halfspaces
     (a point beyond S on a ray from o is beyond the plane of the triangle the ray
