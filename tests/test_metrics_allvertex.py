@@ -263,3 +263,14 @@ def test_monitor_at_every_magnitude(scale):
     dist = new.distances(S)
     assert np.array_equal(dist, old.distances(S))
     assert np.array_equal(dist == 0, np.array([new.hull.contains(x) for x in S]))
+
+
+def test_fallback_in_space_still_corrects_its_proposal():
+    """When no surface is certified (here forced), R³ falls back to the safe kernel of
+    Qhull's vertices, completed by the exact certification (a proposal of 4 rows)."""
+    X = np.random.default_rng(4).normal(size=(120, 3))
+    with mock.patch.object(metrics, "_exact_polytope", return_value=None), \
+            mock.patch.object(metrics, "_proposed_rows", lambda X: np.arange(4)):
+        hull = certified_hull(X)
+    assert "cones" not in hull._cache
+    assert _facet_set(hull) == _facet_set(metrics._exact_polytope(X))
