@@ -23,6 +23,7 @@ JSON arrays may also be given as Python tuples when ``check`` is called directly
 
 from __future__ import annotations
 
+import bisect
 import json
 import math
 import sys
@@ -618,6 +619,10 @@ class _Replay:
             field[v] = p
         self.field = field
         self.top = [w * field[v] + w - 1 for v in range(n)]  # v's guard bit
+        self.unit = max(1, -(-n * w // 1024))
+        self.work = (n + g.m) * self.unit
+        if self.work > MAX_SEARCH_WORK:
+            return  # the tables alone are beyond the limit: run() stops before using them
         out = g.outmask()
         # indexed by w (p + 1), the bit length of the guard bit of field p (node v):
         # less = the lowest bits of the fields of v's out-neighbours;
@@ -628,11 +633,9 @@ class _Replay:
             L = w * (field[v] + 1)
             self.less[L] = sum(1 << (w * field[j]) for j in _bits(out[v]))
             self.least[L] = max(1, deg[v] - r + 2)
-        # fit[k]: the fields p (a prefix: least grows with p) with least ≤ k
-        self.fit = [sum(1 << (w * p + w - 1) for p in range(n) if self.least[w * (p + 1)] <= k)
-                    for k in range(n + 1)]
-        self.unit = max(1, -(-n * w // 1024))
-        self.work = (n + g.m) * self.unit
+        # fit[k]: the number of fields p with least ≤ k (a prefix: least grows with p)
+        least = [self.least[w * (p + 1)] for p in range(n)]
+        self.fit = [bisect.bisect_right(least, k) for k in range(n + 1)]
 
     def pack(self, mask: int) -> int:
         """The packed form of the node set ``mask`` (a bitmask)."""
@@ -672,22 +675,22 @@ class _Replay:
         U, without that member (enough to show watch ⊄ core; D is not used again).
         Work: one step per round, per cut and per node whose out-neighbours are
         subtracted."""
-        less, fit, ones, shift = self.less, self.fit, self.ones, self.w - 1
+        less, fit, ones, w = self.less, self.fit, self.ones, self.w
         todo = gone & U
         steps = 0
         while todo:
             U ^= todo
             k = U.bit_count()
-            C = U & fit[k]
+            C = U & ((1 << w * fit[k]) - 1)
             while C.bit_count() < k:
                 k = C.bit_count()
-                C &= fit[k]
+                C &= (1 << w * fit[k]) - 1
                 steps += 1
             if not C:
                 U = 0
                 steps += 1
                 break
-            D |= (todo >> shift) * ones
+            D |= (todo >> (w - 1)) * ones
             steps += 1 + todo.bit_count()
             while todo:
                 low = todo & -todo
@@ -705,9 +708,12 @@ class _Replay:
         the first that is not, or say why the replay stopped (beyond MAX_SEARCH_WORK)."""
         g, shrink, top = self.g, self.shrink, self.top
         ntok = len(tree)
+        self.work += ntok * self.unit
+        if self.work > MAX_SEARCH_WORK:
+            return self.beyond(0, ntok)
         meter = [0]
         core0 = core(g, g.full, self.r, meter)  # P = core_r(V \ B), B = order[:k]
-        self.work += meter[0] + ntok * self.unit
+        self.work += meter[0]
         P, PD = self.pack(core0), self.deficits(core0)
         pos = 0
         B = 0
@@ -717,8 +723,7 @@ class _Replay:
             stack = [(S0, B, P, PD, Q, QD)]
             while stack:
                 if self.work > MAX_SEARCH_WORK:
-                    return (f"replaying its tree needs more than {MAX_SEARCH_WORK} steps "
-                            f"(the checker's work limit; stopped at token {pos} of {ntok})")
+                    return self.beyond(pos, ntok)
                 if pos >= ntok:
                     raise Invalid(f"{self.where}: search tree ends early (in the subtree of "
                                   f"root {k})")
@@ -758,6 +763,12 @@ class _Replay:
             raise Invalid(f"{self.where}: search tree has {ntok - pos} unused tokens after "
                           f"the {g.n} roots")
         return ""
+
+    @staticmethod
+    def beyond(pos: int, ntok: int) -> str:
+        """Why the replay stopped at token ``pos`` of ``ntok``."""
+        return (f"replaying its tree needs more than {MAX_SEARCH_WORK} steps "
+                f"(the checker's work limit; stopped at token {pos} of {ntok})")
 
     def sizes(self, S: int, Q: int) -> tuple[int, int]:
         """(need1, need2) for packed S, Q: the sizes of a closed S1 ⊇ S and of a closed
@@ -972,9 +983,15 @@ def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) ->
 
 
 def _proof_cost_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
-    _obj(p, where, ("method", "order"), ("info",))
-    _perm(p["order"], f"{where}.order", g.n)
+    _obj(p, where, ("method", "order"), ("info", "tree"))
+    order = _perm(p["order"], f"{where}.order", g.n)
     _info(p, where)
+    if p.get("tree") is not None:  # the sized search's tree (cost_tree.py)
+        tree = _tokens(p["tree"], f"{where}.tree", g.n)
+        if _cost_tree.replay(g.inmask, r, s, order, tree, where):
+            return "cost_search (tree replayed)"
+        return _enumerate_or_trust("cost_search", where, g, r, s, ctx, "tree beyond the "
+                                   f"replay limit ({_cost_tree.MAX_COST_TREE_WORK} steps)")
     return _enumerate_or_trust("cost_search", where, g, r, s, ctx)
 
 
@@ -1332,6 +1349,8 @@ def _sibling(name: str) -> Any:
 
 
 _kernels = _sibling("kernels")  # safe kernels
+_cost_tree = _sibling("cost_tree")  # s*(r) search trees
+_cost_tree.install(Invalid)
 KINDS.update(_kernels.install(Invalid, _obj, _int, _array, _tname, unchecked=Unchecked))
 KINDS.update(_sibling("redundancy").install(  # redundancy of costs
     Invalid, _obj, _int, _array, _tname, unchecked=Unchecked, rat=_kernels._rat))

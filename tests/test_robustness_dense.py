@@ -144,7 +144,8 @@ def _sized_search(ig, r, upper, roots=None):
     run = se._CostRun(K, ig.n, (0, ig.n) if roots is None else (roots.start, roots.stop), upper)
     while run.state[K.CS_STATUS] == K.RUNNING:
         K.min_cost_sized_step(inmask, mmask, mout, order, r, 0, run.stack, run.depth,
-                              run.state, run.ubuf, 10_000, run.progress)
+                              run.state, run.ubuf, 10_000, run.progress,
+                              np.empty(1, dtype=np.int32), False)
     return int(run.state[K.CS_BEST]), int(run.ubuf[K.CB_W1]), int(run.ubuf[K.CB_W2])
 
 
@@ -275,3 +276,64 @@ def test_favour_names_an_engine():
     ig = index_graph(nx.complete_graph(4, create_using=nx.DiGraph))
     with pytest.raises(ValueError, match="favour must be one of"):
         min_cost_pair(ig, 1, 4, favour="milp")
+
+
+# --------------------------------------------------------------------------- #
+# recorded s* trees (search.cost_tree) and their replay (certificates/cost_tree.py)
+# --------------------------------------------------------------------------- #
+
+
+def _cost_cert(ig, r, s, tree, order):
+    return {"rescon_certificate": 1, "kind": "rs_robust", "graph": ig.graph_json(), "r": r,
+            "s": s, "proof": {"method": "cost_search", "order": list(order),
+                              "tree": list(tree)}}
+
+
+@settings(max_examples=60, deadline=None)
+@given(dense_digraphs(max_n=9))
+def test_recorded_cost_trees_replay_and_prove_exactly_s_star(G):
+    """The tree below s*(r) replays valid; the same tree claimed for s*(r) + 1 is
+    rejected (a pair of cost s*(r) exists); the search below s*(r) + 1 meets it."""
+    import rescon
+    from rescon.graphs.search import cost_tree, search_order
+
+    ig = index_graph(G)
+    order = search_order(ig).tolist()
+    for r in range(1, (ig.n + 1) // 2 + 1):
+        s = leblanc_max_s(G, r)
+        if s == 0:
+            continue
+        tree = cost_tree(ig, r, s)
+        assert rescon.check_certificate(_cost_cert(ig, r, s, tree, order)).valid
+        if s < ig.n:
+            assert not rescon.check_certificate(_cost_cert(ig, r, s + 1, tree, order)).valid
+            with pytest.raises(ValueError, match="a pair costs"):
+                cost_tree(ig, r, s + 1)
+
+
+def test_tampered_cost_trees_are_rejected():
+    """ER(24, 0.85): the recorded tree proves s*(ρ) = s with the checker's own bound;
+    a branch cut to a leaf, a leaf made a branch, a missing or an extra token, or a
+    different order is rejected."""
+    import rescon
+    from rescon.graphs.search import cost_tree, search_order
+
+    G = nx.gnp_random_graph(24, 0.85, directed=True, seed=3)
+    ig = index_graph(G)
+    r = rescon.robustness(G, method="dp").r_max
+    s, _ = _dp_min_cost(ig, r)
+    order = search_order(ig).tolist()
+    tree = list(cost_tree(ig, r, s))
+    assert rescon.check_certificate(_cost_cert(ig, r, s, tree, order)).valid
+    branch = next(k for k, t in enumerate(tree) if t >= 0)
+    leaf = next(k for k, t in enumerate(tree) if t == -1)
+    tampered = [
+        tree[:branch] + [-1] + tree[branch + 1:],
+        tree[:leaf] + [order[0]] + tree[leaf + 1:],  # order[0] is labelled in every state
+        tree[:-1],
+        tree + [-1],
+    ]
+    for bad in tampered:
+        assert not rescon.check_certificate(_cost_cert(ig, r, s, bad, order)).valid
+    swapped = order[1:] + order[:1]
+    assert not rescon.check_certificate(_cost_cert(ig, r, s, tree, swapped)).valid

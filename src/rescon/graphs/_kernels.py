@@ -429,9 +429,10 @@ CK_S, CK_X, CK_C, CK_M = 0, 1, 2, 3
 COST_STACK_WIDTH = 4
 # indices into the int64 state of the cost search
 CS_SP, CS_ROOT, CS_STATUS, CS_NODES, CS_BEST, CS_END = 0, 1, 2, 3, 4, 5
-# the sized search's current size combination (|S1|, |S2|); 0: no root started yet
-CS_S1, CS_S2 = 6, 7
-COST_STATE_LEN = 8
+# the sized search's current size combination (|S1|, |S2|; 0: no root started yet)
+# and its number of recorded tokens
+CS_S1, CS_S2, CS_NTOK = 6, 7, 8
+COST_STATE_LEN = 9
 # uint64 buffer: current B, best S1, best S2
 CB_B, CB_W1, CB_W2 = 0, 1, 2
 
@@ -753,6 +754,8 @@ def min_cost_sized_step(
     ubuf: np.ndarray,
     max_nodes: int,
     progress: np.ndarray,
+    tokens: np.ndarray,
+    record: bool,
 ) -> None:
     """Advance the two-sided branch and bound for s*(r) with both set sizes fixed
     (the same problem, state layout and roots as :func:`min_cost_step`, whose
@@ -768,6 +771,10 @@ def min_cost_sized_step(
     pruned; else the node of ``sized_branch_node`` is labelled S1, S2 or R (three
     children). A state without unlabelled nodes is a pair whose exact cost the bound
     gives; a cheaper one becomes the incumbent.
+
+    With ``record``, each expanded state appends a token (certificates/FORMAT.md,
+    ``cost_search`` tree): its branch node, or -1 for a leaf; status NEED_ROOM when
+    ``tokens`` is full.
     """
     n = inmask.shape[0]
     full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
@@ -777,6 +784,9 @@ def min_cost_sized_step(
     sp = state[CS_SP]
     done = 0
     while done < max_nodes:
+        if record and state[CS_NTOK] >= tokens.shape[0]:
+            state[CS_STATUS] = NEED_ROOM
+            break
         if sp == 0:
             if state[CS_BEST] <= lower or not next_sizes(state, order, n, ubuf):
                 state[CS_STATUS] = UNSAT
@@ -801,10 +811,17 @@ def min_cost_sized_step(
             ubuf[CB_W1] = L1
             ubuf[CB_W2] = L2
         if bound >= state[CS_BEST] or A == ZERO:
+            if record:
+                tokens[state[CS_NTOK]] = -1
+            state[CS_NTOK] += 1
             room = n - state[CS_ROOT] + 1
             progress[0] += 3.0 ** -depth / (n * (room * (room - 1) // 2))
             continue
-        bu = U1 << np.uint64(sized_branch_node(A, L1, L2, mmask, mout))
+        u = sized_branch_node(A, L1, L2, mmask, mout)
+        if record:
+            tokens[state[CS_NTOK]] = u
+        state[CS_NTOK] += 1
+        bu = U1 << np.uint64(u)
         stack[sp, 0] = L1
         stack[sp, 1] = L2
         stack[sp, 2] = L0 | bu

@@ -40,6 +40,7 @@ from .search import (
     MAX_SEARCH_NODES,
     CostOutcome,
     SearchOutcome,
+    cost_tree,
     decide_r_robust,
     min_cost_pair,
 )
@@ -458,7 +459,7 @@ def _s_star_fresh(
         return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
     if method == "search":
         found = _deepening_search(ig, r, lower, upper, deadline, on_progress=on_progress)
-        return _cost_search_result(ig, r, found, lower, upper, proof, pair)
+        return _cost_search_result(ig, r, found, lower, upper, proof, pair, deadline)
     milp = _milp_s(ig, r, lower, upper, deadline, on_progress)
     return _milp_s_result(ig, r, milp.outcome(), lower, upper, proof, pair)
 
@@ -513,8 +514,11 @@ def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper
 
 
 def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, upper: int,
-                        proof: Proof, pair: bd.Pair | None) -> _SStar:
-    """s*(r) from the s* branch and bounds (see search.min_cost_pair)."""
+                        proof: Proof, pair: bd.Pair | None,
+                        deadline: float | None = None) -> _SStar:
+    """s*(r) from the s* branch and bounds (see search.min_cost_pair); an exact value's
+    proof carries the sized search's tree below it when one is recorded within
+    ``TREE_SECONDS`` (search.cost_tree; the checker replays it)."""
     if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
@@ -528,7 +532,14 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
         if out.floor > lower:  # finished deepening rounds proved more than the bounds
             lower, proof = out.floor, search_proof
         return _SStar(None, lower, upper, proof, pair, "search")
+    stop = time.perf_counter() + TREE_SECONDS
+    tree = cost_tree(ig, r, upper, deadline=stop if deadline is None else min(stop, deadline))
+    if tree is not None:
+        search_proof["tree"] = list(tree)
     return _SStar(upper, upper, upper, search_proof, pair, "search")
+
+
+TREE_SECONDS = 2.0  # budget for recording the s* proof tree (search.cost_tree)
 
 
 DEEPEN_CHEAP_SECONDS = 0.1
@@ -574,7 +585,7 @@ def _race_s(ig: IndexedGraph, r: int, lower: int, upper: int, proof: Proof,
         raise
     if out.status != "stopped" or (deadline is not None and time.perf_counter() > deadline):
         milp.cancel()
-        return _cost_search_result(ig, r, out, lower, upper, proof, pair)
+        return _cost_search_result(ig, r, out, lower, upper, proof, pair, deadline)
     return _milp_s_result(ig, r, milp.outcome(), lower, upper, proof, pair)
 
 

@@ -29,6 +29,7 @@ __all__ = [
     "MAX_TREE_TOKENS",
     "CostOutcome",
     "SearchOutcome",
+    "cost_tree",
     "decide_r_robust",
     "min_cost_pair",
     "search_order",
@@ -38,6 +39,7 @@ MAX_SEARCH_NODES = 64
 FAVOURED_SHARE = 0.75  # of the wall time, for min_cost_pair's favoured engine
 MAX_TREE_TOKENS = 4_000_000
 _SLICE = 20_000
+_NO_TOKENS = np.empty(1, dtype=np.int32)
 
 
 @dataclass(frozen=True)
@@ -340,7 +342,7 @@ def min_cost_pair(
     def advance(run: _CostRun) -> None:
         args = (r, lower, run.stack, run.depth, run.state, run.ubuf, _SLICE, run.progress)
         if run is sized:
-            K.min_cost_sized_step(inmask, mmask, mout, order, *args)
+            K.min_cost_sized_step(inmask, mmask, mout, order, *args, _NO_TOKENS, False)
         else:
             K.min_cost_step(inmask, outmask, order, *args)
 
@@ -369,3 +371,33 @@ def min_cost_pair(
     nodes = int(sized.state[K.CS_NODES] + charged.state[K.CS_NODES])
     engine = "" if status == "stopped" else "sized" if run is sized else "charged"
     return CostOutcome(status, best, pair, nodes, tuple(order.tolist()), engine=engine)
+
+
+def cost_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = None,
+              max_tokens: int = MAX_TREE_TOKENS) -> tuple[int, ...] | None:
+    """The recorded tree of the sized search (``_kernels.min_cost_sized_step``) below
+    cap s: the certificate that every pair whose sets both keep an r-closed member
+    costs ≥ s (certificates/FORMAT.md, ``cost_search``). None when it needs more than
+    ``max_tokens`` tokens or passes ``deadline``; ValueError when it meets a pair
+    cheaper than s (then s is no lower bound)."""
+    K, inmask, _, order = _kernel_inputs(ig)
+    mmask, mout = K.non_in_masks(inmask)
+    run = _CostRun(K, ig.n, (0, ig.n), s)
+    tokens = np.empty(min(1 << 12, max_tokens), dtype=np.int32)
+    while True:
+        run.state[K.CS_STATUS] = K.RUNNING
+        K.min_cost_sized_step(inmask, mmask, mout, order, r, -1, run.stack, run.depth,
+                              run.state, run.ubuf, _SLICE, run.progress, tokens, True)
+        if run.state[K.CS_BEST] < s:
+            raise ValueError(f"a pair costs {int(run.state[K.CS_BEST])} < s = {s}")
+        status = run.state[K.CS_STATUS]
+        if status == K.NEED_ROOM:
+            if tokens.shape[0] >= max_tokens:
+                return None
+            grown = np.empty(min(2 * tokens.shape[0], max_tokens), dtype=np.int32)
+            grown[: tokens.shape[0]] = tokens
+            tokens = grown
+        elif status != K.RUNNING:
+            return tuple(tokens[: run.state[K.CS_NTOK]].tolist())
+        elif deadline is not None and time.perf_counter() > deadline:
+            return None
