@@ -284,3 +284,38 @@ def test_over_the_limit_is_unchecked_beyond_enumeration(monkeypatch):
     monkeypatch.setattr(C, "MAX_SEARCH_WORK", 1)
     res = C.check(small)
     assert res.verdict == "valid" and "enumeration" in res.reason, res
+
+
+def _leaf_list_cert(n: int, edges: list[list[int]]) -> dict:
+    return {"rescon_certificate": 1, "kind": "rs_robust", "graph": {"n": n, "edges": edges},
+            "r": 1, "s": 1,
+            "proof": {"method": "search", "order": list(range(n)), "tree": [-1] * n}}
+
+
+def test_a_large_graph_is_answered_within_the_work_limit():
+    """n = 3000 without edges (the graph limit accepts it; its replay stops at its first
+    leaf): the replay's set-up built a table of n + 1 packed sets of n fields, n² big-int
+    additions outside the work count (~80 s; never ending for n = 10^4)."""
+    t0 = time.perf_counter()
+    res = C.check(_leaf_list_cert(3000, []))
+    assert res.verdict == "invalid" and "leaf -1 at token 0" in res.reason, res
+    assert time.perf_counter() - t0 < 10
+
+
+def test_tables_beyond_the_work_limit_are_not_built(monkeypatch):
+    """The set-up charge (n + |E| steps of ⌈n·w / 1024⌉) alone beyond MAX_SEARCH_WORK:
+    unchecked without building the packed tables (for every node a set of up to n·w
+    bits: n²·w bits, gigabytes for the n ≈ 10^5 the graph limit accepts)."""
+    import tracemalloc
+
+    n = 2000  # every node sends to node 0, the last field: each table entry has n·w bits
+    cert = _leaf_list_cert(n, [[v, 0] for v in range(1, n)] + [[0, v] for v in range(1, n)])
+    monkeypatch.setattr(C, "MAX_SEARCH_WORK", 2 * n)
+    tracemalloc.start()
+    try:
+        res = C.check(cert)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert res.verdict == "unchecked" and "work limit" in res.unchecked[0], res
+    assert peak < 2_000_000, peak  # the tables: n · n·w bits ≈ 6 MB
