@@ -337,3 +337,25 @@ def test_tampered_cost_trees_are_rejected():
         assert not rescon.check_certificate(_cost_cert(ig, r, s, bad, order)).valid
     swapped = order[1:] + order[:1]
     assert not rescon.check_certificate(_cost_cert(ig, r, s, tree, swapped)).valid
+
+
+@pytest.mark.slow
+def test_dense_er25_certificate_is_replayed_in_full():
+    """ER(25, 0.8), seed 25000: s*(11) = 2 by the sized search; the certificate carries
+    its tree and the checker verifies every part (nothing on trust); a tampered tree
+    makes it invalid."""
+    import json
+
+    import rescon
+
+    G = nx.gnp_random_graph(25, 0.8, directed=True, seed=25000)
+    rep = rescon.robustness(G, time_limit=60)
+    assert rep.exact and rep.s_max == 2
+    proof = rep.certificate["lower_s"]
+    assert proof["method"] == "cost_search" and proof["tree"]
+    check = rescon.check_certificate(rep.certificate)
+    assert check.valid and check.trusted == () and check.unchecked == ()
+    bad = json.loads(json.dumps(rep.certificate))
+    tree = bad["lower_s"]["tree"]
+    tree[next(k for k, t in enumerate(tree) if t >= 0)] = -1  # a branch cut to a leaf
+    assert not rescon.check_certificate(bad).valid

@@ -516,9 +516,10 @@ def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper
 def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, upper: int,
                         proof: Proof, pair: bd.Pair | None,
                         deadline: float | None = None) -> _SStar:
-    """s*(r) from the s* branch and bounds (see search.min_cost_pair); an exact value's
-    proof carries the sized search's tree below it when one is recorded within
-    ``TREE_SECONDS`` (search.cost_tree; the checker replays it)."""
+    """s*(r) from the s* branch and bounds (see search.min_cost_pair); when the sized
+    search settled the value, its proof carries that search's tree below it, if one
+    is recorded within ``TREE_SECONDS`` (search.cost_tree; the checker replays it; the
+    sized search on graphs where the charged-set one won would mostly waste the time)."""
     if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
@@ -532,10 +533,11 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
         if out.floor > lower:  # finished deepening rounds proved more than the bounds
             lower, proof = out.floor, search_proof
         return _SStar(None, lower, upper, proof, pair, "search")
-    stop = time.perf_counter() + TREE_SECONDS
-    tree = cost_tree(ig, r, upper, deadline=stop if deadline is None else min(stop, deadline))
-    if tree is not None:
-        search_proof["tree"] = list(tree)
+    if out.engine == "sized":
+        stop = time.perf_counter() + TREE_SECONDS
+        tree = cost_tree(ig, r, upper, deadline=stop if deadline is None else min(stop, deadline))
+        if tree is not None:
+            search_proof["tree"] = list(tree)
     return _SStar(upper, upper, upper, search_proof, pair, "search")
 
 
