@@ -309,7 +309,9 @@ def _search_lines(rows: list[dict], before: str) -> list[str]:
          "2.5·10^7 steps), median of the repeats; `before`: the checker of revision "
          f"{before} (every core peeled from scratch, limit 1.2·10^7 mask operations), "
          "once; `before, no limit`: that replay with its limit lifted, once (run when "
-         "`before` is unchecked). `unchecked parts`: what today's checker did not verify."),
+         "`before` is unchecked). `unchecked parts`: what today's checker did not verify. "
+         "A `before` = `invalid` on a robustness row: its `cost_search` proof carries a "
+         "tree (certificates/cost_tree.py), a key that older checker does not know."),
         f"- Target: `valid` in ≤ {TARGET_S:g} s.", "",
         "| case | kind | ρ | proof | tokens | build s | after | after s | unchecked parts "
         "| before | before s | before, no limit | no limit s | met | load |",
