@@ -604,7 +604,8 @@ class _Replay:
     weighted by ⌈n·w / 1024⌉: one per token, per round of :meth:`shrink` and per node
     whose out-neighbours it subtracts, per member of S at a -3 leaf, and n + |E| + n
     to set up the tables and the first root (plus the mask operations of its
-    :func:`core`).
+    :func:`core`); besides, the table ``less`` holds up to n·w bits per node with
+    out-neighbours, one step per 64 bits (memory ≤ 64·MAX_SEARCH_WORK bits).
     """
 
     def __init__(self, g: Graph, r: int, where: str) -> None:
@@ -620,10 +621,11 @@ class _Replay:
         self.field = field
         self.top = [w * field[v] + w - 1 for v in range(n)]  # v's guard bit
         self.unit = max(1, -(-n * w // 1024))
-        self.work = (n + g.m) * self.unit
+        out = g.outmask()
+        senders = sum(1 for mk in out if mk)
+        self.work = (n + g.m) * self.unit + senders * n * w // 64
         if self.work > MAX_SEARCH_WORK:
             return  # the tables alone are beyond the limit: run() stops before using them
-        out = g.outmask()
         # indexed by w (p + 1), the bit length of the guard bit of field p (node v):
         # less = the lowest bits of the fields of v's out-neighbours;
         # least = max(1, d_v - r + 2), the least size of a closed set holding v

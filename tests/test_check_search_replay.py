@@ -319,3 +319,27 @@ def test_tables_beyond_the_work_limit_are_not_built(monkeypatch):
         tracemalloc.stop()
     assert res.verdict == "unchecked" and "work limit" in res.unchecked[0], res
     assert peak < 2_000_000, peak  # the tables: n · n·w bits ≈ 6 MB
+
+
+def test_the_packed_table_is_charged_by_its_size(monkeypatch):
+    """A star on n = 3000 nodes, every leaf sending to the hub (the last field): the
+    table of out-neighbour fields holds n·w bits per node, n²·w bits in all (14 MB
+    here; 800 MB for n = 20 000 within the default limit, when only n + |E| steps were
+    charged). It counts one step per 64 bits: beyond the limit it is not built."""
+    import tracemalloc
+
+    n = 3000
+    edges = [[v, 0] for v in range(1, n)] + [[0, v] for v in range(1, n)]
+    cert = _leaf_list_cert(n, edges)
+    w = n.bit_length() + 1
+    setup = (n + len(edges)) * -(-n * w // 1024)
+    assert setup < 1_000_000 < setup + n * n * w // 64
+    monkeypatch.setattr(C, "MAX_SEARCH_WORK", 1_000_000)
+    tracemalloc.start()
+    try:
+        res = C.check(cert)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert res.verdict == "unchecked" and "work limit" in res.unchecked[0], res
+    assert peak < 5_000_000, peak
