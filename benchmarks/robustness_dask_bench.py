@@ -183,7 +183,9 @@ def _write(rows: list[dict], out: Path, argv: str, seconds: float) -> None:
         "(same status and number of states, checked before any time is reported); the "
         "certificates (trees beyond 4 million tokens are not recorded, so the checker reports "
         "them unchecked, serial and split alike) got the same verdict. Times: median of the "
-        "interleaved repeats, in seconds.",
+        "interleaved repeats, in seconds. On a machine shared with other jobs a wall time "
+        "measures the share of the 2 cores a run got (see the load before each run, below); "
+        "the CPU seconds in the second table show the split itself.",
         "",
         "| instance | r | states | serial | 1 worker | 2 workers | 2 w vs 1 w | 2 w vs serial "
         "| certificate |",
