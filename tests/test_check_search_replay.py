@@ -343,3 +343,28 @@ def test_the_packed_table_is_charged_by_its_size(monkeypatch):
         tracemalloc.stop()
     assert res.verdict == "unchecked" and "work limit" in res.unchecked[0], res
     assert peak < 5_000_000, peak
+
+
+def test_the_stack_is_charged_by_its_size(monkeypatch):
+    """No edges and r = 1 (nothing is ever peeled): a tree that branches on nodes
+    1..n-1 along its first children holds n stack entries, each with a fresh packed Q
+    and its D (2·n·w bits per level, 12 MB for n = 2000; 375 MB for n = 10^4 within
+    the default limit when only the tokens were charged). The stack counts one step
+    per 64 bits of its largest size, 2(n + 1)·n·w bits, before the replay starts: here
+    beyond the limit, so the tree is not replayed, and the graph (not 1-robust) is
+    refuted by the linear-time witness pairs instead, in little memory."""
+    import tracemalloc
+
+    n = 2000
+    tree = list(range(1, n)) + [-1] * (2 * n)
+    cert = {**_leaf_list_cert(n, []), "proof": {"method": "search", "order": list(range(n)),
+                                                  "tree": tree}}
+    monkeypatch.setattr(C, "MAX_SEARCH_WORK", 1_000_000)
+    tracemalloc.start()
+    try:
+        res = C.check(cert)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert res.verdict == "invalid" and "witness pairs" in res.reason, res
+    assert peak < 5_000_000, peak
