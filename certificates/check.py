@@ -605,9 +605,10 @@ class _Replay:
     whose out-neighbours it subtracts, per member of S at a -3 leaf, and n + |E| + n
     to set up the tables and the first root (plus the mask operations of its
     :func:`core`); besides, one step per 64 bits of memory: the table ``less`` (up
-    to n·w bits per node with out-neighbours) and the stack (at most n + 1 entries, as
-    each level fixes one more node in S ∪ X, each with up to two packed sets of its
-    own), so memory stays below 64·MAX_SEARCH_WORK bits.
+    to n·w bits per node with out-neighbours) and the stack (at most n + 1 levels, as
+    each fixes one more node in S ∪ X, each with up to four packed sets of its own:
+    S or X with the new node, and a re-peeled set with its D), so memory stays below
+    64·MAX_SEARCH_WORK bits.
     """
 
     def __init__(self, g: Graph, r: int, where: str) -> None:
@@ -625,7 +626,7 @@ class _Replay:
         self.unit = max(1, -(-n * w // 1024))
         out = g.outmask()
         senders = sum(1 for mk in out if mk)
-        self.work = (n + g.m) * self.unit + (senders + 2 * n + 2) * n * w // 64
+        self.work = (n + g.m) * self.unit + (senders + 4 * n + 4) * n * w // 64
         if self.work > MAX_SEARCH_WORK:
             return  # the tables alone are beyond the limit: run() stops before using them
         # indexed by w (p + 1), the bit length of the guard bit of field p (node v):

@@ -350,7 +350,7 @@ def test_the_stack_is_charged_by_its_size(monkeypatch):
     1..n-1 along its first children holds n stack entries, each with a fresh packed Q
     and its D (2·n·w bits per level, 12 MB for n = 2000; 375 MB for n = 10^4 within
     the default limit when only the tokens were charged). The stack counts one step
-    per 64 bits of its largest size, 2(n + 1)·n·w bits, before the replay starts: here
+    per 64 bits of its largest size, 4(n + 1)·n·w bits, before the replay starts: here
     beyond the limit, so the tree is not replayed, and the graph (not 1-robust) is
     refuted by the linear-time witness pairs instead, in little memory."""
     import tracemalloc
