@@ -168,6 +168,33 @@ def test_public_api_on_the_cluster_writes_the_serial_certificate(cluster, tiny_p
     assert check.holds is False and verdict.valid, verdict.reason
 
 
+@pytest.mark.slow
+def test_workers_start_an_embedded_cluster_only_when_a_search_needs_it(tiny_parts,
+                                                                        monkeypatch):
+    """workers=1: the LocalCluster starts inside the call (a search outlasted 50 states)
+    and the answer and certificate are the serial ones."""
+    from rescon.graphs import robustness as rob
+
+    monkeypatch.setattr(rob, "SEED_SEARCH_SECONDS", 60.0)
+    G = nx.gnp_random_graph(24, 0.5, seed=6, directed=True)
+    clear_cache()
+    serial = rescon.is_r_robust(G, 5, method="search")
+    started = []
+    monkeypatch.setattr(distributed._Cluster, "client", _spy(distributed._Cluster.client,
+                                                              started))
+    clear_cache()
+    split = rescon.is_r_robust(G, 5, method="search", workers=1)
+    assert started and split.holds is serial.holds is True
+    assert split.certificate == serial.certificate
+
+
+def _spy(method, calls):
+    def wrapped(self):
+        calls.append(self.workers)
+        return method(self)
+    return wrapped
+
+
 def test_a_time_limit_stops_the_split_search(cluster):
     ig = index_graph(nx.gnp_random_graph(40, 0.8, seed=1, directed=True))
     import time
