@@ -20,7 +20,7 @@ from __future__ import annotations
 
 __all__ = ["MAX_COST_TREE_WORK", "bound", "install", "replay"]
 
-MAX_COST_TREE_WORK = 25_000_000  # n per replayed state (~10 s)
+MAX_COST_TREE_WORK = 25_000_000  # n·⌈n / 1024⌉ per replayed state (~10 s)
 
 Invalid: type = ValueError  # check.py's exception, bound by install()
 
@@ -89,11 +89,13 @@ def _bits(mask: int):
 def replay(inmask: list[int], r: int, s: int, order: list[int], tree: list[int] | tuple,
            where: str, max_work: int = MAX_COST_TREE_WORK) -> bool:
     """Replay ``tree``: True when every leaf's bound is ≥ s and the tokens are exactly
-    the tree's; False when the replay passes ``max_work`` (n per state; then nothing is
-    decided). Raises ``Invalid`` with the first fault."""
+    the tree's; False when the replay passes ``max_work`` (a state costs n operations on
+    n-bit sets, charged n·⌈n / 1024⌉; then nothing is decided). Raises ``Invalid`` with
+    the first fault."""
     n = len(inmask)
     full = (1 << n) - 1
     mmask = [full & ~inmask[i] & ~(1 << i) for i in range(n)]
+    state_work = n * max(1, -(-n // 1024))
     pos, work, B = 0, 0, 0
     for k in range(n):
         room = n - k
@@ -106,7 +108,7 @@ def replay(inmask: list[int], r: int, s: int, order: list[int], tree: list[int] 
                         raise Invalid(f"{where}.tree ends before the search does "
                                       f"(root {k}, sizes {s1}, {s2})")
                     t = tree[pos]
-                    work += n
+                    work += state_work
                     if work > max_work:
                         return False
                     if t == -1:
