@@ -64,6 +64,8 @@ def _cofactors(D: np.ndarray, perms: np.ndarray, psigns: np.ndarray
                                 np.abs(a2 * b0) + np.abs(a0 * b2),
                                 np.abs(a0 * b1) + np.abs(a1 * b0)])
         return C, Cabs
+    if k in (4, 5):
+        return _cofactors45(D)
     C, Cabs = np.empty((T, k)), np.empty((T, k))
     for j in range(k):
         cols = [t for t in range(k) if t != j]
@@ -77,6 +79,43 @@ def _cofactors(D: np.ndarray, perms: np.ndarray, psigns: np.ndarray
             det = det + psigns[p] * prod
             per = per + aprod
         C[:, j] = (1.0 if (k - 1 + j) % 2 == 0 else -1.0) * det
+        Cabs[:, j] = per
+    return C, Cabs
+
+
+def _minor2(D: np.ndarray, r: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
+    """det and permanent of |·| of rows r, r + 1 and columns a, b (as the numba scan)."""
+    x, y = D[:, r, a] * D[:, r + 1, b], D[:, r, b] * D[:, r + 1, a]
+    return x - y, np.abs(x) + np.abs(y)
+
+
+def _cofactors45(D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The closed forms of the numba scan for k = 4, 5 (:func:`._candidates._cofactors4`,
+    :func:`._candidates._cofactors5`), every operation in the same order: k = 4 expands
+    each 3 × 3 minor along row 0 over the 2 × 2 minors of rows 1, 2; k = 5 each 4 × 4
+    minor along rows 0, 1 over the 2 × 2 minors of rows 0, 1 and 2, 3."""
+    T, _, k = D.shape
+    C, Cabs = np.empty((T, k)), np.empty((T, k))
+    pairs = list(itertools.combinations(range(k), 2))
+    top = {ab: _minor2(D, 0, *ab) for ab in pairs} if k == 5 else {}
+    low = {ab: _minor2(D, 1 if k == 4 else 2, *ab) for ab in pairs}
+    for j in range(k):
+        cols = [t for t in range(k) if t != j]
+        det, per = np.zeros(T), np.zeros(T)
+        if k == 4:
+            sign = 1.0
+            for i in cols:
+                m, p = low[tuple(t for t in cols if t != i)]
+                det = det + sign * D[:, 0, i] * m
+                per = per + np.abs(D[:, 0, i]) * p
+                sign = -sign
+        else:
+            for u, v in itertools.combinations(range(4), 2):
+                w0, w1 = (t for t in range(4) if t not in (u, v))
+                term = top[cols[u], cols[v]][0] * low[cols[w0], cols[w1]][0]
+                det = det + (term if (1 + u + v) % 2 == 0 else -term)
+                per = per + top[cols[u], cols[v]][1] * low[cols[w0], cols[w1]][1]
+        C[:, j] = det if (k - 1 + j) % 2 == 0 else -det
         Cabs[:, j] = per
     return C, Cabs
 
