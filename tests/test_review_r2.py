@@ -215,3 +215,22 @@ def test_diameter_equals_the_exact_one_through_the_calipers_windows(seed, monkey
             exact = _sqrt(max(_dot(d, d) for p in P for q in P
                               for d in [tuple(a - b for a, b in zip(p, q, strict=True))]))
             assert abs(metrics.diameter(X) - exact) <= 4 * 2.0**-53 * exact
+
+
+def test_exact_projection_onto_a_hull_far_from_the_origin(monkeypatch):
+    """150 states on a unit sphere about 1e15 (a grid of 1/8): a state one ulp outside
+    a vertex raised SolverError ("more than 200000 active sets") — the guides' frame
+    took the facets' offsets and the vertices from their floats at 1e15, off by ~ulp
+    ≈ a tenth of the hull, so the active sets ranked first were wrong. Fixed by taking
+    them from the exact facets and vertices (rounded once, about the frame's centre).
+    The projection is the vertex: the distance is 1/8 · √3."""
+    from rescon.consensus.metrics import ValidityMonitor
+
+    rng = np.random.default_rng(5)
+    rng.integers(0, 4, size=(150, 3))
+    X = rng.normal(size=(150, 3))
+    X = X / np.linalg.norm(X, axis=1)[:, None] + 1e15
+    x = np.full(3, 1e15 - 0.75)
+    mon = ValidityMonitor(X)
+    assert not mon.hull.contains(x)
+    assert abs(mon.distance(x) - math.sqrt(3) / 8) <= 4e-16

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import operator
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
@@ -138,9 +139,42 @@ def _from_frame(y: np.ndarray, o: np.ndarray, e: int) -> np.ndarray:
 
 def _framed(K: SafeKernel, o: np.ndarray, e: int):
     """A, b, origin, basis and vertices of Ψ in the frame y = (x − o) / 2^e: the rows
-    A y ≤ (b − A o) / 2^e."""
-    return (K.A, np.ldexp(K.b / 4 - K.A @ (o / 4), 2 - e),
-            _to_frame(K.affine_origin, o, e), K.affine_basis, _to_frame(K.vertices, o, e))
+    A y ≤ (b − A o) / 2^e, from :func:`_offsets` (the origin is the first vertex)."""
+    D, c = _offsets(K, o)
+    V = np.ldexp(D, 2 - e)
+    return K.A, np.ldexp(c, 2 - e), V[0], K.affine_basis, V
+
+
+def _offsets(K: SafeKernel, o: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(v − o) / 4 for the exact vertices v and (b − A o) / 4 for the rows, each
+    rounded once from its exact value (kept in K's cache: o is K's vertex mean):
+    from the floats of v and b, a kernel 1 wide at 1e15 was off by ~ulp(1e15) = 1/8
+    and the guides ranked the wrong active sets (the exact search then exceeded
+    MAX_ACTIVE_SETS). A facet of a full-dimensional Ψ is a·x ≤ β with A's row
+    a / ‖a‖, so its offset is (β − a·o) / ‖a‖; a facet relative to a flat Ψ is tight
+    at a vertex, so its offset is the largest A·(v − o)."""
+    key = ("frame", o.tobytes())
+    if key not in K._cache:
+        ex = K._exact
+        of = [Fraction(float(v)) for v in o]
+        D = np.array([[float((v - w) / 4) for v, w in zip(x, of, strict=True)]
+                      for x in ex.vertices]).reshape(len(ex.vertices), len(of))
+        if ex.kernel_eqs or not len(K.A):
+            c = (K.A @ D.T).max(axis=1) if len(K.A) else np.zeros(0)
+        else:
+            c = np.array([_float((beta - sum(map(operator.mul, a, of))) / (4 * top))
+                          / math.hypot(*(float(v / top) for v in a))
+                          for a, beta in ex.facets for top in [max(map(abs, a))]])
+        K._cache[key] = (D, c)
+    return K._cache[key]
+
+
+def _float(q: Fraction) -> float:
+    """q rounded to a float, ±inf beyond the float range (a guide's offset)."""
+    try:
+        return float(q)
+    except OverflowError:
+        return math.inf if q > 0 else -math.inf
 
 
 def _geometric_guide(A, b, origin, B, V, dim: int, m: np.ndarray) -> np.ndarray:
