@@ -234,3 +234,21 @@ def test_exact_projection_onto_a_hull_far_from_the_origin(monkeypatch):
     mon = ValidityMonitor(X)
     assert not mon.hull.contains(x)
     assert abs(mon.distance(x) - math.sqrt(3) / 8) <= 4e-16
+
+
+def test_exact_projection_onto_a_subnormal_hull():
+    """States one ulp outside a hull of subnormal states (k · 2^-1074, |k| ≤ 50, on a
+    sphere): the frame divided the floats by 4 before scaling them up, which rounds
+    subnormals to a few bits, and the projection raised SolverError (> 200000 active
+    sets). Every distance is now found, 0 exactly for the states in the hull."""
+    from rescon.consensus.metrics import ValidityMonitor
+
+    rng = np.random.default_rng(11)
+    X = rng.normal(size=(150, 3))
+    X = np.round(X / np.linalg.norm(X, axis=1)[:, None] * 50) * 5e-324
+    mon = ValidityMonitor(X)
+    V, c = mon.hull.vertices, X.mean(axis=0)
+    S = np.array([np.nextafter(v, v + (v - c)) for v in V[:40]])
+    dist = mon.distances(S)
+    assert ((dist == 0) == np.array([mon.hull.contains(x) for x in S])).all()
+    assert (dist[dist > 0] <= 2 * 5e-324).all()  # one step per coordinate: ≤ √3 ulp

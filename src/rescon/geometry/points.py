@@ -128,8 +128,10 @@ def _frame(K: SafeKernel, m: np.ndarray | None = None) -> tuple[np.ndarray, int]
 
 
 def _to_frame(x: np.ndarray, c: np.ndarray, e: int) -> np.ndarray:
-    """(x − c) / 2^e in floats, without overflow in between (a hint's precision)."""
-    return np.ldexp(x / 4 - c / 4, 2 - e)
+    """(x − c) / 2^e for a point x, each entry rounded once from its exact value
+    (no overflow in between, no bits lost to subnormal differences)."""
+    return np.array([_float((Fraction(float(a)) - Fraction(float(b))) / Fraction(2) ** e)
+                     for a, b in zip(x, c, strict=True)])
 
 
 def _from_frame(y: np.ndarray, o: np.ndarray, e: int) -> np.ndarray:
@@ -140,32 +142,37 @@ def _from_frame(y: np.ndarray, o: np.ndarray, e: int) -> np.ndarray:
 def _framed(K: SafeKernel, o: np.ndarray, e: int):
     """A, b, origin, basis and vertices of Ψ in the frame y = (x − o) / 2^e: the rows
     A y ≤ (b − A o) / 2^e, from :func:`_offsets` (the origin is the first vertex)."""
-    D, c = _offsets(K, o)
-    V = np.ldexp(D, 2 - e)
-    return K.A, np.ldexp(c, 2 - e), V[0], K.affine_basis, V
+    D, c, t = _offsets(K, o)
+    V = np.ldexp(D, -t - e)
+    return K.A, np.ldexp(c, -t - e), V[0], K.affine_basis, V
 
 
-def _offsets(K: SafeKernel, o: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(v − o) / 4 for the exact vertices v and (b − A o) / 4 for the rows, each
-    rounded once from its exact value (kept in K's cache: o is K's vertex mean):
-    from the floats of v and b, a kernel 1 wide at 1e15 was off by ~ulp(1e15) = 1/8
-    and the guides ranked the wrong active sets (the exact search then exceeded
-    MAX_ACTIVE_SETS). A facet of a full-dimensional Ψ is a·x ≤ β with A's row
-    a / ‖a‖, so its offset is (β − a·o) / ‖a‖; a facet relative to a flat Ψ is tight
-    at a vertex, so its offset is the largest A·(v − o)."""
+def _offsets(K: SafeKernel, o: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """(v − o)·2^t for the exact vertices v and (b − A o)·2^t for the rows, each
+    rounded once from its exact value, with max |v − o|·2^t ∈ [1/2, 2) (no overflow,
+    no subnormal); kept in K's cache (o is K's vertex mean). From the floats of v and
+    b, a kernel 1 wide at 1e15 was off by ~ulp(1e15) = 1/8, one of subnormal states
+    by its own size, and the guides ranked the wrong active sets (the exact search
+    then exceeded MAX_ACTIVE_SETS). A facet of a full-dimensional Ψ is a·x ≤ β with
+    A's row a / ‖a‖, so its offset is (β − a·o) / ‖a‖; a facet relative to a flat Ψ
+    is tight at a vertex, so its offset is the largest A·(v − o)."""
     key = ("frame", o.tobytes())
     if key not in K._cache:
         ex = K._exact
         of = [Fraction(float(v)) for v in o]
-        D = np.array([[float((v - w) / 4) for v, w in zip(x, of, strict=True)]
-                      for x in ex.vertices]).reshape(len(ex.vertices), len(of))
+        diffs = [[v - w for v, w in zip(x, of, strict=True)] for x in ex.vertices]
+        top = max((abs(q) for row in diffs for q in row), default=Fraction(0))
+        t = top.denominator.bit_length() - top.numerator.bit_length() if top else 0
+        unit = Fraction(2) ** t
+        D = np.array([[float(q * unit) for q in row] for row in diffs]).reshape(
+            len(diffs), len(of))
         if ex.kernel_eqs or not len(K.A):
             c = (K.A @ D.T).max(axis=1) if len(K.A) else np.zeros(0)
         else:
-            c = np.array([_float((beta - sum(map(operator.mul, a, of))) / (4 * top))
-                          / math.hypot(*(float(v / top) for v in a))
-                          for a, beta in ex.facets for top in [max(map(abs, a))]])
-        K._cache[key] = (D, c)
+            c = np.array([_float((beta - sum(map(operator.mul, a, of))) * unit / m)
+                          / math.hypot(*(float(v / m) for v in a))
+                          for a, beta in ex.facets for m in [max(map(abs, a))]])
+        K._cache[key] = (D, c, t)
     return K._cache[key]
 
 
