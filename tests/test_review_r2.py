@@ -5,8 +5,9 @@ exact oracle (Fractions) on small inputs."""
 from __future__ import annotations
 
 import math
+import warnings
 from fractions import Fraction
-from itertools import combinations
+from itertools import combinations, product
 
 import numpy as np
 import pytest
@@ -252,3 +253,17 @@ def test_exact_projection_onto_a_subnormal_hull():
     dist = mon.distances(S)
     assert ((dist == 0) == np.array([mon.hull.contains(x) for x in S])).all()
     assert (dist[dist > 0] <= 2 * 5e-324).all()  # one step per coordinate: ≤ √3 ulp
+
+
+def test_state_on_a_hull_triangle_in_floats_raises_no_warning():
+    """A subnormal state just inside the corner of an integer grid's hull (the float
+    closest point of a triangle is the state itself: distance 0): the lower bound of
+    triangle_distances divided by it and numpy warned "divide by zero" on every such
+    state of a run. Its distance is 0 (it lies in the hull), with no warning."""
+    from rescon.consensus.metrics import ValidityMonitor
+
+    X = np.array(list(product(range(4), repeat=3)) + [(1, 2, 3)], dtype=float)
+    mon = ValidityMonitor(X)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert mon.distances(np.full((1, 3), 5e-324)).tolist() == [0.0]

@@ -379,7 +379,7 @@ class ValidityMonitor:
         for s in range(0, len(X), 256):
             rows.append(_closest_on_triangles(X[s:s + 256], A, B, C))
         Y = np.concatenate(rows) if rows else np.empty((0, 3))
-        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
             n = X - Y
             dist = np.sqrt((n * n).sum(axis=1))
             V = self.hull.vertices
