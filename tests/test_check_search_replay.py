@@ -295,11 +295,12 @@ def _leaf_list_cert(n: int, edges: list[list[int]]) -> dict:
 def test_a_large_graph_is_answered_within_the_work_limit():
     """n = 3000 without edges (the graph limit accepts it; its replay stops at its first
     leaf): the replay's set-up built a table of n + 1 packed sets of n fields, n² big-int
-    additions outside the work count (~80 s; never ending for n = 10^4)."""
+    additions outside the work count (~80 s; never ending for n = 10^4). The bound is a
+    hang guard, not a speed target: ~1 s now, 40 s leaves room for a loaded machine."""
     t0 = time.perf_counter()
     res = C.check(_leaf_list_cert(3000, []))
     assert res.verdict == "invalid" and "leaf -1 at token 0" in res.reason, res
-    assert time.perf_counter() - t0 < 10
+    assert time.perf_counter() - t0 < 40
 
 
 def test_tables_beyond_the_work_limit_are_not_built(monkeypatch):
