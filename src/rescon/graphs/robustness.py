@@ -43,6 +43,7 @@ from .search import (
     cost_tree,
     decide_r_robust,
     min_cost_pair,
+    search_order,
 )
 
 __all__ = [
@@ -77,7 +78,9 @@ class RobustnessReport:
     s_witness : (S1, S2) showing G is not (r_max, s_max + 1)-robust, None if s_max = n;
         when only s* hit the time limit, the cheapest pair found (not (r_max, s_upper + 1)).
     lower_proof : how r_max was proven ("trivial", "degree", "complete",
-        "construction", "spectral", "implied", "search", "milp", "dp").
+        "construction", "spectral", "implied", "search", "milp", "dp", or
+        "cost_search": the replayable tree below s = 1 attached to a search or MILP
+        decision whose own proof the checker cannot replay).
     certificate : JSON-ready ``robustness`` certificate (certificates/FORMAT.md).
     exact : False only when ``time_limit`` cut the search; then ρ ∈ [r_lower, r_upper],
         and when ρ was settled but s*(ρ) was not, s*(ρ) ∈ [s_lower, s_upper].
@@ -235,9 +238,34 @@ def _decide_r(
     refuted = facts.upper(r)
     if refuted is not None and refuted[0] == 0:
         return _Decision(False, pair=refuted[1])
-    dec = _decide_r_fresh(ig, r, method, deadline, seeds, known_pair, on_progress)
+    dec = _replayable(ig, r, _decide_r_fresh(ig, r, method, deadline, seeds, known_pair,
+                                             on_progress), deadline)
     _remember(facts, r, 1, dec)
     return dec
+
+
+def _replayable(ig: IndexedGraph, r: int, dec: _Decision, deadline: float | None) -> _Decision:
+    """``dec`` with a proof the checker replays, where one is cheap: a ``search`` proof
+    without its tree (beyond MAX_TREE_TOKENS) or a ``milp`` proof (n ≤ 64) becomes the
+    sized search's tree below s = 1 (search.cost_tree: every pair whose sets both keep
+    an r-closed member costs ≥ 1, i.e. r-robustness), if it is recorded within
+    ``TREE_SECONDS`` (dense graphs: 4.9k tokens on ER(30, 0.8), where the decision tree
+    has > 4M). Otherwise ``dec`` unchanged; the answer never changes."""
+    proof = dec.proof
+    if (not dec.holds or proof is None or ig.n > MAX_SEARCH_NODES
+            or not (proof["method"] == "milp"
+                    or proof["method"] == "search" and proof["tree"] is None)):
+        return dec
+    stop = time.perf_counter() + TREE_SECONDS
+    try:
+        tree = cost_tree(ig, r, 1, deadline=stop if deadline is None else min(stop, deadline))
+    except ValueError as exc:
+        raise RESCONError(f"internal error: {r}-robustness was proven, but {exc}") from exc
+    if tree is None:
+        return dec
+    return replace(dec, proof={"method": "cost_search", "order": search_order(ig).tolist(),
+                               "tree": list(tree),
+                               "info": {**proof.get("info", {}), "decided_by": proof["method"]}})
 
 
 def _remember(facts: Facts, r: int, s: int, dec: _Decision) -> None:
