@@ -9,9 +9,10 @@ r-robust).
 Strategy: polynomial bounds first (witness pairs above; degree, complete and
 construction proofs below); only when they do not meet, an exact method: the
 bitmask branch and bound (n ≤ 64, its search tree is the certificate) raced against
-the improved MILP for ρ; for s*, the subset DP (n ≤ 22), else the two s* branch and
-bounds of search.min_cost_pair (charged-set, sized) raced against the MILP (n ≤ 64),
-else the MILP.
+the improved MILP for ρ (when neither leaves a replayable proof, the s* sized search's
+tree below s = 1 proves r-robustness, if it is small: dense graphs); for s*, the
+subset DP (n ≤ 22), else the two s* branch and bounds of search.min_cost_pair
+(charged-set, sized) raced against the MILP (n ≤ 64), else the MILP.
 
 Before any search, every fact already proven about the same graph in this process
 (facts.py: a bounded cache keyed by node labels and edges) is used through the
