@@ -13,8 +13,15 @@ import pytest
 import rescon
 from rescon.errors import RESCONError
 from rescon.graphs import bounds as bd
+from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.robustness import _Decision, _replayable
+
+
+@pytest.fixture(autouse=True)
+def _fresh_facts():
+    """Each test decides its graphs afresh (facts.py caches proofs across calls)."""
+    clear_cache()
 
 
 def _cut_branch(proof):
@@ -41,7 +48,6 @@ def test_dense_er30_robustness_certificate_is_fully_checked():
     assert rescon.check_certificate(bad).verdict == "invalid"
 
 
-@pytest.mark.slow
 def test_milp_proof_of_r_robustness_is_replaced_by_a_replayed_tree():
     """ER(30, 0.8), seed 30001: the MILP's proof of ρ = 12 would be taken on trust
     (n > 20); the attached s = 1 tree is replayed."""
