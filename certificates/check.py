@@ -685,11 +685,11 @@ class _Replay:
         steps = 0
         while todo:
             U ^= todo
-            k = U.bit_count()
-            C = U & ((1 << w * fit[k]) - 1)
-            while C.bit_count() < k:
-                k = C.bit_count()
+            C = U
+            k = C.bit_count()
+            while C >> w * fit[k]:  # members beyond the fields p < fit[k]: cut them
                 C &= (1 << w * fit[k]) - 1
+                k = C.bit_count()
                 steps += 1
             if not C:
                 U = 0
