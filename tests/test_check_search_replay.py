@@ -10,11 +10,8 @@ trees tampered with. Its cores are compared with a from-scratch peel.
 
 from __future__ import annotations
 
-import importlib.util
 import random
-import sys
 import time
-from pathlib import Path
 
 import networkx as nx
 import pytest
@@ -23,22 +20,7 @@ from hypothesis import strategies as st
 
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import decide_r_robust
-
-CHECK_PY = Path(__file__).resolve().parents[1] / "certificates" / "check.py"
-
-
-def _load_checker():
-    """The checker file of this repository (not whatever copy may be installed)."""
-    name = "_rescon_certificates_check_replay_under_test"
-    spec = importlib.util.spec_from_file_location(name, CHECK_PY)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
-    spec.loader.exec_module(mod)
-    return mod
-
-
-C = _load_checker()
-
+from tests.test_checker import C  # the checker file of this repository
 
 # --------------------------------------------------------------------------- #
 # the plain replay of FORMAT.md: every core from scratch
