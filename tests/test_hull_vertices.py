@@ -54,13 +54,21 @@ def planar_sets(draw) -> np.ndarray:
 def test_chain_hull_is_the_exact_hull(X, seed):
     """The monotone-chain hull is the exact polytope safe_kernel(X, 0): dimension,
     exact vertices, exact facets, exact membership and a valid certificate."""
+    assert_is_the_exact_hull(metrics._exact_polygon, X, seed)
+
+
+def assert_is_the_exact_hull(build, X: np.ndarray, seed: int) -> None:
+    """``build(X)`` is the exact polytope safe_kernel(X, 0): dimension, exact vertices,
+    exact facets, exact membership of X and of scaled copies of its points, and a
+    certificate the checker accepts — or both refuse (a facet's float row overflows)."""
     try:
         exact = safe_kernel(X, 0)
     except InputError:  # a facet's float row overflows (1e300): both refuse alike
         with pytest.raises(InputError):
-            metrics._exact_polygon(X)
+            build(X)
         return
-    hull = metrics._exact_polygon(X)
+    hull = build(X)
+    assert hull is not None
     assert hull.dim == exact.dim
     assert hull.exact_vertices == exact.exact_vertices
     assert np.array_equal(hull.vertices, exact.vertices)

@@ -16,11 +16,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from rescon import check_certificate
 from rescon.consensus import metrics
 from rescon.consensus.metrics import ValidityMonitor, certified_hull, diameter
-from rescon.errors import InputError
 from rescon.geometry.kernel import safe_kernel
+from tests.test_hull_vertices import _facet_set, assert_is_the_exact_hull
 
 
 def _sphere(n: int, radius: float = 1.0, seed: int = 0) -> np.ndarray:
@@ -28,10 +27,6 @@ def _sphere(n: int, radius: float = 1.0, seed: int = 0) -> np.ndarray:
     return X / np.linalg.norm(X, axis=1)[:, None] * radius
 
 
-def _facet_set(hull) -> set:
-    """The exact facets a·x ≤ β, each scaled to max|a_j| = 1 (a unique form)."""
-    return {(tuple(v / top for v in a), beta / top)
-            for a, beta in hull._exact.facets for top in (max(map(abs, a)),)}
 
 
 @st.composite
@@ -61,22 +56,7 @@ def test_certified_surface_hull_is_the_exact_hull(X, seed):
     """The certified-surface hull is the exact polytope safe_kernel(X, 0): exact vertices,
     exact facets, exact membership, a certificate the checker accepts (or both refuse
     a facet whose float row overflows)."""
-    try:
-        exact = safe_kernel(X, 0)
-    except InputError:
-        with pytest.raises(InputError):
-            metrics._exact_polytope(X)
-        return
-    hull = metrics._exact_polytope(X)
-    assert hull is not None
-    assert hull.dim == exact.dim == 3
-    assert hull.exact_vertices == exact.exact_vertices
-    assert np.array_equal(hull.vertices, exact.vertices)
-    assert _facet_set(hull) == _facet_set(exact)
-    rng = np.random.default_rng(seed)
-    S = np.r_[X, X[rng.integers(0, len(X), 8)] * rng.choice([0.5, 1.0, 1.5], size=(8, 1))]
-    assert [hull.contains(x) for x in S] == [exact.contains(x) for x in S]
-    assert check_certificate(hull.certificate).valid
+    assert_is_the_exact_hull(metrics._exact_polytope, X, seed)
 
 
 def test_flat_sets_are_left_to_the_kernel():
