@@ -268,6 +268,18 @@ def test_over_the_limit_is_unchecked_beyond_enumeration(monkeypatch):
     assert res.verdict == "valid" and "enumeration" in res.reason, res
 
 
+def _check_with_peak(cert: dict):
+    """(the checker's result, the peak of memory Python allocated while it ran)."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        res = C.check(cert)
+        return res, tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
 def _leaf_list_cert(n: int, edges: list[list[int]]) -> dict:
     return {"rescon_certificate": 1, "kind": "rs_robust", "graph": {"n": n, "edges": edges},
             "r": 1, "s": 1,
@@ -289,17 +301,10 @@ def test_tables_beyond_the_work_limit_are_not_built(monkeypatch):
     """The set-up charge (n + |E| steps of ⌈n·w / 1024⌉) alone beyond MAX_SEARCH_WORK:
     unchecked without building the packed tables (for every node a set of up to n·w
     bits: n²·w bits, gigabytes for the n ≈ 10^5 the graph limit accepts)."""
-    import tracemalloc
-
     n = 2000  # every node sends to node 0, the last field: each table entry has n·w bits
     cert = _leaf_list_cert(n, [[v, 0] for v in range(1, n)] + [[0, v] for v in range(1, n)])
     monkeypatch.setattr(C, "MAX_SEARCH_WORK", 2 * n)
-    tracemalloc.start()
-    try:
-        res = C.check(cert)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    res, peak = _check_with_peak(cert)
     assert res.verdict == "unchecked" and "work limit" in res.unchecked[0], res
     assert peak < 2_000_000, peak  # the tables: n · n·w bits ≈ 6 MB
 
@@ -309,8 +314,6 @@ def test_the_packed_table_is_charged_by_its_size(monkeypatch):
     table of out-neighbour fields holds n·w bits per node, n²·w bits in all (14 MB
     here; 800 MB for n = 20 000 within the default limit, when only n + |E| steps were
     charged). It counts one step per 64 bits: beyond the limit it is not built."""
-    import tracemalloc
-
     n = 3000
     edges = [[v, 0] for v in range(1, n)] + [[0, v] for v in range(1, n)]
     cert = _leaf_list_cert(n, edges)
@@ -318,12 +321,7 @@ def test_the_packed_table_is_charged_by_its_size(monkeypatch):
     setup = (n + len(edges)) * -(-n * w // 1024)
     assert setup < 1_000_000 < setup + n * n * w // 64
     monkeypatch.setattr(C, "MAX_SEARCH_WORK", 1_000_000)
-    tracemalloc.start()
-    try:
-        res = C.check(cert)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    res, peak = _check_with_peak(cert)
     assert res.verdict == "unchecked" and "work limit" in res.unchecked[0], res
     assert peak < 5_000_000, peak
 
@@ -336,18 +334,11 @@ def test_the_stack_is_charged_by_its_size(monkeypatch):
     per 64 bits of its largest size, 4(n + 1)·n·w bits, before the replay starts: here
     beyond the limit, so the tree is not replayed, and the graph (not 1-robust) is
     refuted by the linear-time witness pairs instead, in little memory."""
-    import tracemalloc
-
     n = 2000
     tree = list(range(1, n)) + [-1] * (2 * n)
     cert = {**_leaf_list_cert(n, []), "proof": {"method": "search", "order": list(range(n)),
                                                   "tree": tree}}
     monkeypatch.setattr(C, "MAX_SEARCH_WORK", 1_000_000)
-    tracemalloc.start()
-    try:
-        res = C.check(cert)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    res, peak = _check_with_peak(cert)
     assert res.verdict == "invalid" and "witness pairs" in res.reason, res
     assert peak < 5_000_000, peak
