@@ -241,8 +241,10 @@ def test_bad_options_are_one_line_errors(capsys, tmp_path):
     G = nx.cycle_graph(8)
     with pytest.raises(InputError, match="either scheduler"):
         rescon.robustness(G, scheduler="tcp://127.0.0.1:1", workers=2)
-    with pytest.raises(InputError, match="integer >= 0"):
-        rescon.max_s(G, 1, workers=-1)
+    for bad in (-1, 1.5, True, "2"):
+        with pytest.raises(InputError, match="workers must be a nonnegative integer"):
+            rescon.max_s(G, 1, workers=bad)
+    assert rescon.max_s(G, 1, workers=np.int64(0)) == rescon.max_s(G, 1)  # numpy ints too
     with pytest.raises(InputError, match="search \\(n ≤ 64\\) runs on a cluster; got n = 65"):
         rescon.is_r_robust(nx.cycle_graph(65), 1, workers=2)
     edges = tmp_path / "g.txt"

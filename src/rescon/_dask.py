@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
+from ._validate import integer
 from .errors import InputError, MissingDependency
 
 __all__ = ["CONNECT_SECONDS", "WORKER_SECONDS", "check_workers", "client", "require"]
@@ -21,14 +22,13 @@ CONNECT_SECONDS = 5
 WORKER_SECONDS = 30
 
 
-def check_workers(scheduler: str | None, workers: int | None) -> None:
-    """Refuse both a scheduler and a worker count, or a count that is not an int ≥ 0
-    (0: run serially in this process)."""
+def check_workers(scheduler: str | None, workers: int | None) -> int | None:
+    """``workers`` as a Python int (numpy integers accepted) or None; refuses both a
+    scheduler and a worker count, or a count that is not an integer ≥ 0 (0: run
+    serially in this process)."""
     if scheduler is not None and workers is not None:
         raise InputError("workers: give either scheduler (an existing cluster) or workers")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 0):
-        raise InputError(f"workers must be an integer >= 0; got {workers!r}")
+    return None if workers is None else integer("workers", workers, low=0)
 
 
 def require() -> None:

@@ -113,7 +113,7 @@ def searches_on(scheduler: str | None = None, workers: int | None = None) -> Ite
 
     Raises InputError for both given or a bad count, MissingDependency without dask
     (checked on entry, not when a search first needs the cluster)."""
-    _dask.check_workers(scheduler, workers)
+    workers = _dask.check_workers(scheduler, workers)
     if scheduler is None and not workers:
         yield
         return

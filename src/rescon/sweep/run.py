@@ -47,7 +47,7 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     progress : a bar on stderr (default: when stderr is a terminal).
     """
     g = read_grid(grid)
-    check_workers(scheduler, workers)
+    workers = check_workers(scheduler, workers)
     pd = _pandas()
     folder = _prepare(out, g) if out is not None else None
     cells = g.cells()
