@@ -278,3 +278,24 @@ def test_missing_dask_is_a_one_line_error(monkeypatch, capsys, tmp_path):
     err = capsys.readouterr().err.strip()
     assert "rescon[dask]" in err and "\n" not in err
     assert main(["robustness", str(edges), "--workers", "0"]) == 0  # serial needs no dask
+
+
+def test_cli_r_query_shares_one_cluster(monkeypatch, tmp_path, capsys):
+    """`rescon robustness G --r R --workers N` asks two questions (R-robust? s*(R)?) on
+    one cluster: it prepared one per question before."""
+    made = []
+    real = distributed._Cluster
+
+    class Counted(real):
+        def __init__(self, *args, **kwargs):
+            made.append(args)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(distributed, "_Cluster", Counted)
+    clear_cache()
+    edges = tmp_path / "g.txt"
+    edges.write_text("".join(f"{i} {(i + k) % 9}\n" for i in range(9) for k in (1, 2, 3)))
+    assert main(["robustness", str(edges), "--r", "2", "--workers", "1", "--json"]) == 0
+    out = capsys.readouterr().out
+    assert '"r_robust": true' in out and '"s_max"' in out
+    assert len(made) == 1

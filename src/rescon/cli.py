@@ -71,7 +71,8 @@ def _emit(result: dict[str, Any], as_json: bool, lines: list[str]) -> None:
 
 
 def _cmd_robustness(args: argparse.Namespace) -> int:
-    from .graphs.robustness import is_rs_robust, max_s, robustness
+    from .graphs.distributed import searches_for
+    from .graphs.robustness import is_rs_robust, robustness
     from .io import read_graph
 
     if args.s is not None and args.r is None:
@@ -108,16 +109,9 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         _emit(out, args.json, lines)
         return 0
     if args.s is None:
-        res = is_rs_robust(G, args.r, 1, **kw)
+        with searches_for(G, args.scheduler, args.workers):  # one cluster for both queries
+            res, s_max = _r_robust_and_s_star(G, args)
         _write_certificate(res.certificate, cert_path)
-        s_max: int | None = 0 if res.holds is False else None
-        left = None if args.time_limit is None else args.time_limit - res.seconds
-        if res.holds and (left is None or left > 0):
-            try:
-                s_max = max_s(G, args.r, method=args.method, time_limit=left,
-                              scheduler=args.scheduler, workers=args.workers)
-            except TimeLimitReached:
-                s_max = None
         out = {"r": args.r, "r_robust": res.holds, "s_max": s_max,
                "witness": _pair_json(res.witness)}
         verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
@@ -134,6 +128,23 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
                      f"S2 = {_sorted(res.witness[1])}")
     _emit(out, args.json, lines)
     return 0
+
+
+def _r_robust_and_s_star(G: Any, args: argparse.Namespace) -> tuple[Any, int | None]:
+    """``rescon robustness --r R``: is G R-robust, and s*(R) when it is (0 when it is
+    not, None when the time limit ends first), within one time limit (on the cluster of
+    the caller's ``searches_for`` block, if any)."""
+    from .graphs.robustness import is_rs_robust, max_s
+
+    res = is_rs_robust(G, args.r, 1, time_limit=args.time_limit, method=args.method)
+    s_max: int | None = 0 if res.holds is False else None
+    left = None if args.time_limit is None else args.time_limit - res.seconds
+    if res.holds and (left is None or left > 0):
+        try:
+            s_max = max_s(G, args.r, method=args.method, time_limit=left)
+        except TimeLimitReached:
+            s_max = None
+    return res, s_max
 
 
 def _cmd_kernel(args: argparse.Namespace) -> int:
