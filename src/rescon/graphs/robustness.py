@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+from rescon_certificates.check import MAX_ENUM_N
 
 from .._progress import progress_bar
 from .._validate import integer
@@ -246,27 +247,38 @@ def _decide_r(
 
 
 def _replayable(ig: IndexedGraph, r: int, dec: _Decision, deadline: float | None) -> _Decision:
-    """``dec`` with a proof the checker replays, where one is cheap: a ``search`` proof
-    without its tree (beyond MAX_TREE_TOKENS) or a ``milp`` proof (n ≤ 64) becomes the
-    sized search's tree below s = 1 (search.cost_tree: every pair whose sets both keep
-    an r-closed member costs ≥ 1, i.e. r-robustness), if it is recorded within
-    ``TREE_SECONDS`` (dense graphs: 4.9k tokens on ER(30, 0.8), where the decision tree
-    has > 4M). Otherwise ``dec`` unchanged; the answer never changes."""
-    proof = dec.proof
-    if (not dec.holds or proof is None or ig.n > MAX_SEARCH_NODES
-            or not (proof["method"] == "milp"
-                    or proof["method"] == "search" and proof["tree"] is None)):
+    """``dec`` with its proof of r-robustness made replayable where that is cheap
+    (:func:`_replayed`, s = 1); a refutation is kept. The answer never changes."""
+    if not dec.holds or dec.proof is None:
         return dec
+    proof = _replayed(ig, r, 1, dec.proof, deadline)
+    return dec if proof is dec.proof else replace(dec, proof=proof)
+
+
+def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | None) -> Proof:
+    """``proof`` of (r, s)-robustness, or one the checker replays where that is cheap: a
+    ``milp`` proof, a ``search`` or ``cost_search`` proof without its tree (beyond
+    MAX_TREE_TOKENS, or the charged-set engine settled s*), or a ``dp`` proof beyond the
+    checker's own enumeration (n > MAX_ENUM_N) becomes the sized search's tree below s
+    (search.cost_tree: every pair whose sets both keep an r-closed member costs ≥ s,
+    i.e. (r, s)-robustness), if it is recorded within ``TREE_SECONDS`` (dense graphs:
+    4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M); the
+    deciding method stays in ``info.decided_by``. Otherwise ``proof`` itself."""
+    method = proof["method"]
+    if (ig.n > MAX_SEARCH_NODES
+            or not (method == "milp" or method == "dp" and ig.n > MAX_ENUM_N
+                    or method in ("search", "cost_search") and proof.get("tree") is None)):
+        return proof
     stop = time.perf_counter() + TREE_SECONDS
     try:
-        tree = cost_tree(ig, r, 1, deadline=stop if deadline is None else min(stop, deadline))
+        tree = cost_tree(ig, r, s, deadline=stop if deadline is None else min(stop, deadline))
     except ValueError as exc:
-        raise RESCONError(f"internal error: {r}-robustness was proven, but {exc}") from exc
+        raise RESCONError(f"internal error: ({r}, {s})-robustness was proven, "
+                          f"but {exc}") from exc
     if tree is None:
-        return dec
-    return replace(dec, proof={"method": "cost_search", "order": search_order(ig).tolist(),
-                               "tree": list(tree),
-                               "info": {**proof.get("info", {}), "decided_by": proof["method"]}})
+        return proof
+    return {"method": "cost_search", "order": search_order(ig).tolist(), "tree": list(tree),
+            "info": {**proof.get("info", {}), "decided_by": method}}
 
 
 def _remember(facts: Facts, r: int, s: int, dec: _Decision) -> None:
@@ -426,6 +438,8 @@ def _s_star(
     facts = facts_for(ig)
     ss = _s_star_fresh(ig, r, method, deadline, seeds, r_proof, candidates + facts.pairs,
                        facts.lower(r), cap, on_progress)
+    if ss.value is not None and ss.proof is not None:
+        ss = replace(ss, proof=_replayed(ig, r, ss.lower, ss.proof, deadline))
     if ss.proof is not None:
         facts.add_proof(r, ss.lower, ss.proof)
     facts.add_pair(ss.pair)
@@ -488,7 +502,7 @@ def _s_star_fresh(
         return _SStar(cost, cost, cost, {"method": "dp"}, dp_pair, "dp")
     if method == "search":
         found = _deepening_search(ig, r, lower, upper, deadline, on_progress=on_progress)
-        return _cost_search_result(ig, r, found, lower, upper, proof, pair, deadline)
+        return _cost_search_result(ig, r, found, lower, upper, proof, pair)
     milp = _milp_s(ig, r, lower, upper, deadline, on_progress)
     return _milp_s_result(ig, r, milp.outcome(), lower, upper, proof, pair)
 
@@ -543,12 +557,9 @@ def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper
 
 
 def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, upper: int,
-                        proof: Proof, pair: bd.Pair | None,
-                        deadline: float | None = None) -> _SStar:
-    """s*(r) from the s* branch and bounds (see search.min_cost_pair); when the sized
-    search settled the value, its proof carries that search's tree below it, if one
-    is recorded within ``TREE_SECONDS`` (search.cost_tree; the checker replays it; the
-    sized search on graphs where the charged-set one won would mostly waste the time)."""
+                        proof: Proof, pair: bd.Pair | None) -> _SStar:
+    """s*(r) from the s* branch and bounds (see search.min_cost_pair); its proof gets
+    the sized search's tree in :func:`_s_star` (:func:`_replayed`)."""
     if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
@@ -562,15 +573,10 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
         if out.floor > lower:  # finished deepening rounds proved more than the bounds
             lower, proof = out.floor, search_proof
         return _SStar(None, lower, upper, proof, pair, "search")
-    if out.engine == "sized":
-        stop = time.perf_counter() + TREE_SECONDS
-        tree = cost_tree(ig, r, upper, deadline=stop if deadline is None else min(stop, deadline))
-        if tree is not None:
-            search_proof["tree"] = list(tree)
     return _SStar(upper, upper, upper, search_proof, pair, "search")
 
 
-TREE_SECONDS = 2.0  # budget for recording the s* proof tree (search.cost_tree)
+TREE_SECONDS = 2.0  # budget for recording a replayable proof tree (search.cost_tree)
 
 
 DEEPEN_CHEAP_SECONDS = 0.1
@@ -616,7 +622,7 @@ def _race_s(ig: IndexedGraph, r: int, lower: int, upper: int, proof: Proof,
         raise
     if out.status != "stopped" or (deadline is not None and time.perf_counter() > deadline):
         milp.cancel()
-        return _cost_search_result(ig, r, out, lower, upper, proof, pair, deadline)
+        return _cost_search_result(ig, r, out, lower, upper, proof, pair)
     return _milp_s_result(ig, r, milp.outcome(), lower, upper, proof, pair)
 
 
