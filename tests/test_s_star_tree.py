@@ -5,8 +5,6 @@ is attached instead, and the checker replays it."""
 
 from __future__ import annotations
 
-import json
-
 import networkx as nx
 import pytest
 
@@ -15,20 +13,13 @@ from rescon.errors import RESCONError
 from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.robustness import _replayed
+from tests.test_rho_tree import _cut_branch
 
 
 @pytest.fixture(autouse=True)
 def _fresh_facts():
     """Each test decides its graphs afresh (facts.py caches proofs across calls)."""
     clear_cache()
-
-
-def _cut_branch(proof):
-    """A copy of ``proof`` whose first branch token is cut to a leaf."""
-    bad = json.loads(json.dumps(proof))
-    tree = bad["tree"]
-    tree[next(k for k, t in enumerate(tree) if t >= 0)] = -1
-    return bad
 
 
 def _cert(ig, r, s, proof):
