@@ -404,23 +404,103 @@ def _basis_of(H, T: list[int], k: int) -> list[int]:
 def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     """For each list T of k rows, the point where their hyperplanes meet, homogeneous
     (w, y) with w > 0 and primitive, or None if they do not meet in one point: (w, y)
-    spans the null space of the k × (k+1) integer matrix with rows (−b_h, a_h). (The
-    hyperplanes share data points, so the minors share large factors — a third to
-    two thirds of their bits in d = 4-5 — which the gcd removes for everything
-    downstream.)"""
+    spans the null space of the k × (k+1) integer matrix E_T with rows e_h = (−b_h, a_h).
+
+    The rows are hyperplanes through data points, and :func:`_meet` solves through
+    them, on far smaller integers than the cross product of E_T (whose minors share
+    factors of a third to two thirds of their bits): when det A_T ≠ 0 — shown modulo a
+    prime (:func:`_det_mod`; a multiple of the prime, ~2^-31 of bases, is left to the
+    cross product of E_T, which is exact either way) — the null space is the line of
+    the vertex, and any nonzero x with E_T x = 0 spans it; its primitive form with
+    x_0 > 0 is the answer."""
     if not Ts:
         return []
-    used = sorted({h for T in Ts for h in T})
-    E = _object_rows([(-b, *a) for a, b in map(H.exact, used)], k + 1)
-    at = {h: i for i, h in enumerate(used)}
-    out: list[tuple[int, ...] | None] = []
-    for row in cross_all(E[np.array([[at[h] for h in T] for T in Ts])]).tolist():
-        if row[0] == 0:
-            out.append(None)
-            continue
-        g = gcd(*row) if row[0] > 0 else -gcd(*row)
-        out.append(tuple(v // g for v in row))
+    B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
+    used, at = np.unique(B, return_inverse=True)
+    at = at.reshape(B.shape)
+    rows = [H.exact(h) for h in used.tolist()]
+    E = _object_rows([(-b, *a) for a, b in rows], k + 1)
+    A = np.array([[v % _PRIME for v in a] for a, _ in rows], dtype=np.int64)
+    sure = _det_mod(A[at], _PRIME) != 0
+    out: list[tuple[int, ...] | None] = [None] * len(Ts)
+    X = np.empty((len(Ts), k + 1), dtype=object)
+    if sure.any():
+        X[sure] = _meet(H, E, B[sure], at[sure], k)
+    if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
+        X[~sure] = cross_all(E[at[~sure]])
+    for p, row in enumerate(X.tolist()):
+        if row[0] != 0:
+            g = gcd(*row) if row[0] > 0 else -gcd(*row)
+            out[p] = tuple(v // g for v in row)
     return out
+
+
+#: a prime below 2^31: a product of two residues fits an int64
+_PRIME = 2_147_483_647
+
+
+def _det_mod(A: np.ndarray, p: int) -> np.ndarray:
+    """det A[i] mod p for the (P, m, m) int64 residues A (entries in [0, p)), by
+    Laplace expansion along the rows (the minors of the first r rows on every r-set of
+    columns), reduced after every product."""
+    m = A.shape[1]
+    minors = {(c,): A[:, 0, c] for c in range(m)}
+    for r in range(1, m):
+        nxt = {}
+        for cols in itertools.combinations(range(m), r + 1):
+            acc = np.zeros(len(A), dtype=np.int64)
+            for i, c in enumerate(cols):
+                term = A[:, r, c] * minors[cols[:i] + cols[i + 1:]] % p
+                acc = acc + term if (r + i) % 2 == 0 else acc - term
+            nxt[cols] = acc % p
+        minors = nxt
+    return minors[tuple(range(m))]
+
+
+def _meet(H, E: np.ndarray, B: np.ndarray, at: np.ndarray, k: int) -> np.ndarray:
+    """For each basis B[i] (k rows with det A ≠ 0; ``at``: their positions in E), a
+    nonzero homogeneous x = (x_0, y) with e_h·x = 0 for h ∈ B[i], through the data points.
+
+    Take a group G of the rows whose hyperplanes share a set Q of k − |G| + 1 data
+    points (two rows through k − 1 common points; else G one row, Q its k points):
+    the points of Q are affinely independent, so flat(Q) has dimension k − |G|, the
+    dimension of ⋂_G H_h (independent rows), and flat(Q) ⊆ ⋂_G H_h: they are equal and
+    hold the vertex. So x = Σ_{q ∈ Q} λ_q (1, q) with M λ = 0 for the other rows,
+    M_{hq} = e_h·(1, q) (brackets of k + 1 data points): λ is the cross product of M
+    (:func:`.exact.cross_all`), nonzero as M has full rank (the vertex is the only
+    point of flat(Q) on the other rows)."""
+    pts = H.through[B]  # (P, k, k): the data points of each row
+    pairs = list(itertools.combinations(range(k), 2))
+    group = np.full(len(B), -1)
+    for g, (i, j) in enumerate(pairs):
+        common = (pts[:, i, :, None] == pts[:, j, None, :]).any(axis=2).sum(axis=1)
+        group[(group < 0) & (common == k - 1)] = g
+    L = _object_rows([(1, *y) for y in H.Yi], k + 1)
+    X = np.empty((len(B), k + 1), dtype=object)
+    paired = group >= 0
+    if paired.any():
+        g = group[paired]
+        ij = np.array(pairs, dtype=np.int64)[g]
+        rest = np.array([[r for r in range(k) if r not in pair] for pair in pairs],
+                        dtype=np.int64).reshape(len(pairs), k - 2)[g]
+        first = pts[paired, ij[:, 0]]  # (P', k)
+        inside = (first[:, :, None] == pts[paired, ij[:, 1]][:, None, :]).any(axis=2)
+        Q = first[inside].reshape(-1, k - 1)
+        X[paired] = _through(E, L, np.take_along_axis(at[paired], rest, axis=1), Q)
+    if not paired.all():
+        X[~paired] = _through(E, L, at[~paired, 1:], pts[~paired, 0])
+    return X
+
+
+def _through(E: np.ndarray, L: np.ndarray, others: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """x = Σ_q λ_q L[q] over the points Q[i] with λ the cross product of M_{hq} =
+    E[h]·L[q], h ∈ others[i] (:func:`_meet`); x = L[q] when no other row is left."""
+    Lq = L[Q]  # (P, r + 1, k + 1)
+    if others.shape[1] == 0:
+        return Lq[:, 0]
+    M = E[others] @ np.swapaxes(Lq, 1, 2)  # (P, r, r + 1)
+    lam = cross_all(M)
+    return (lam[:, :, None] * Lq).sum(axis=1)
 
 
 def _object_rows(rows: list[tuple[int, ...]], width: int) -> np.ndarray:

@@ -1,0 +1,82 @@
+"""The certification of the d = 4-5 fast path (issue 13 §3): its exact vertices from
+the data points (:func:`fastpath._meet`), the modular independence test, and the
+closure, against independent exact computations."""
+
+from __future__ import annotations
+
+import itertools
+import random
+from fractions import Fraction
+from math import gcd
+
+import numpy as np
+import pytest
+
+from rescon.geometry import fastpath
+from rescon.geometry.exact import nullspace_exact
+from rescon.geometry.halfspaces import _int_det
+from tests.test_kernel_d45 import _halfspaces
+
+
+def _reference_vertex(H, T):
+    """The primitive (w, y), w > 0, spanning the null space of the rows (−b, a) of T,
+    by exact Gaussian elimination; None unless it is one finite point."""
+    rows = [[-b, *a] for a, b in map(H.exact, T)]
+    ns = nullspace_exact([[Fraction(v) for v in r] for r in rows])
+    if len(ns) != 1 or ns[0][0] == 0:
+        return None
+    x = ns[0]
+    den = 1
+    for v in x:
+        den = den * v.denominator // gcd(den, v.denominator)
+    z = [int(v * den) for v in x]
+    g = gcd(*z) * (1 if z[0] > 0 else -1)
+    return tuple(v // g for v in z)
+
+
+def _clouds():
+    rng = np.random.default_rng(11)
+    yield rng.normal(size=(16, 4)), 2
+    yield rng.normal(size=(11, 5)), 1
+    yield rng.normal(size=(14, 3)), 2
+    yield rng.normal(size=(12, 2)), 2
+    yield rng.integers(-3, 4, size=(18, 4)).astype(float), 2  # ties, duplicates
+    yield rng.normal(size=(12, 4)) * 10.0 ** rng.integers(-300, 300, size=(12, 1)), 1
+    yield 1.0 + 1e-13 * rng.normal(size=(13, 4)), 1  # converged states
+
+
+@pytest.mark.parametrize("case", range(7))
+def test_vertices_through_the_data_points_equal_the_null_space(case):
+    X, F = list(_clouds())[case]
+    H, hull, _, _ = _halfspaces(X, F)
+    k = hull.dim
+    rng = np.random.default_rng(case)
+    m = len(H)
+    bases = [sorted(rng.choice(m, size=k, replace=False).tolist()) for _ in range(150)]
+    # rows sharing k − 1 data points (the paired case) and dependent sets
+    by_points = {}
+    for h in range(m):
+        for sub in itertools.combinations(sorted(H.through[h].tolist()), k - 1):
+            by_points.setdefault(sub, []).append(h)
+    for hs in list(by_points.values())[:200]:
+        if len(hs) >= 2:
+            rest = rng.choice(m, size=k - 2, replace=False).tolist()
+            bases.append([hs[0], hs[1], *rest])
+    bases.append([0] * k)  # one row k times: no single point
+    bases.append([*rng.choice(m, size=k - 1, replace=False).tolist(),
+                  int(rng.integers(m))])
+    got = fastpath._solve_all(H, bases, k)
+    want = [_reference_vertex(H, T) if len(set(T)) == k else None for T in bases]
+    assert got == want
+    assert any(v is not None for v in got)
+
+
+def test_det_mod_equals_the_exact_determinant():
+    rng = random.Random(4)
+    p = fastpath._PRIME
+    for m in (1, 2, 3, 4, 5):
+        mats = [[[rng.randint(-2**70, 2**70) for _ in range(m)] for _ in range(m)]
+                for _ in range(40)]
+        mats.append([[1] * m for _ in range(m)])  # singular
+        A = np.array([[[v % p for v in row] for row in M] for M in mats], dtype=np.int64)
+        assert fastpath._det_mod(A, p).tolist() == [_int_det(M) % p for M in mats]
