@@ -253,92 +253,110 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
             k: int) -> list[list[int]] | None:
     """The edges of P_S — for each vertex, its neighbours, increasing — if every extreme
     ray of every vertex's tangent cone leads to another vertex, else None. A simple
-    vertex (k tight rows) has a simplicial cone whose rays keep all but one row tight; a
-    non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight along a ray
-    have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆ tight[u], and then
-    it is the other end of the edge (the line meets P_S in that edge). Found through the
-    (k − 1)-subsets of the tight sets (of at most MAX_TIGHT rows; :class:`_RayIndex`) —
-    a ray whose Z is one of them names its vertices — else among the vertices on Z's
-    rarest row. The simple vertices (most of them) are matched all at once."""
-    index = _RayIndex(tight, len(normals), k)
-    if index.simple_ends is None:
-        return None
-    non_simple = [vi for vi, t in enumerate(tight) if t.bit_count() > k]
+    vertex (k tight rows, its basis) has a simplicial cone whose rays keep all but one
+    row tight; a non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight
+    along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆
+    tight[u], and then it is the other end of the edge (the line meets P_S in that
+    edge). Found through the (k − 1)-subsets of the tight sets (:class:`_RayIndex`)."""
+    index = _RayIndex(tight, basis, len(normals), k)
+    non_simple = index.non_simple
     starts = _simplicial_rays(normals, [basis[vi] for vi in non_simple], k)
-    edges = index.simple_ends
+    ray_v: list[int] = []
+    ray_z: list[int] = []
     for vi, start in zip(non_simple, starts, strict=True):
-        ends = set()
         for Z in _tangent_rays(normals, basis[vi], list(_bits(tight[vi])), k, start):
-            u = index.other_end(vi, Z)
-            if u is None:
-                return None
-            ends.add(u)
-        edges[vi] = sorted(ends)
-    return edges
+            ray_v.append(vi)
+            ray_z.append(Z)
+    ends = index.other_ends(ray_v, ray_z)
+    simple_ends = index.simple_ends()
+    if ends is None or simple_ends is None:
+        return None
+    edges: list[set[int]] = [set() for _ in tight]
+    for vi, u in zip(ray_v, ends, strict=True):
+        edges[vi].add(u)
+    for vi, us in zip(index.simple.tolist(), simple_ends, strict=True):
+        edges[vi].update(us)
+    return [sorted(e) for e in edges]
 
 
 class _RayIndex:
     """The vertices by the (k − 1)-subsets of their tight sets (of at most MAX_TIGHT
-    rows), each subset a key: its positions p₁ < … < p_{k−1} in base |S| (int64 —
-    sorted, so the vertices sharing a key are a run). ``simple_ends``: for each simple
-    vertex its neighbours, the other vertex on each of its k keys (its rays' Z), found
-    for all at once (None if some ray leads nowhere; [] for the non-simple ones)."""
+    rows), each subset a key: its positions p₁ < … < p_{k−1} in base |S| (int64 when
+    it fits — sorted, so the vertices sharing a key are a run). A simple vertex's
+    tight set is its basis (``simple_rows``, sorted)."""
 
-    def __init__(self, tight: list[int], n_rows: int, k: int) -> None:
+    def __init__(self, tight: list[int], basis: list[list[int]], n_rows: int, k: int
+                 ) -> None:
         self.tight, self.k = tight, k
         self.weights = [n_rows**i for i in range(k - 1)]
-        self._members: dict[int, list[int]] = {}
+        self._members: dict[int, list[int]] | None = None
+        counts = np.array([t.bit_count() for t in tight], dtype=np.int64)
+        self.simple = np.flatnonzero(counts == k)
+        self.non_simple = np.flatnonzero(counts > k).tolist()
+        self.simple_rows = np.sort(np.array([basis[vi] for vi in self.simple.tolist()],
+                                            dtype=np.int64).reshape(-1, k), axis=1)
         wide = np.int64 if n_rows ** (k - 1) < 2**62 else object  # the keys fit int64?
-        simple = [vi for vi, t in enumerate(tight) if t.bit_count() == k]
-        B = np.array([list(_bits(tight[vi])) for vi in simple], dtype=np.int64).reshape(-1, k)
-        W = np.array(self.weights, dtype=wide)
-        keys = [np.delete(B, j, axis=1) @ W for j in range(k)]  # ray j of each: B_j left out
-        owners = [np.asarray(simple, dtype=np.int64)] * k
-        more_v, more_k = [], []
-        for vi, t in enumerate(tight):
-            if k < t.bit_count() <= MAX_TIGHT:
-                for sub in itertools.combinations(_bits(t), k - 1):
-                    more_v.append(vi)
-                    more_k.append(self._key(sub))
-        K = np.concatenate([*keys, np.array(more_k, dtype=wide)])
-        owner = np.concatenate([*owners, np.array(more_v, dtype=np.int64)])
+        self.W = np.array(self.weights, dtype=wide)
+        keys, owners = [], []
+        groups = [(self.simple, self.simple_rows)]
+        for t in range(k + 1, MAX_TIGHT + 1):  # the non-simple ones, by their size t
+            vs = [vi for vi in self.non_simple if counts[vi] == t]
+            if vs:
+                groups.append((np.array(vs, dtype=np.int64),
+                               np.array([list(_bits(tight[vi])) for vi in vs], dtype=np.int64)))
+        for vs, rows in groups:
+            combos = np.array(list(itertools.combinations(range(rows.shape[1]), k - 1)),
+                              dtype=np.int64)
+            keys.append((rows[:, combos] @ self.W).ravel())
+            owners.append(np.repeat(vs, len(combos)))
+        K = np.concatenate(keys)
         order = np.argsort(K, kind="stable")
-        self.keys, self.owners = K[order], owner[order]
-        edges: list[list[int]] = [[] for _ in tight]
-        self.simple_ends = edges
-        if not simple:
-            return
-        # the run of each simple vertex's key: its other member is the ray's other end
-        lo = np.searchsorted(self.keys, K[:len(simple) * k], side="left")
-        hi = np.searchsorted(self.keys, K[:len(simple) * k], side="right")
-        own = owner[:len(simple) * k]
+        self.keys, self.owners = K[order], np.concatenate(owners)[order]
+
+    def simple_ends(self) -> list[list[int]] | None:
+        """For each simple vertex, the other ends of its k rays (all at once: the ray
+        leaving row j keeps the others, a key, and every vertex registered under it
+        lies on the ray's line), or None if one leads nowhere."""
+        if not len(self.simple):
+            return []
+        k, B = self.k, self.simple_rows
+        K = np.stack([np.delete(B, j, axis=1) @ self.W for j in range(k)], axis=1)
+        lo = np.searchsorted(self.keys, K, side="left")
+        hi = np.searchsorted(self.keys, K, side="right")
+        own = self.simple[:, None]
         first = self.owners[lo]
-        second = self.owners[np.minimum(lo + 1, len(order) - 1)]
+        second = self.owners[np.minimum(lo + 1, len(self.owners) - 1)]
         other = np.where(first != own, first, np.where(hi - lo >= 2, second, -1))
-        ends = other.reshape(k, len(simple)).T.tolist()
-        for s, (vi, row) in enumerate(zip(simple, ends, strict=True)):
-            for j, u in enumerate(row):
-                if u < 0:  # no other registered vertex on the line: scan
-                    u = self._scan(vi, tight[vi] ^ (1 << int(B[s, j])))
-                    if u is None:
-                        self.simple_ends = None
-                        return
-                    row[j] = u
-            edges[vi] = sorted(set(row))
+        out = other.tolist()
+        for s in np.flatnonzero((other < 0).any(axis=1)).tolist():  # none registered: scan
+            vi = int(self.simple[s])
+            for j in np.flatnonzero(other[s] < 0).tolist():
+                u = self._scan(vi, self.tight[vi] ^ (1 << int(B[s, j])))
+                if u is None:
+                    return None
+                out[s][j] = u
+        return out
 
-    def _key(self, positions) -> int:
-        return sum(p * w for p, w in zip(positions, self.weights, strict=True))
-
-    def other_end(self, vi: int, Z: int) -> int | None:
-        """A vertex u ≠ vi with Z ⊆ tight[u], or None."""
-        if Z.bit_count() == self.k - 1:
-            key = self._key(_bits(Z))
-            lo = int(np.searchsorted(self.keys, key, side="left"))
-            hi = int(np.searchsorted(self.keys, key, side="right"))
-            u = next((int(u) for u in self.owners[lo:hi] if u != vi), None)
-            if u is not None:
-                return u
-        return self._scan(vi, Z)
+    def other_ends(self, ray_v: list[int], ray_z: list[int]) -> list[int] | None:
+        """For each ray (vertex v, tight rows Z), a vertex u ≠ v with Z ⊆ tight[u]: among
+        those registered under the key of Z's first k − 1 rows (every u with Z ⊆ tight[u]
+        and at most MAX_TIGHT rows is), else by :meth:`_scan`; None if one has none."""
+        if not ray_v:
+            return []
+        first = [list(itertools.islice(_bits(Z), self.k - 1)) for Z in ray_z]
+        K = np.array(first, dtype=np.int64).reshape(-1, self.k - 1) @ self.W
+        lo = np.searchsorted(self.keys, K, side="left").tolist()
+        hi = np.searchsorted(self.keys, K, side="right").tolist()
+        owners, tight = self.owners.tolist(), self.tight
+        out = []
+        for v, Z, a, b in zip(ray_v, ray_z, lo, hi, strict=True):
+            u = next((u for u in owners[a:b] if u != v and tight[u] & Z == Z), None)
+            if u is None:
+                u = self._scan(v, Z)
+                if u is None:
+                    return None
+            out.append(u)
+        return out
 
     def _scan(self, vi: int, Z: int) -> int | None:
         """A vertex u ≠ vi with Z ⊆ tight[u] among those on Z's rarest row."""
@@ -347,7 +365,8 @@ class _RayIndex:
 
     def _on(self, h: int) -> list[int]:
         """The vertices tight on row h (all rows' lists built on first use)."""
-        if not self._members:
+        if self._members is None:
+            self._members = {}
             for u, t in enumerate(self.tight):
                 for g in _bits(t):
                     self._members.setdefault(g, []).append(u)
