@@ -107,7 +107,10 @@ def test_tangent_rays_equal_brute_force(k, extra, data):
     normals = basis + more
     # pointed: the basis rows alone make the cone pointed; keep it nonzero
     T = list(range(len(normals)))
-    start = fastpath._simplicial_rays(normals, [list(range(k))], k)[0]
+    R = np.empty((k, k - 1, k), dtype=object)  # the basis's rays: −e_j (cone d ≥ 0)
+    R[:] = [[normals[g] for g in range(k) if g != h] for h in range(k)]
+    start = [tuple(-v for v in d) if fastpath._dot(normals[h], d) > 0 else tuple(d)
+             for h, d in enumerate(cross_all(R).tolist())]
     got = fastpath._tangent_rays(normals, list(range(k)), T, k, start)
     assert len(got) == len(set(got))
     assert set(got) == _brute_rays(normals, T, k)

@@ -80,3 +80,31 @@ def test_det_mod_equals_the_exact_determinant():
         mats.append([[1] * m for _ in range(m)])  # singular
         A = np.array([[[v % p for v in row] for row in M] for M in mats], dtype=np.int64)
         assert fastpath._det_mod(A, p).tolist() == [_int_det(M) % p for M in mats]
+
+
+@pytest.mark.parametrize("case", range(7))
+def test_simplicial_rays_through_the_data_points_are_the_null_directions(case):
+    """Each ray of a basis's simplicial cone spans the null space of the other k − 1
+    normals and points into a_h·d < 0 (brute force: exact elimination)."""
+    X, F = list(_clouds())[case]
+    H, hull, _, _ = _halfspaces(X, F)
+    k = hull.dim
+    rng = np.random.default_rng(case)
+    tries = [sorted(rng.choice(len(H), size=k, replace=False).tolist()) for _ in range(80)]
+    bases = [T for T, v in zip(tries, fastpath._solve_all(H, tries, k), strict=True)
+             if v is not None]
+    S_set = sorted({h for T in bases for h in T})
+    where = {h: i for i, h in enumerate(S_set)}
+    normals = [H.exact(h)[0] for h in S_set]
+    pos = [[where[h] for h in T] for T in bases]
+    got = fastpath._simplicial_rays(H, S_set, normals, pos, k)
+    assert len(got) == len(bases) > 0
+    for T, rays in zip(bases, got, strict=True):
+        for h, d in zip(T, rays, strict=True):
+            ns = nullspace_exact([[Fraction(v) for v in H.exact(g)[0]] for g in T if g != h])
+            assert len(ns) == 1
+            # d is a positive multiple of ±ns[0], on the side a_h·d < 0
+            ratio = {Fraction(x) / y for x, y in zip(d, ns[0], strict=True) if y != 0}
+            assert len(ratio) == 1 and all(x == 0 for x, y in zip(d, ns[0], strict=True)
+                                           if y == 0)
+            assert fastpath._dot(H.exact(h)[0], d) < 0

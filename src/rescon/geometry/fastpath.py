@@ -27,6 +27,7 @@ rows were dependent) — returns None and the caller clips exactly (:mod:`.polyt
 from __future__ import annotations
 
 import itertools
+import operator
 from math import gcd
 
 import numpy as np
@@ -234,7 +235,8 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         if slack == 0 and h in where:
             tight[vi] |= 1 << where[h]
     normals = [H.exact(h)[0] for h in S_set]
-    edges = _closed(tight, basis, normals, k)
+    edges = _closed(tight, basis, normals, k,
+                    lambda bases: _simplicial_rays(H, S_set, normals, bases, k))
     if edges is None:
         return None
     P = ExactPolytope(k, unit=scale)
@@ -250,7 +252,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
 
 
 def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
-            k: int) -> list[list[int]] | None:
+            k: int, start_rays) -> list[list[int]] | None:
     """The edges of P_S — for each vertex, its neighbours, increasing — if every extreme
     ray of every vertex's tangent cone leads to another vertex, else None. A simple
     vertex (k tight rows, its basis) has a simplicial cone whose rays keep all but one
@@ -260,7 +262,7 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     edge). Found through the (k − 1)-subsets of the tight sets (:class:`_RayIndex`)."""
     index = _RayIndex(tight, basis, len(normals), k)
     non_simple = index.non_simple
-    starts = _simplicial_rays(normals, [basis[vi] for vi in non_simple], k)
+    starts = start_rays([basis[vi] for vi in non_simple])
     ray_v: list[int] = []
     ray_z: list[int] = []
     for vi, start in zip(non_simple, starts, strict=True):
@@ -437,9 +439,8 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
     used, at = np.unique(B, return_inverse=True)
     at = at.reshape(B.shape)
-    rows = [H.exact(h) for h in used.tolist()]
-    E = _object_rows([(-b, *a) for a, b in rows], k + 1)
-    A = np.array([[v % _PRIME for v in a] for a, _ in rows], dtype=np.int64)
+    E = _homogeneous(H, used.tolist(), k)
+    A = np.array([[v % _PRIME for v in a] for a in E[:-1, 1:].tolist()], dtype=np.int64)
     sure = _det_mod(A[at], _PRIME) != 0
     out: list[tuple[int, ...] | None] = [None] * len(Ts)
     X = np.empty((len(Ts), k + 1), dtype=object)
@@ -476,38 +477,52 @@ def _det_mod(A: np.ndarray, p: int) -> np.ndarray:
     return minors[tuple(range(m))]
 
 
-def _meet(H, E: np.ndarray, B: np.ndarray, at: np.ndarray, k: int) -> np.ndarray:
-    """For each basis B[i] (k rows with det A ≠ 0; ``at``: their positions in E), a
-    nonzero homogeneous x = (x_0, y) with e_h·x = 0 for h ∈ B[i], through the data points.
+def _homogeneous(H, hs: list[int], k: int) -> np.ndarray:
+    """The rows e_h = (−b_h, a_h) of the halfspaces hs, then the row at infinity
+    (1, 0, …, 0) (x_0 = 0: a direction), as an object array (len(hs) + 1, k + 1)."""
+    return _object_rows([*((-b, *a) for a, b in map(H.exact, hs)), (1, *[0] * k)], k + 1)
+
+
+def _meet(H, E: np.ndarray, R: np.ndarray, at: np.ndarray, k: int,
+          direction: bool = False) -> np.ndarray:
+    """For each row set R[i] (k rows with det A ≠ 0; or, with ``direction``, k − 1 of
+    such a basis and the row at infinity, the last of E; ``at``: R's positions in E),
+    a nonzero homogeneous x = (x_0, y) with e_h·x = 0 for those rows, through the data
+    points (with ``direction``: x_0 = 0 and y the null direction of the k − 1 normals).
 
     Take a group G of the rows whose hyperplanes share a set Q of k − |G| + 1 data
     points (two rows through k − 1 common points; else G one row, Q its k points):
-    the points of Q are affinely independent, so flat(Q) has dimension k − |G|, the
-    dimension of ⋂_G H_h (independent rows), and flat(Q) ⊆ ⋂_G H_h: they are equal and
-    hold the vertex. So x = Σ_{q ∈ Q} λ_q (1, q) with M λ = 0 for the other rows,
-    M_{hq} = e_h·(1, q) (brackets of k + 1 data points): λ is the cross product of M
-    (:func:`.exact.cross_all`), nonzero as M has full rank (the vertex is the only
-    point of flat(Q) on the other rows)."""
-    pts = H.through[B]  # (P, k, k): the data points of each row
-    pairs = list(itertools.combinations(range(k), 2))
-    group = np.full(len(B), -1)
+    the points of Q are affinely independent, so flat(Q) (projective: its points at
+    infinity too) has dimension k − |G|, the dimension of ⋂_G H_h (independent rows),
+    and flat(Q) ⊆ ⋂_G H_h: they are equal and hold the answer. So x = Σ_{q ∈ Q} λ_q
+    (1, q) with M λ = 0 for the other rows, M_{hq} = e_h·(1, q) (brackets of k + 1
+    data points; 1 for the row at infinity): λ is the cross product of M
+    (:func:`.exact.cross_all`), nonzero as M has full rank (the rows, the one at
+    infinity included, are independent, so x spans their null space)."""
+    r = R.shape[1]
+    pts = H.through[R]  # (P, r, k): the data points of each row
+    pairs = list(itertools.combinations(range(r), 2))
+    group = np.full(len(R), -1)
     for g, (i, j) in enumerate(pairs):
         common = (pts[:, i, :, None] == pts[:, j, None, :]).any(axis=2).sum(axis=1)
         group[(group < 0) & (common == k - 1)] = g
     L = _object_rows([(1, *y) for y in H.Yi], k + 1)
-    X = np.empty((len(B), k + 1), dtype=object)
+    X = np.empty((len(R), k + 1), dtype=object)
+    extra = np.full((len(R), int(direction)), len(E) - 1)  # the row at infinity
     paired = group >= 0
     if paired.any():
         g = group[paired]
         ij = np.array(pairs, dtype=np.int64)[g]
-        rest = np.array([[r for r in range(k) if r not in pair] for pair in pairs],
-                        dtype=np.int64).reshape(len(pairs), k - 2)[g]
+        rest = np.array([[c for c in range(r) if c not in pair] for pair in pairs],
+                        dtype=np.int64).reshape(len(pairs), r - 2)[g]
         first = pts[paired, ij[:, 0]]  # (P', k)
         inside = (first[:, :, None] == pts[paired, ij[:, 1]][:, None, :]).any(axis=2)
         Q = first[inside].reshape(-1, k - 1)
-        X[paired] = _through(E, L, np.take_along_axis(at[paired], rest, axis=1), Q)
+        others = np.hstack([np.take_along_axis(at[paired], rest, axis=1), extra[paired]])
+        X[paired] = _through(E, L, others, Q)
     if not paired.all():
-        X[~paired] = _through(E, L, at[~paired, 1:], pts[~paired, 0])
+        X[~paired] = _through(E, L, np.hstack([at[~paired, 1:], extra[~paired]]),
+                              pts[~paired, 0])
     return X
 
 
@@ -530,14 +545,19 @@ def _object_rows(rows: list[tuple[int, ...]], width: int) -> np.ndarray:
     return E
 
 
-def _simplicial_rays(normals: list[tuple[int, ...]], bases: list[list[int]], k: int
-                     ) -> list[list[tuple[int, ...]]]:
-    """For each basis B (k independent rows), the extreme rays of {d : a_h·d ≤ 0, h ∈ B}:
-    for each h ∈ B the null direction of B − {h}, signed so that a_h·d < 0."""
+def _simplicial_rays(H, S_set: list[int], normals: list[tuple[int, ...]],
+                     bases: list[list[int]], k: int) -> list[list[tuple[int, ...]]]:
+    """For each basis B (k independent rows, positions in S_set), the extreme rays of
+    {d : a_h·d ≤ 0, h ∈ B}: for each h ∈ B the null direction of B − {h}
+    (:func:`_meet` with the row at infinity), signed so that a_h·d < 0."""
     if not bases:
         return []
-    N = _object_rows(normals, k)
-    D = cross_all(N[np.array([[g for g in B if g != h] for B in bases for h in B])]).tolist()
+    rows = [[g for g in B if g != h] for B in bases for h in B]
+    used, at = np.unique(np.array(rows, dtype=np.int64), return_inverse=True)
+    S = np.asarray(S_set, dtype=np.int64)
+    E = _homogeneous(H, S[used].tolist(), k)
+    D = _meet(H, E, S[used][at.reshape(len(rows), k - 1)], at.reshape(len(rows), k - 1), k,
+              direction=True)[:, 1:].tolist()
     out = []
     for p, B in enumerate(bases):
         rays = []
@@ -558,32 +578,35 @@ def _tangent_rays(normals: list[tuple[int, ...]], basis: list[int], T: list[int]
     s_p·q − s_q·p for every adjacent pair with s_p = a_h·p > 0 > s_q = a_h·q. Two
     extreme rays are adjacent iff no third ray is tight on every row tight on both (the
     combinatorial test, exact for degenerate cones)."""
-    # (direction, tight rows as a bitset)
+    # (direction, tight rows as a bitset); the last cut needs no new directions
     rays = [(d, sum(1 << g for g in basis if g != h)) for h, d in zip(basis, start, strict=True)]
-    for h in T:
-        if h in basis:
-            continue
+    cuts = [h for h in T if h not in basis]
+    for c, h in enumerate(cuts):
         s = [_dot(normals[h], d) for d, _ in rays]
-        plus = [i for i, v in enumerate(s) if v > 0]
-        minus = [i for i, v in enumerate(s) if v < 0]
+        zs = [z for _, z in rays]
         new = []
-        for p in plus:
-            for q in minus:
-                common = rays[p][1] & rays[q][1]
-                if bin(common).count("1") < k - 2 or any(
-                        (z & common) == common for i, (_, z) in enumerate(rays)
-                        if i != p and i != q):
+        for p, sp in enumerate(s):
+            if sp <= 0:
+                continue
+            for q, sq in enumerate(s):
+                if sq >= 0:
                     continue
-                d = tuple(s[p] * x - s[q] * y for x, y in zip(rays[q][0], rays[p][0],
-                                                                 strict=True))
-                new.append((_primitive_direction(d), common | 1 << h))
+                common = zs[p] & zs[q]
+                # adjacent: no third ray tight on all of common (p and q are)
+                if common.bit_count() < k - 2 or sum(
+                        z & common == common for z in zs) > 2:
+                    continue
+                d = None if c == len(cuts) - 1 else _primitive_direction(
+                    tuple(sp * x - sq * y for x, y in zip(rays[q][0], rays[p][0],
+                                                          strict=True)))
+                new.append((d, common | 1 << h))
         rays = [(d, z | (1 << h if v == 0 else 0)) for (d, z), v in zip(rays, s, strict=True)
                 if v <= 0] + new
     return [z for _, z in rays]
 
 
 def _dot(a: tuple[int, ...], d: tuple[int, ...]) -> int:
-    return sum(x * y for x, y in zip(a, d, strict=True))
+    return sum(map(operator.mul, a, d))
 
 
 def _primitive_direction(d: tuple[int, ...]) -> tuple[int, ...]:
