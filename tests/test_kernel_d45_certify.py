@@ -108,3 +108,21 @@ def test_simplicial_rays_through_the_data_points_are_the_null_directions(case):
             assert len(ratio) == 1 and all(x == 0 for x, y in zip(d, ns[0], strict=True)
                                            if y == 0)
             assert fastpath._dot(H.exact(h)[0], d) < 0
+
+
+def test_members_of_bitsets_equal_the_bit_by_bit_lists():
+    from rescon.geometry.polytope import _bits, members_of, tight_pairs
+
+    rng = random.Random(1)
+    for _ in range(200):
+        tight = [rng.getrandbits(rng.choice([0, 3, 8, 9, 64, 700, 3000]))
+                 for _ in range(rng.randint(0, 30))]
+        want: dict[int, list[int]] = {}
+        for i, t in enumerate(tight):
+            for h in _bits(t):
+                want.setdefault(h, []).append(i)
+        got = members_of(tight)
+        assert got == want and list(got) == sorted(want)
+        vs, hs = tight_pairs(tight)
+        assert list(zip(vs.tolist(), hs.tolist(), strict=True)) == [
+            (i, h) for i, t in enumerate(tight) for h in sorted(_bits(t))]

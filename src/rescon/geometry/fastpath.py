@@ -34,7 +34,7 @@ import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
 from .exact import cross_all
-from .polytope import ExactPolytope
+from .polytope import ExactPolytope, members_of, tight_pairs
 
 __all__ = ["certified_kernel"]
 
@@ -229,7 +229,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
             continue
         a, b = H.exact(h)
         w, *y = verts[vi]
-        slack = sum(ai * yi for ai, yi in zip(a, y, strict=True)) - b * w
+        slack = sum(map(operator.mul, a, y)) - b * w
         if slack > 0:
             return None
         if slack == 0 and h in where:
@@ -301,11 +301,14 @@ class _RayIndex:
         self.W = np.array(self.weights, dtype=wide)
         keys, owners = [], []
         groups = [(self.simple, self.simple_rows)]
+        keyed = [vi for vi in self.non_simple if counts[vi] <= MAX_TIGHT]
+        rows = tight_pairs([tight[vi] for vi in keyed])[1]  # by vertex, increasing
+        starts = np.concatenate([[0], np.cumsum(counts[keyed])]).astype(np.int64)
         for t in range(k + 1, MAX_TIGHT + 1):  # the non-simple ones, by their size t
-            vs = [vi for vi in self.non_simple if counts[vi] == t]
-            if vs:
-                groups.append((np.array(vs, dtype=np.int64),
-                               np.array([list(_bits(tight[vi])) for vi in vs], dtype=np.int64)))
+            at = np.flatnonzero(counts[keyed] == t)
+            if len(at):
+                groups.append((np.asarray(keyed, dtype=np.int64)[at],
+                               rows[starts[at][:, None] + np.arange(t)]))
         for vs, rows in groups:
             combos = np.array(list(itertools.combinations(range(rows.shape[1]), k - 1)),
                               dtype=np.int64)
@@ -368,10 +371,7 @@ class _RayIndex:
     def _on(self, h: int) -> list[int]:
         """The vertices tight on row h (all rows' lists built on first use)."""
         if self._members is None:
-            self._members = {}
-            for u, t in enumerate(self.tight):
-                for g in _bits(t):
-                    self._members.setdefault(g, []).append(u)
+            self._members = members_of(self.tight)
         return self._members[h]
 
 
@@ -532,8 +532,11 @@ def _through(E: np.ndarray, L: np.ndarray, others: np.ndarray, Q: np.ndarray) ->
     Lq = L[Q]  # (P, r + 1, k + 1)
     if others.shape[1] == 0:
         return Lq[:, 0]
-    M = E[others] @ np.swapaxes(Lq, 1, 2)  # (P, r, r + 1)
-    lam = cross_all(M)
+    # M (P, r, r + 1): each bracket once (neighbouring vertices share most of them)
+    pairs, where = np.unique(others[:, :, None] * len(L) + Q[:, None, :],
+                             return_inverse=True)
+    brackets = (E[pairs // len(L)] * L[pairs % len(L)]).sum(axis=1)
+    lam = cross_all(brackets[where].reshape(*others.shape, Q.shape[1]))
     return (lam[:, :, None] * Lq).sum(axis=1)
 
 

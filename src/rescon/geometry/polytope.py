@@ -30,7 +30,7 @@ from .._rounding import underflow_floor
 from ._budget import PYTHON_STEP, require
 from .exact import bareiss_rank, nullspace_exact
 
-__all__ = ["ExactPolytope", "Farkas"]
+__all__ = ["ExactPolytope", "Farkas", "members_of", "tight_pairs"]
 
 
 @dataclass(frozen=True)
@@ -47,6 +47,30 @@ def _bits(t: int):
         low = t & -t
         yield low.bit_length() - 1
         t ^= low
+
+
+def tight_pairs(tight: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """(vertex, row) for every set bit of the bitsets ``tight``, ordered by vertex then
+    row: the bitsets' bytes side by side, only the nonzero bytes unpacked."""
+    width = max((max(tight, default=0).bit_length() + 7) // 8, 1)
+    buf = np.frombuffer(b"".join(t.to_bytes(width, "little") for t in tight),
+                        dtype=np.uint8).reshape(len(tight), width)
+    vi, byte = np.nonzero(buf)
+    pair, bit = np.nonzero(np.unpackbits(buf[vi, byte][:, None], axis=1, bitorder="little"))
+    return vi[pair], byte[pair] * 8 + bit
+
+
+def members_of(tight: list[int]) -> dict[int, list[int]]:
+    """Row → the vertices whose bitset ``tight`` holds it, increasing (rows in
+    increasing order, only those set somewhere)."""
+    vs, hs = tight_pairs(tight)
+    if not len(hs):
+        return {}
+    order = np.argsort(hs, kind="stable")
+    hs, vs = hs[order], vs[order]
+    cuts = np.flatnonzero(hs[1:] != hs[:-1]) + 1
+    return dict(zip(hs[np.r_[0, cuts]].tolist(), (g.tolist() for g in np.split(vs, cuts)),
+                    strict=True))
 
 
 class _Members(dict):
@@ -283,12 +307,9 @@ class ExactPolytope:
         return bareiss_rank(rows)[0] if rows else 0
 
     def incidence(self) -> dict[int, list[int]]:
-        """constraint → the vertices tight on it (only constraints tight somewhere)."""
-        out: dict[int, list[int]] = {}
-        for i, t in enumerate(self.tight):
-            for h in _bits(t):
-                out.setdefault(h, []).append(i)
-        return out
+        """constraint → the vertices tight on it (only constraints tight somewhere):
+        :func:`members_of`."""
+        return members_of(self.tight)
 
     def clear_rank(self, members: list[int]) -> int:
         """A lower bound on the affine dimension of the vertices ``members``: the
