@@ -126,3 +126,17 @@ def test_members_of_bitsets_equal_the_bit_by_bit_lists():
         vs, hs = tight_pairs(tight)
         assert list(zip(vs.tolist(), hs.tolist(), strict=True)) == [
             (i, h) for i, t in enumerate(tight) for h in sorted(_bits(t))]
+
+
+@pytest.mark.parametrize("was_on", [True, False])
+def test_the_fast_path_leaves_the_collector_as_it_found_it(was_on):
+    import gc
+
+    H, hull, _, unit = _halfspaces(np.random.default_rng(2).normal(size=(14, 4)), 1)
+    first = np.flatnonzero(H.outside == 1)
+    (gc.enable if was_on else gc.disable)()
+    try:
+        assert fastpath.certified_kernel(H, hull.dim, unit, first) is not None
+        assert gc.isenabled() == was_on
+    finally:
+        gc.enable()

@@ -26,6 +26,8 @@ rows were dependent) — returns None and the caller clips exactly (:mod:`.polyt
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import itertools
 import operator
 from math import gcd
@@ -121,11 +123,27 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
     if len(H) < k + 1:
         return None
     sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
-    for options in QHULL_OPTIONS:
-        P = _attempt(H, k, scale, sel, options)
-        if P is not None:
-            return P
+    with _collection_deferred():
+        for options in QHULL_OPTIONS:
+            P = _attempt(H, k, scale, sel, options)
+            if P is not None:
+                return P
     return None
+
+
+@contextlib.contextmanager
+def _collection_deferred():
+    """Python's cyclic garbage collector off (if it was on) while the fast path runs: it
+    allocates ~10⁵ containers (vertex tuples, lists of rows), none of them in a cycle,
+    which set off collections of the whole heap — a third of the fast path's time in
+    d = 4, n = 50 (0.11 of 0.35 CPU-s). Reference counting still frees everything."""
+    on = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if on:
+            gc.enable()
 
 
 def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
