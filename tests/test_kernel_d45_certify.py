@@ -12,10 +12,13 @@ from math import gcd
 import numpy as np
 import pytest
 
+import rescon
 from rescon.geometry import fastpath
+from rescon.geometry import kernel as km
 from rescon.geometry.exact import nullspace_exact
 from rescon.geometry.halfspaces import _int_det
-from tests.test_kernel_d45 import _halfspaces
+from tests.test_kernel_d45 import _both_paths, _halfspaces
+from tests.test_kernels_d45_fast import _cloud, _public
 
 
 def _reference_vertex(H, T):
@@ -140,3 +143,46 @@ def test_the_fast_path_leaves_the_collector_as_it_found_it(was_on):
         assert gc.isenabled() == was_on
     finally:
         gc.enable()
+
+
+@pytest.mark.parametrize("kind,d,n,F", [
+    ("gaussian", 5, 13, 1), ("sphere", 5, 12, 2), ("tiny", 5, 12, 1), ("huge", 5, 12, 1),
+    ("integers", 5, 13, 1), ("duplicated", 5, 20, 2), ("converged", 5, 12, 1),
+    ("gaussian", 4, 5, 0), ("gaussian", 5, 6, 0), ("integers", 4, 20, 3),
+])
+def test_d5_and_hostile_kernels_are_bit_identical_to_exact_clipping(kind, d, n, F,
+                                                                   monkeypatch):
+    X = _cloud(kind, d, n, 7)
+    fast = rescon.safe_kernel(X, F)
+    monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
+    slow = rescon.safe_kernel(X, F)
+    assert _public(fast) == _public(slow)
+
+
+def test_mixed_magnitudes_are_bit_identical_to_exact_clipping(monkeypatch):
+    rng = np.random.default_rng(8)
+    X = rng.normal(size=(14, 4)) * 10.0 ** rng.integers(-300, 300, size=(14, 4))
+    fast = rescon.safe_kernel(X, 1)
+    monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
+    assert _public(fast) == _public(rescon.safe_kernel(X, 1))
+
+
+def test_a_moved_vertex_is_refused():
+    """A proposal whose rows are changed so that it names another point: the proof
+    refuses it (an infeasible point, or a true vertex left out)."""
+    X = np.random.default_rng(3).normal(size=(20, 4))
+    _, slow, H, unit, first = _both_paths(X, 1)
+    _, facets = fastpath._propose(H, first)
+    honest = fastpath._certify(H, 4, unit, first, facets)
+    assert honest is not None and set(honest.verts) == set(slow.verts)
+    moved = 0
+    rng = np.random.default_rng(0)
+    for p in rng.permutation(len(facets))[:15].tolist():
+        lied = [list(f) for f in facets]
+        lied[p] = [*lied[p][:3], int(rng.integers(len(first)))]
+        v = fastpath._solve_all(H, [[int(first[i]) for i in lied[p]]], 4)[0]
+        if v is None or v in honest.verts:
+            continue
+        moved += 1
+        assert fastpath._certify(H, 4, unit, first, lied) is None
+    assert moved > 0
