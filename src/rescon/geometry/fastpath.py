@@ -4,8 +4,10 @@ Floats (a Chebyshev LP for an interior point, then qhull's halfspace intersectio
 propose the vertices of Ψ and, for each vertex, the valid halfspaces that qhull finds
 tight there (k of them at a simple vertex, more where qhull merged a non-simple one —
 common in d ≥ 4, where many hyperplanes through data points meet). Each proposal is
-solved exactly from k of its rows that floats suggest are independent (Cramer's rule
-for all vertices at once); the proposal is accepted only if, in exact arithmetic,
+solved exactly from k of its rows that floats suggest are independent: det A ≠ 0 is
+shown modulo a prime, then the vertex is found in the flat of the data points that
+two of its hyperplanes share (:func:`_meet`, on integers a third the size of Cramer's
+rule); the proposal is accepted only if, in exact arithmetic,
 
 1. every proposed vertex v satisfies every valid halfspace, and its tight set within
    the defining halfspaces S (the rows of all proposals) is computed exactly — so
