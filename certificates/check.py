@@ -23,11 +23,11 @@ JSON arrays may also be given as Python tuples when ``check`` is called directly
 
 from __future__ import annotations
 
-import bisect
+import itertools
 import json
 import math
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -567,13 +567,44 @@ def _proof_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> s
     return "search"
 
 
-def _tokens(x: Any, where: str, n: int) -> list[int] | tuple[int, ...]:
-    """The token list of a search tree: integers in -3..n-1 (checked in C when they are)."""
+def _tokens(x: Any, where: str, n: int, least: int = -3) -> list[int] | tuple[int, ...]:
+    """The token list of a search tree: integers in least..n-1 (checked in C when they
+    are)."""
     tree = _array(x, where)
-    if tree and ({type(t) for t in tree} != {int} or min(tree) < -3 or max(tree) >= n):
-        k, t = next((k, t) for k, t in enumerate(tree) if not _is_int(t) or not -3 <= t < n)
-        raise Invalid(f"{where}[{k}] = {t!r} is not a token (-3..-1 or a node 0..{n - 1})")
+    if tree and ({type(t) for t in tree} != {int} or min(tree) < least or max(tree) >= n):
+        k, t = next((k, t) for k, t in enumerate(tree) if not _is_int(t) or not least <= t < n)
+        raise Invalid(f"{where}[{k}] = {t!r} is not a token ({least}..-1 or a node "
+                      f"0..{n - 1})")
     return tree
+
+
+@dataclass(frozen=True, eq=False)
+class _Side:
+    """Per-node thresholds of one side of a replayed search (:class:`_Replay`): a member
+    v of a closed set has fewer than t[v] in-neighbours outside it, so a closed set
+    holding v has at least m_v = max(1, d_v − t[v] + 2) members. Packed sets:
+    ``cut[k]`` / ``keep[k]`` hold the fields with m_v > k / ≤ k; ``D`` is the deficit
+    table of V (a member's field 2^(w−1) + min(t[v], n) − 1, all ones for the nodes of
+    ``gone``, those with t[v] ≤ 0, never in a closed set)."""
+
+    t: list[int]
+    cut: list[int]
+    keep: list[int]
+    D: int
+    gone: int
+
+    def least_in(self, Q: int, n: int) -> int:
+        """min_{v∈Q} m_v for a packed Q (n + 1 when Q = ∅): a binary search on ``keep``."""
+        if not Q:
+            return n + 1
+        lo, hi = 1, n + 1
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if Q & self.keep[mid]:
+                hi = mid
+            else:
+                lo = mid + 1
+        return lo
 
 
 class _Replay:
@@ -615,8 +646,8 @@ class _Replay:
         n = g.n
         self.g, self.r, self.where = g, r, where
         self.w = w = n.bit_length() + 1
+        self.deg = deg = [mk.bit_count() for mk in g.inmask]
         self.ones = (1 << w) - 1
-        deg = [mk.bit_count() for mk in g.inmask]
         self.node = sorted(range(n), key=lambda v: (deg[v], v))
         field = [0] * n
         for p, v in enumerate(self.node):
@@ -630,17 +661,33 @@ class _Replay:
         if self.work > MAX_SEARCH_WORK:
             return  # the tables alone are beyond the limit: run() stops before using them
         # indexed by w (p + 1), the bit length of the guard bit of field p (node v):
-        # less = the lowest bits of the fields of v's out-neighbours;
-        # least = max(1, d_v - r + 2), the least size of a closed set holding v
+        # less = the lowest bits of the fields of v's out-neighbours
         self.less = [0] * (w * (n + 1))
-        self.least = [1] * (w * (n + 1))
         for v in range(n):
-            L = w * (field[v] + 1)
-            self.less[L] = sum(1 << (w * field[j]) for j in _bits(out[v]))
-            self.least[L] = max(1, deg[v] - r + 2)
-        # fit[k]: the number of fields p with least ≤ k (a prefix: least grows with p)
-        least = [self.least[w * (p + 1)] for p in range(n)]
-        self.fit = [bisect.bisect_right(least, k) for k in range(n + 1)]
+            self.less[w * (field[v] + 1)] = sum(1 << (w * field[j]) for j in _bits(out[v]))
+        self.full = self.pack(g.full)
+        self.side = self.threshold_side([r] * n)
+
+    def threshold_side(self, t: list[int]) -> _Side:
+        """The :class:`_Side` of the per-node thresholds ``t`` (t[v] for node v): a member
+        v of a closed set has fewer than t[v] in-neighbours outside it."""
+        n, w, top = self.g.n, self.w, self.top
+        least = [max(1, d - tv + 2) for d, tv in zip(self.deg, t)]
+        cut, acc = [0] * (n + 2), [0] * (n + 2)
+        for v in range(n):
+            acc[min(least[v], n + 1)] |= 1 << top[v]
+        for k in range(1, n + 2):
+            acc[k] |= acc[k - 1]
+            cut[k] = self.full & ~acc[k]
+        D = gone = 0
+        for v in range(n):
+            if t[v] >= 1:
+                D |= ((1 << (w - 1)) + min(t[v], n) - 1) << (w * self.field[v])
+            else:
+                D |= self.ones << (w * self.field[v])
+                gone |= 1 << top[v]
+        self.work += 3 * n * self.unit
+        return _Side(t, cut, acc, D, gone)
 
     def pack(self, mask: int) -> int:
         """The packed form of the node set ``mask`` (a bitmask)."""
@@ -650,22 +697,9 @@ class _Replay:
         """The node-set bitmask of a packed set."""
         return sum(1 << self.node[b // self.w] for b in _bits(packed))
 
-    def deficits(self, U: int) -> int:
-        """D of the closed node set U (a bitmask), as in the class docstring."""
-        g, w = self.g, self.w
-        rr = min(self.r, g.n)
-        D = 0
-        for j in range(g.n):
-            if U >> j & 1:
-                value = (1 << (w - 1)) + rr - 1 - (g.inmask[j] & ~U).bit_count()
-            else:
-                value = self.ones
-            D |= value << (w * self.field[j])
-        self.work += g.n * self.unit
-        return D
-
-    def shrink(self, U: int, D: int, gone: int, watch: int = 0) -> tuple[int, int]:
-        """core_r(U \\ gone) and its D, for a closed U with D (packed sets).
+    def shrink(self, U: int, D: int, gone: int, side: _Side, watch: int = 0) -> tuple[int, int]:
+        """core(U \\ gone) for the thresholds of ``side`` and its D, for a closed U with D
+        (packed sets).
 
         Each round removes ``todo`` from U, makes their fields all ones and subtracts
         the fields of their out-neighbours; the members whose guard bit is then cleared
@@ -674,21 +708,21 @@ class _Replay:
         the result is the core. Every member j of a nonempty closed C ⊆ U has at most
         r − 1 in-neighbours outside C, so |C| ≥ m_j = max(1, d_j − r + 2) ("least"):
         C ⊆ U' = {j ∈ U : m_j ≤ |U|}, then C ⊆ {j ∈ U' : m_j ≤ |U'|}, and so on (each
-        is U cut to a prefix of the fields, ``fit``); when this reaches ∅, the core is
+        cuts the fields of ``side.cut``); when this reaches ∅, the core is
         empty (and D is not used again). With ``watch``, the peeling stops once a
         member of ``watch`` is peeled: the set returned then lies between the core and
         U, without that member (enough to show watch ⊄ core; D is not used again).
         Work: one step per round, per cut and per node whose out-neighbours are
         subtracted."""
-        less, fit, ones, w = self.less, self.fit, self.ones, self.w
+        less, cut, keep, ones, w = self.less, side.cut, side.keep, self.ones, self.w
         todo = gone & U
         steps = 0
         while todo:
             U ^= todo
             C = U
             k = C.bit_count()
-            while C >> w * fit[k]:  # members beyond the fields p < fit[k]: cut them
-                C &= (1 << w * fit[k]) - 1
+            while C & cut[k]:  # members j with m_j > k = |C|: cut them
+                C &= keep[k]
                 k = C.bit_count()
                 steps += 1
             if not C:
@@ -708,66 +742,94 @@ class _Replay:
         self.work += steps * self.unit
         return U, D
 
-    def run(self, order: list[int], tree: list[int] | tuple[int, ...]) -> str:
+    def run(self, order: list[int], tree: list[int] | tuple[int, ...],
+            configs: Iterable[tuple[int, _Side, _Side]] | None = None) -> str:
         """Check every leaf of ``tree``; '' when all are justified, raise Invalid on
-        the first that is not, or say why the replay stopped (beyond MAX_SEARCH_WORK)."""
-        g, shrink, top = self.g, self.shrink, self.top
+        the first that is not, or say why the replay stopped (beyond MAX_SEARCH_WORK).
+        ``configs``: the (gone, side1, side2) of the subtrees in turn (:meth:`config`);
+        default the one of a ``search`` tree, (∅, r, r)."""
         ntok = len(tree)
         self.work += ntok * self.unit
         if self.work > MAX_SEARCH_WORK:
             return self.beyond(0, ntok)
-        meter = [0]
-        core0 = core(g, g.full, self.r, meter)  # P = core_r(V \ B), B = order[:k]
-        self.work += meter[0]
-        P, PD = self.pack(core0), self.deficits(core0)
         pos = 0
-        B = 0
-        for k in range(g.n):
-            S0 = 1 << top[order[k]]
-            Q, QD = shrink(P, PD, S0)
-            stack = [(S0, B, P, PD, Q, QD)]
-            while stack:
-                if self.work > MAX_SEARCH_WORK:
-                    return self.beyond(pos, ntok)
-                if pos >= ntok:
-                    raise Invalid(f"{self.where}: search tree ends early (in the subtree of "
-                                  f"root {k})")
-                S, X, P1, PD1, Q1, QD1 = stack.pop()
-                t = tree[pos]
-                if t >= 0:
-                    bit = 1 << top[t]
-                    if (S | X) & bit:
-                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
-                    if P1 & X:
-                        P1, PD1 = shrink(P1, PD1, X)
-                    if Q1 & S:
-                        Q1, QD1 = shrink(Q1, QD1, S)
-                    stack.append((S, X | bit, P1, PD1, Q1, QD1))  # second: u out of S1
-                    stack.append((S | bit, X, P1, PD1, Q1, QD1))  # first: u in S1
-                elif t == -1:
-                    if Q1 & S:
-                        Q1 = shrink(Q1, QD1, S)[0]
-                    if Q1:
-                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
-                elif t == -2:
-                    if P1 & X:
-                        P1 = shrink(P1, PD1, X, S)[0]
-                    if not S & ~P1:
-                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
-                else:
-                    if Q1 & S:
-                        Q1 = shrink(Q1, QD1, S)[0]
-                    if P1 & X:
-                        P1 = shrink(P1, PD1, X)[0]
-                    if sum(self.sizes(S, Q1)) <= (P1 | Q1).bit_count():
-                        raise Invalid(self.why(t, pos, S, X, B, P1, Q1))
-                pos += 1
-            B |= S0
-            P, PD = shrink(P, PD, S0)
+        for gone, a, b in configs or [(0, self.side, self.side)]:
+            pos = self.config(order, tree, pos, self.pack(gone), a, b)
+            if pos < 0:
+                return self.beyond(-1 - pos, ntok)
         if pos != ntok:
             raise Invalid(f"{self.where}: search tree has {ntok - pos} unused tokens after "
-                          f"the {g.n} roots")
+                          f"the last root")
         return ""
+
+    def config(self, order: list[int], tree: list[int] | tuple[int, ...], pos: int,
+               gone: int, a: _Side, b: _Side) -> int:
+        """Replay, from token ``pos``, the subtrees of the roots order[k] ∉ ``gone``
+        (packed; B = gone ∪ order[:k]): with order[k] ∈ S1 for the thresholds of ``a`` on
+        S1's side and ``b`` on S2's, then, unless a is b, with the sides swapped. The
+        position after them, or −1 − pos when the replay stops at pos (work limit)."""
+        shrink, top, ntok = self.shrink, self.top, len(tree)
+        chain = {side: shrink(self.full, side.D, side.gone | gone, side) for side in (a, b)}
+        B, before = gone, []
+        for k in range(self.g.n):
+            S0 = 1 << top[order[k]]
+            if S0 & gone:
+                continue
+            for s1, s2 in ((a, b),) if a is b else ((a, b), (b, a)):
+                P, PD = chain[s1]
+                Q, QD = shrink(*chain[s2], S0, s2)
+                stack = [(S0, B, P, PD, Q, QD)]
+                while stack:
+                    if self.work > MAX_SEARCH_WORK:
+                        return -1 - pos
+                    if pos >= ntok:
+                        raise Invalid(f"{self.where}: search tree ends early (in the subtree "
+                                      f"of root {k})")
+                    S, X, P1, PD1, Q1, QD1 = stack.pop()
+                    t = tree[pos]
+                    if t >= 0:
+                        bit = 1 << top[t]
+                        if (S | X) & bit:
+                            raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
+                        if P1 & X:
+                            P1, PD1 = shrink(P1, PD1, X, s1)
+                        if Q1 & S:
+                            Q1, QD1 = shrink(Q1, QD1, S, s2)
+                        stack.append((S, X | bit, P1, PD1, Q1, QD1))  # second: u out of S1
+                        stack.append((S | bit, X, P1, PD1, Q1, QD1))  # first: u in S1
+                    elif t == -1:
+                        if Q1 & S:
+                            Q1 = shrink(Q1, QD1, S, s2)[0]
+                        if Q1:
+                            raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
+                    elif t == -2:
+                        if P1 & X:
+                            P1 = shrink(P1, PD1, X, s1, S)[0]
+                        if not S & ~P1:
+                            raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
+                    elif t == -4:
+                        if self.crowded(S, before, s1) is None:
+                            raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
+                    else:
+                        if Q1 & S:
+                            Q1 = shrink(Q1, QD1, S, s2)[0]
+                        if P1 & X:
+                            P1 = shrink(P1, PD1, X, s1)[0]
+                        if sum(self.sizes(S, Q1, s1, s2)) <= (P1 | Q1).bit_count():
+                            raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
+                    pos += 1
+            B |= S0
+            before.append(order[k])
+            chain = {side: shrink(*chain[side], S0, side) for side in chain}
+        return pos
+
+    def crowded(self, S: int, before: list[int], side: _Side) -> int | None:
+        """A node j of ``before`` with more than d_j − t_j in-neighbours in the packed
+        set S (t: the thresholds of ``side``), or None."""
+        self.work += (S.bit_count() + len(before)) * self.unit
+        S = self.unpack(S)
+        inmask, deg, t = self.g.inmask, self.deg, side.t
+        return next((j for j in before if (inmask[j] & S).bit_count() > deg[j] - t[j]), None)
 
     @staticmethod
     def beyond(pos: int, ntok: int) -> str:
@@ -775,24 +837,24 @@ class _Replay:
         return (f"replaying its tree needs more than {MAX_SEARCH_WORK} steps "
                 f"(the checker's work limit; stopped at token {pos} of {ntok})")
 
-    def sizes(self, S: int, Q: int) -> tuple[int, int]:
-        """(need1, need2) for packed S, Q: the sizes of a closed S1 ⊇ S and of a closed
-        nonempty S2 ⊆ Q are at least these.
+    def sizes(self, S: int, Q: int, s1: _Side, s2: _Side) -> tuple[int, int]:
+        """(need1, need2) for packed S, Q: the sizes of a closed S1 ⊇ S (thresholds of
+        ``s1``) and of a closed nonempty S2 ⊆ Q (``s2``) are at least these.
 
-        |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺ (each i ∈ S keeps ≤ r − 1 of its
-        in-neighbours outside) and |S2| ≥ min_{j∈Q} max(1, d_j − r + 2) (n + 1 when
-        Q = ∅), the bound of Q's lowest field."""
-        inmask, r = self.g.inmask, self.r
+        |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − t_i + 1)⁺ (each i ∈ S keeps ≤ t_i − 1 of
+        its in-neighbours outside) and |S2| ≥ min_{j∈Q} max(1, d_j − t_j + 2) (n + 1 when
+        Q = ∅)."""
+        inmask, t = self.g.inmask, s1.t
         self.work += S.bit_count() * self.unit
         S = self.unpack(S)
         need1 = S.bit_count() + max(
-            [0] + [(inmask[i] & ~S).bit_count() - r + 1 for i in _bits(S)])
-        need2 = self.least[(Q & -Q).bit_length()] if Q else self.g.n + 1
-        return need1, need2
+            [0] + [(inmask[i] & ~S).bit_count() - t[i] + 1 for i in _bits(S)])
+        return need1, s2.least_in(Q, self.g.n)
 
-    def why(self, t: int, pos: int, S: int, X: int, B: int, P: int, Q: int) -> str:
+    def why(self, t: int, pos: int, S: int, X: int, B: int, P: int, Q: int, s1: _Side,
+            s2: _Side) -> str:
         """Why token ``t`` at ``pos`` is wrong at the state (S, X) of root B, with the
-        exact P = core_r(V \\ X) for a -2 or -3 leaf and Q = core_r(V \\ S \\ B) for a
+        exact P = core(V \\ X) for a -2 or -3 leaf and Q = core(V \\ S \\ B) for a
         -1 or -3 leaf (packed sets)."""
         fmt = self.fmt
         if t >= 0:
@@ -804,7 +866,10 @@ class _Replay:
             return f"{head}: core(V \\ S \\ B) = {fmt(Q)} is nonempty (S = {fmt(S)}, B = {fmt(B)})"
         if t == -2:
             return f"{head}: S = {fmt(S)} is inside core(V \\ X) = {fmt(P)} (X = {fmt(X)})"
-        need1, need2 = self.sizes(S, Q)
+        if t == -4:
+            return (f"{head}: no earlier root has more than d_j - t_j in-neighbours in "
+                    f"S = {fmt(S)}")
+        need1, need2 = self.sizes(S, Q, s1, s2)
         return (f"{head}: |S1| >= {need1} and |S2| >= {need2} fit in |P u Q| = "
                 f"{(P | Q).bit_count()} (S = {fmt(S)}, X = {fmt(X)}, B = {fmt(B)})")
 
@@ -987,10 +1052,61 @@ def _proof_spectral(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) ->
     return "spectral"
 
 
+def _configurations(n: int, c: int) -> Iterator[tuple[int, int]]:
+    """The configurations (Q1, Q2) (bitmasks) of a ``charged_tree``, in its order
+    (FORMAT.md): (∅, ∅), then by size k = 1..c, Q = Q1 ∪ Q2 in lexicographic order of
+    its sorted nodes, Q1 = {min Q} ∪ T for the subsets T of the rest of Q by their
+    bitmask over it (bit j: its j-th node)."""
+    yield 0, 0
+    for k in range(1, c + 1):
+        for Q in itertools.combinations(range(n), k):
+            for mask in range(1 << (k - 1)):
+                Q1 = 1 << Q[0]
+                Q2 = 0
+                for j, v in enumerate(Q[1:]):
+                    if mask >> j & 1:
+                        Q1 |= 1 << v
+                    else:
+                        Q2 |= 1 << v
+                yield Q1, Q2
+
+
+def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] | tuple,
+                    where: str) -> str:
+    """Replay a ``charged_tree`` (FORMAT.md): '' when every configuration's subtrees are
+    justified, else why the replay stopped (work limit); raises Invalid on a fault.
+
+    A pair of cost c < s whose sets keep closed members U_k = S_k \\ reach_r(S_k) ≠ ∅
+    has the configuration Q_k = reach_r(S_k), |Q1| + |Q2| = c, and U_k avoids
+    Q1 ∪ Q2 with fewer than t_k(i) = r + |N(i) ∩ Q_k| in-neighbours outside U_k for
+    each member (|N(i) \\ S_k| < r); such sets are closed under union, so the
+    ``search`` replay with these per-side thresholds and B ⊇ Q1 ∪ Q2 excludes them."""
+    rp = _Replay(g, r, f"{where}.charged_tree")
+
+    def configs() -> Iterator[tuple[int, _Side, _Side]]:
+        for Q1, Q2 in _configurations(g.n, s - 1):
+            if not Q1:
+                yield 0, rp.side, rp.side
+                continue
+            a, b = (rp.threshold_side([r + (mk & Q).bit_count() for mk in g.inmask])
+                    if Q else rp.side for Q in (Q1, Q2))
+            yield Q1 | Q2, a, b
+
+    return rp.run(order, tree, configs())
+
+
 def _proof_cost_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
-    _obj(p, where, ("method", "order"), ("info", "tree"))
+    _obj(p, where, ("method", "order"), ("info", "tree", "charged_tree"))
     order = _perm(p["order"], f"{where}.order", g.n)
     _info(p, where)
+    if p.get("charged_tree") is not None:
+        if p.get("tree") is not None:
+            raise Invalid(f"{where}: 'tree' and 'charged_tree' are exclusive")
+        tree = _tokens(p["charged_tree"], f"{where}.charged_tree", g.n, -4)
+        stopped = _charged_replay(g, r, s, order, tree, where)
+        if not stopped:
+            return "cost_search (charged tree replayed)"
+        return _enumerate_or_trust("cost_search", where, g, r, s, ctx, stopped)
     if p.get("tree") is not None:  # the sized search's tree (cost_tree.py)
         tree = _tokens(p["tree"], f"{where}.tree", g.n)
         if _cost_tree.replay(g.inmask, r, s, order, tree, where):

@@ -199,20 +199,21 @@ def test_shrink_is_the_core(seed, n, r):
     g = C.Graph(n, inm, G.number_of_edges())
     R = C._Replay(g, r, "proof")
     U = peel(inm, (1 << n) - 1, r)
-    packed, D = R.pack(U), R.deficits(U)
+    packed, D = R.shrink(R.full, R.side.D, R.side.gone, R.side)  # core_r(V) from V
+    assert R.unpack(packed) == U
     while U:
         gone = 1 << rng.choice(bits(U) + bits(((1 << n) - 1) & ~U))
         # with a watched set: the core when it keeps the whole set, else a set between
         # the core and U \ gone that misses a watched node
         watch = rng.getrandbits(n)
         core = peel(inm, U & ~gone, r)
-        seen = R.unpack(R.shrink(packed, D, R.pack(gone), R.pack(watch))[0])
+        seen = R.unpack(R.shrink(packed, D, R.pack(gone), R.side, R.pack(watch))[0])
         if watch & ~core:
             assert core & ~seen == 0 and seen & ~(U & ~gone) == 0 and watch & ~seen
         else:
             assert seen == core
         U = core
-        packed, D = R.shrink(packed, D, R.pack(gone))
+        packed, D = R.shrink(packed, D, R.pack(gone), R.side)
         assert R.unpack(packed) == U
 
 

@@ -36,6 +36,7 @@ from .._progress import progress_bar
 from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
+from .charged import charged_tree
 from .distributed import searches_for
 from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
@@ -264,23 +265,36 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
     checker's own enumeration (n > MAX_ENUM_N) becomes the sized search's tree below s
     (search.cost_tree: every pair whose sets both keep an r-closed member costs ≥ s,
     i.e. (r, s)-robustness), if it is recorded within ``TREE_SECONDS`` (dense graphs:
-    4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M); the
-    deciding method stays in ``info.decided_by``. Otherwise ``proof`` itself."""
+    4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M), else, for
+    s ≥ 2, the charged tree (charged.charged_tree: one decision tree per set of charged
+    nodes; ER(30, 0.5) with s = 2: 2.4–3.5M tokens, where the sized tree has > 30M),
+    each recorded within ``TREE_SECONDS``; the deciding method stays in
+    ``info.decided_by``. Otherwise ``proof`` itself."""
     method = proof["method"]
     if (ig.n > MAX_SEARCH_NODES
             or not (method == "milp" or method == "dp" and ig.n > MAX_ENUM_N
-                    or method in ("search", "cost_search") and proof.get("tree") is None)):
+                    or method in ("search", "cost_search") and proof.get("tree") is None
+                    and proof.get("charged_tree") is None)):
         return proof
+    key, tree = "tree", _recorded(cost_tree, ig, r, s, deadline)
+    if tree is None and s >= 2:
+        key, tree = "charged_tree", _recorded(charged_tree, ig, r, s, deadline)
+    if tree is None:
+        return proof
+    return {"method": "cost_search", "order": search_order(ig).tolist(), key: list(tree),
+            "info": {**proof.get("info", {}), "decided_by": method}}
+
+
+def _recorded(record: Callable[..., tuple[int, ...] | None], ig: IndexedGraph, r: int, s: int,
+              deadline: float | None) -> tuple[int, ...] | None:
+    """The tree ``record`` (search.cost_tree or charged.charged_tree) proving
+    (r, s)-robustness within ``TREE_SECONDS``, or None."""
     stop = time.perf_counter() + TREE_SECONDS
     try:
-        tree = cost_tree(ig, r, s, deadline=stop if deadline is None else min(stop, deadline))
+        return record(ig, r, s, deadline=stop if deadline is None else min(stop, deadline))
     except ValueError as exc:
         raise RESCONError(f"internal error: ({r}, {s})-robustness was proven, "
                           f"but {exc}") from exc
-    if tree is None:
-        return proof
-    return {"method": "cost_search", "order": search_order(ig).tolist(), "tree": list(tree),
-            "info": {**proof.get("info", {}), "decided_by": method}}
 
 
 def _remember(facts: Facts, r: int, s: int, dec: _Decision) -> None:

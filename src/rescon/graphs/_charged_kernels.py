@@ -1,0 +1,184 @@
+"""Numba kernel recording the charged-set proof of (r, s)-robustness (n ≤ 64).
+
+A pair (S1, S2) of cost c = |reach_r(S1)| + |reach_r(S2)| whose sets both keep an
+r-closed member splits as S_k = U_k ∪ Q_k: Q_k = reach_r(S_k) (the charged nodes,
+|Q1| + |Q2| = c) and U_k ≠ ∅ the rest, whose members i have
+|N(i) \\ U_k| < t_k(i) = r + |N(i) ∩ Q_k| in-neighbours outside U_k. So no pair costs
+less than s iff, for every *configuration* (Q1, Q2) of disjoint sets with
+|Q1| + |Q2| ≤ s − 1, no two disjoint nonempty sets U1, U2 avoiding Q1 ∪ Q2 are closed
+for the thresholds t1, t2: an r-robustness decision with per-node, per-side thresholds,
+searched as ``_kernels.decide_step`` searches r-robustness, plus one leaf for maximal
+pairs (certificates/FORMAT.md, ``cost_search`` with a ``charged_tree``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ._kernels import U1, ZERO, branch_node, low_index, popcount
+
+OVERFLOW, WITNESS = -1, -2  # config_tree's results besides a token count
+
+
+@njit(cache=True, nogil=True)
+def threshold_core(U: np.uint64, removed: np.uint64, inmask: np.ndarray, outmask: np.ndarray,
+                   t: np.ndarray) -> np.uint64:
+    """The largest A ⊆ U \\ removed whose members i have < t[i] in-neighbours outside A,
+    for U such a set (closed) itself: only the out-neighbours of removed nodes can have
+    gained outside in-neighbours, so peel from a worklist. Such sets are closed under
+    union, so the result is unique."""
+    U &= ~removed
+    work = ZERO
+    m = removed
+    while m:
+        u = low_index(m)
+        m &= ~(U1 << np.uint64(u))
+        work |= outmask[u]
+    work &= U
+    while work:
+        i = low_index(work)
+        b = U1 << np.uint64(i)
+        work &= ~b
+        if popcount(inmask[i] & ~U) >= t[i]:
+            U &= ~b
+            work |= outmask[i] & U
+    return U
+
+
+@njit(cache=True, nogil=True)
+def _sizes_fail(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, t1: np.ndarray,
+                t2: np.ndarray) -> bool:
+    """True when a closed U1 ⊇ S (thresholds t1) and a nonempty closed U2 ⊆ Q (t2)
+    cannot both fit, disjoint, in W: |U1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − t1[i] + 1)⁺,
+    |U2| ≥ min_{j∈Q} max(1, d_j − t2[j] + 2)."""
+    extra = 0
+    m = S
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        e = popcount(inmask[i] & ~S) - t1[i] + 1
+        if e > extra:
+            extra = e
+    need2 = 1 << 30
+    m = Q
+    while m:
+        j = low_index(m)
+        m &= ~(U1 << np.uint64(j))
+        e = max(1, popcount(inmask[j]) - t2[j] + 2)
+        if e < need2:
+            need2 = e
+    return popcount(S) + extra + need2 > popcount(W)
+
+
+@njit(cache=True, nogil=True)
+def _crowded(S: np.uint64, R: np.uint64, inmask: np.ndarray, t: np.ndarray) -> bool:
+    """True when a node j of R has more than d_j − t[j] in-neighbours in S (then U1 ⊇ S
+    could take j: no maximal pair leaves j outside)."""
+    m = R
+    while m:
+        j = low_index(m)
+        m &= ~(U1 << np.uint64(j))
+        if popcount(inmask[j] & S) > popcount(inmask[j]) - t[j]:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.uint64,
+             inmask: np.ndarray, outmask: np.ndarray, t1: np.ndarray, t2: np.ndarray,
+             tokens: np.ndarray, ntok: int) -> int:
+    """Record the decision subtree of one root and side, from S = S0, X = B (P0, Q0 the
+    cores of V \\ X for t1 and of V \\ S0 \\ B for t2; R ⊆ B the earlier roots); the new
+    token count, OVERFLOW when ``tokens`` is full or WITNESS when the state is a
+    violating pair.
+
+    Leaves: -1 when Q = ∅, -2 when S ⊄ P, -3 when the sizes cannot fit, -4 when S is
+    ``_crowded`` for R; otherwise the member of S with ≥ t1 outside in-neighbours whose
+    candidates N(i) ∩ P \\ S exceed its need by the least gets one of them
+    (``branch_node``): u into S first, then into X."""
+    n = inmask.shape[0]
+    cap = 2 * n + 2
+    stS = np.empty(cap, dtype=np.uint64)
+    stX = np.empty(cap, dtype=np.uint64)
+    stP = np.empty(cap, dtype=np.uint64)
+    stQ = np.empty(cap, dtype=np.uint64)
+    stS[0], stX[0], stP[0], stQ[0] = S0, B, P0, Q0
+    sp = 1
+    while sp:
+        if ntok >= tokens.shape[0]:
+            return OVERFLOW
+        sp -= 1
+        S, X, P, Q = stS[sp], stX[sp], stP[sp], stQ[sp]
+        leaf = 0
+        if Q == ZERO:
+            leaf = -1
+        elif S & ~P:
+            leaf = -2
+        elif _sizes_fail(S, Q, P | Q, inmask, t1, t2):
+            leaf = -3
+        elif _crowded(S, R, inmask, t1):
+            leaf = -4
+        if leaf != 0:
+            tokens[ntok] = leaf
+            ntok += 1
+            continue
+        best_slack = n + 1
+        best_cand = ZERO
+        m = S
+        while m:
+            i = low_index(m)
+            m &= ~(U1 << np.uint64(i))
+            outside = popcount(inmask[i] & ~S)
+            if outside >= t1[i]:
+                cand = inmask[i] & P & ~S
+                slack = popcount(cand) - (outside - t1[i] + 1)
+                if slack < best_slack:
+                    best_slack = slack
+                    best_cand = cand
+        if best_cand == ZERO:
+            return WITNESS
+        u = branch_node(best_cand, Q, inmask, outmask)
+        tokens[ntok] = u
+        ntok += 1
+        bu = U1 << np.uint64(u)
+        stS[sp], stX[sp], stQ[sp] = S, X | bu, Q  # second: u out of U1
+        stP[sp] = threshold_core(P, bu, inmask, outmask, t1)
+        stS[sp + 1], stX[sp + 1], stP[sp + 1] = S | bu, X, P  # first: u in U1
+        stQ[sp + 1] = threshold_core(Q, bu & Q, inmask, outmask, t2)
+        sp += 2
+    return ntok
+
+
+@njit(cache=True, nogil=True)
+def config_tree(inmask: np.ndarray, outmask: np.ndarray, order: np.ndarray, t1: np.ndarray,
+                t2: np.ndarray, sym: bool, gone: np.uint64, tokens: np.ndarray, ntok: int) -> int:
+    """Append to ``tokens`` (from ``ntok``) the tree of one configuration: its charged
+    nodes ``gone`` = Q1 ∪ Q2, thresholds t1, t2. For each root order[k] ∉ gone (the
+    first node of U1 ∪ U2; B = gone ∪ order[:k] avoids both), the subtree with
+    order[k] ∈ U1 and, unless ``sym`` (t1 = t2: the configuration (∅, ∅)), the one
+    with order[k] ∈ U2 (the sides swapped). Returns the new count, OVERFLOW or
+    WITNESS."""
+    n = inmask.shape[0]
+    full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
+    C1 = threshold_core(full, gone, inmask, outmask, t1)
+    C2 = C1 if sym else threshold_core(full, gone, inmask, outmask, t2)
+    B = gone
+    for k in range(n):
+        b0 = U1 << np.uint64(order[k])
+        if b0 & gone:
+            continue
+        ntok = _subtree(b0, B, B & ~gone, C1, threshold_core(C2, b0 & C2, inmask, outmask, t2),
+                        inmask, outmask, t1, t2, tokens, ntok)
+        if ntok < 0:
+            return ntok
+        if not sym:
+            ntok = _subtree(b0, B, B & ~gone, C2,
+                            threshold_core(C1, b0 & C1, inmask, outmask, t1), inmask, outmask,
+                            t2, t1, tokens, ntok)
+            if ntok < 0:
+                return ntok
+        B |= b0
+        C1 = threshold_core(C1, b0 & C1, inmask, outmask, t1)
+        C2 = C1 if sym else threshold_core(C2, b0 & C2, inmask, outmask, t2)
+    return ntok
