@@ -18,7 +18,7 @@ from rescon.graphs.charged import charged_tree, configurations, count_configurat
 from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import search_order
-from tests.test_checker import C, in_masks, is_robust, rand_edges, rho_and_s
+from tests.test_checker import C, _validator, in_masks, is_robust, rand_edges, rho_and_s
 from tests.test_rho_tree import _cut_branch
 
 
@@ -121,6 +121,7 @@ def test_tampered_charged_trees_are_invalid():
                     if rho_and_s(8, in_masks(8, ig.edges()))[1] >= 2)
     proof = _proof(ig, charged_tree(ig, r, s))
     assert _verdict(ig, r, s, proof) == "valid"
+    _validator().validate(_cert(ig, r, s, proof))  # the JSON schema knows the field
     tree = proof["charged_tree"]
     for bad in ([-5] + tree[1:], tree + [-1], tree[:-1], [0.0] + tree[1:]):
         assert _verdict(ig, r, s, {**proof, "charged_tree": bad}) == "invalid"
