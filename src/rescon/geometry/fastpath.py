@@ -186,10 +186,12 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     tight sets among the defining halfspaces S, feasibility against every valid
     halfspace, and closure: every extreme ray of every vertex's tangent cone leads to
     another proposed vertex (see the module docstring)."""
-    S_set = sorted({int(sel[i]) for f in facets for i in f})
+    S_set = np.unique(sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
+                                      count=sum(map(len, facets)))]).tolist()
     H.exact_all(S_set)
     where = {h: i for i, h in enumerate(S_set)}
-    Ts = [_basis_of(H, [int(sel[i]) for i in f], k) for f in facets]
+    rows_of = sel.tolist()
+    Ts = [_basis_of(H, [rows_of[i] for i in f], k) for f in facets]
     sols = _solve_all(H, Ts, k)
     # None: k dependent rows (a zero-volume piece of a triangulated non-simple vertex),
     # the other proposals or the closure decide
@@ -201,17 +203,19 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     tight: list[int] = []
     of_proposal: list[int] = []
     basis: list[list[int]] = []  # per vertex: k independent rows tight at it (positions in S)
-    known: list[int] = []  # h · len(facets) + i: row h tight at vertex i by construction
     for p in kept:
         i = index.setdefault(sols[p], len(verts))
         of_proposal.append(i)
+        bits = [where[h] for h in Ts[p]]
         if i == len(verts):
             verts.append(sols[p])
-            tight.append(0)
-            basis.append([where[h] for h in Ts[p]])
-        for h in Ts[p]:
-            tight[i] |= 1 << where[h]
-            known.append(h * len(facets) + i)
+            tight.append(sum(1 << g for g in bits))
+            basis.append(bits)
+        else:
+            tight[i] |= sum(1 << g for g in bits)
+    # h · len(facets) + i: row h tight at vertex i by construction
+    known = (np.array([Ts[p] for p in kept], dtype=np.int64) * len(facets)
+             + np.array(of_proposal, dtype=np.int64)[:, None]).ravel()
     # exact feasibility, and the complete tight sets within S: floats of the exact
     # vertices (correctly rounded, int / int) with a rounding bound, plus the underflow
     # term, decide the clear cases; inf or NaN is never "clear"
@@ -233,7 +237,10 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     if near is None:
         return None
     near_r, near_v = near
-    fresh = ~np.isin(rows[near_r] * len(facets) + near_v, known)  # not tight by construction
+    # not tight by construction
+    known.sort()
+    pair = rows[near_r] * len(facets) + near_v
+    fresh = known[np.minimum(np.searchsorted(known, pair), len(known) - 1)] != pair
     near_r, near_v = near_r[fresh], near_v[fresh]
     slacks = _int64_slacks(H, scale, verts, rows[near_r], near_v)
     if slacks is not None:  # small integers: all undecided pairs at once
@@ -243,6 +250,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
             if int(h) in where:
                 tight[int(vi)] |= 1 << where[int(h)]
         near_r = near_v = ()
+    H.exact_all(np.unique(rows[near_r]).tolist())
     for r, vi in zip(near_r, near_v, strict=True):
         h, vi = int(rows[r]), int(vi)
         if h in where and tight[vi] >> where[h] & 1:
