@@ -836,3 +836,150 @@ def min_cost_sized_step(
         sp += 3
     state[CS_SP] = sp
     state[CS_NODES] += done
+
+
+@njit(cache=True, nogil=True, inline="always")
+def walk_move_delta(u: int, b: int, lab: np.ndarray, cnt: np.ndarray, deg: np.ndarray,
+                    outptr: np.ndarray, outidx: np.ndarray, r: int, unc: np.ndarray):
+    """(change of the charged count, change of the excess, uncharged members of S1, of
+    S2 after the move) when node u moves from its set lab[u] (0: neither, 1: S1, 2: S2)
+    to b ≠ lab[u].
+
+    cnt[k, j] = |N(j) ∩ S_k|; j ∈ S_k has o_j = d_j − cnt[k, j] outside in-neighbours,
+    is charged iff o_j ≥ r, and has excess (o_j − r + 1)⁺ (how many more of them it
+    would need inside to be uncharged). Moving u changes only u's own terms and, for
+    each out-neighbour w of u, o_w + 1 in u's old set, o_w − 1 in the new one."""
+    a = lab[u]
+    u1 = unc[1]
+    u2 = unc[2]
+    delta = 0
+    dex = 0
+    if a != 0:
+        o = deg[u] - cnt[a, u]
+        dex -= max(o - r + 1, 0)
+        if o >= r:
+            delta -= 1
+        elif a == 1:
+            u1 -= 1
+        else:
+            u2 -= 1
+    if b != 0:
+        o = deg[u] - cnt[b, u]
+        dex += max(o - r + 1, 0)
+        if o >= r:
+            delta += 1
+        elif b == 1:
+            u1 += 1
+        else:
+            u2 += 1
+    for t in range(outptr[u], outptr[u + 1]):
+        w = outidx[t]
+        lw = lab[w]
+        if lw == 0 or w == u:
+            continue
+        if lw == a:
+            o = deg[w] - cnt[a, w]
+            if o >= r - 1:
+                dex += 1
+            if o == r - 1:
+                delta += 1
+                if a == 1:
+                    u1 -= 1
+                else:
+                    u2 -= 1
+        elif lw == b:
+            o = deg[w] - cnt[b, w]
+            if o >= r:
+                dex -= 1
+            if o == r:
+                delta -= 1
+                if b == 1:
+                    u1 += 1
+                else:
+                    u2 += 1
+    return delta, dex, u1, u2
+
+
+@njit(cache=True, nogil=True)
+def pair_walk(deg: np.ndarray, outptr: np.ndarray, outidx: np.ndarray, r: int,
+              lab: np.ndarray, moves: int, tenure: int, floor: int, seed: int) -> np.int64:
+    """Tabu walk on labellings lab[u] ∈ {0 (neither), 1 (S1), 2 (S2)} for a cheap pair:
+    one whose sets both keep an uncharged (r-closed) member, of small cost
+    |reach_r(S1)| + |reach_r(S2)|. The walk descends the total excess
+    Σ_{i ∈ S1 ∪ S2} (o_i − r + 1)⁺ (``walk_move_delta``) plus (n + 1) per set without an
+    uncharged member, not the cost itself: the cost is flat over wide plateaus (a move
+    rarely frees a node at once), the excess tells how close each member is (ER(40, 0.8),
+    r = 17: walks reach the optimum, cost 5, in half the draws; on the cost they stop at
+    8-10). Each step takes the best move of one node to another label (ties at
+    random); a node moved in the last ``tenure`` (+ 0-2) steps stays put unless the move
+    gives a valid pair cheaper than the walk's best. Stops after ``moves`` steps or at
+    cost ``floor``. ``lab`` ends as the cheapest valid labelling visited; returns its
+    cost (n + 1 if none was valid). deg: in-degrees; outidx[outptr[u]:outptr[u + 1]]:
+    the nodes that receive from u (any n). Heuristic (any valid pair's cost bounds s*(r)
+    from above, one of cost 0 refutes r-robustness); seeded, so reproducible."""
+    np.random.seed(seed)
+    n = deg.shape[0]
+    cnt = np.zeros((3, n), dtype=np.int64)  # row 0 (nodes in neither set) is unused
+    for u in range(n):
+        for t in range(outptr[u], outptr[u + 1]):
+            cnt[lab[u], outidx[t]] += 1
+    unc = np.zeros(3, dtype=np.int64)
+    cost = 0
+    excess = 0
+    for u in range(n):
+        if lab[u] != 0:
+            excess += max(deg[u] - cnt[lab[u], u] - r + 1, 0)
+            if deg[u] - cnt[lab[u], u] >= r:
+                cost += 1
+            else:
+                unc[lab[u]] += 1
+    big = n + 1
+    best = big
+    best_lab = lab.copy()
+    if unc[1] > 0 and unc[2] > 0:
+        best = cost
+    until = np.zeros(n, dtype=np.int64)
+    for step in range(1, moves + 1):
+        if best <= floor:
+            break
+        pick_u = -1
+        pick_b = 0
+        pick_score = 1 << 40
+        ties = 0
+        for u in range(n):
+            for b in range(3):
+                if b == lab[u]:
+                    continue
+                delta, dex, u1, u2 = walk_move_delta(u, b, lab, cnt, deg, outptr, outidx,
+                                                     r, unc)
+                valid = u1 > 0 and u2 > 0
+                new = cost + delta
+                if until[u] > step and not (valid and new < best):
+                    continue
+                score = big * ((u1 == 0) + (u2 == 0)) + excess + dex
+                if score < pick_score:
+                    pick_u, pick_b, pick_score, ties = u, b, score, 1
+                elif score == pick_score:
+                    ties += 1
+                    if np.random.randint(ties) == 0:
+                        pick_u, pick_b = u, b
+        if pick_u < 0:
+            break
+        delta, dex, u1, u2 = walk_move_delta(pick_u, pick_b, lab, cnt, deg, outptr, outidx,
+                                             r, unc)
+        a = lab[pick_u]
+        for t in range(outptr[pick_u], outptr[pick_u + 1]):
+            w = outidx[t]
+            cnt[a, w] -= 1
+            cnt[pick_b, w] += 1
+        lab[pick_u] = pick_b
+        cost += delta
+        excess += dex
+        unc[1] = u1
+        unc[2] = u2
+        until[pick_u] = step + tenure + np.random.randint(3)
+        if u1 > 0 and u2 > 0 and cost < best:
+            best = cost
+            best_lab[:] = lab
+    lab[:] = best_lab
+    return best

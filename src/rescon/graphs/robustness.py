@@ -45,6 +45,7 @@ from .search import (
     MAX_SEARCH_NODES,
     CostOutcome,
     SearchOutcome,
+    SizedRun,
     cost_tree,
     decide_r_robust,
     min_cost_pair,
@@ -176,13 +177,9 @@ def _half_pair(ig: IndexedGraph) -> bd.Pair:
     return bd.Pair(half, frozenset(range(ig.n)) - half)
 
 
-def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]], *,
-                 seed_search: bool = False, deadline: float | None = None) -> Proof | None:
+def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]]) -> Proof | None:
     """A proof of (r, s)-robustness from the bounds, if one gives it: trivial, degree,
-    complete, construction from a clique, spectral (undirected: ⌈λ2/2⌉ ≥ r + s − 1),
-    or (s = 1, ``seed_search``) construction
-    from a small seed proven r-robust by a short search (≤ 1 s, and within
-    ``deadline``)."""
+    complete, construction from a clique, spectral (undirected: ⌈λ2/2⌉ ≥ r + s − 1)."""
     if r <= 0:
         return {"method": "trivial"}
     if bd.degree_r(ig) >= r:
@@ -194,8 +191,6 @@ def _cheap_proof(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]], *,
         r_spec, spec = bd.spectral_r(ig)
         if spec is not None and r_spec >= r + s - 1:
             proof = spec if s == 1 else {"method": "implied", "r": r_spec, "s": 1, "proof": spec}
-    if proof is None and s == 1 and seed_search:
-        proof = _searched_seed_construction(ig, r, deadline)
     return proof
 
 
@@ -314,14 +309,21 @@ def _decide_r_fresh(
     known_pair: tuple[int, bd.Pair] | None,
     on_progress: Callable[[float, int], None] | None,
 ) -> _Decision:
-    """Is ig r-robust (r ≤ ⌈n/2⌉)? Bounds first, then the exact ``method``."""
+    """Is ig r-robust (r ≤ ⌈n/2⌉)? Bounds first (proofs, the known pair, the walks'
+    witness, a construction from a searched seed), then the exact ``method``."""
     _check_method_size(method, ig.n)
-    proof = _cheap_proof(ig, r, 1, seeds, seed_search=True, deadline=deadline)
+    proof = _cheap_proof(ig, r, 1, seeds)
     if proof is not None:
         return _Decision(True, proof=proof)
     value, pair = known_pair if known_pair is not None else bd.upper_witness(ig)
     if value < r:
         return _Decision(False, pair=pair)
+    walked = _walked_witness(ig, r, deadline)
+    if walked is not None:
+        return _Decision(False, pair=walked)
+    proof = _searched_seed_construction(ig, r, deadline)
+    if proof is not None:
+        return _Decision(True, proof=proof)
     if method == "auto" and ig.n > MAX_SEARCH_NODES:
         method = "milp"
     if method == "auto":
@@ -337,6 +339,23 @@ def _decide_r_fresh(
     return _milp_decision(ig, r, milp_min_cost(ig, r, upper=1, decision_only=True,
                                                time_limit=_remaining(deadline),
                                                on_progress=on_progress))
+
+
+WITNESS_SECONDS = 1.0  # budget of the tabu walks for two disjoint r-closed sets
+
+
+def _walked_witness(ig: IndexedGraph, r: int, deadline: float | None) -> bd.Pair | None:
+    """Two disjoint r-closed sets (a pair of cost 0 at threshold r: not r-robust) found
+    by the tabu walks (bounds.tabu_pairs) within ``WITNESS_SECONDS``, or None. Dense
+    graphs are where the exact decision finds its witness slowly: ER(50, 0.8), seed
+    50000, r = 21: the walks find one in 0.1 s, the MILP took 41 s, the decision
+    search more than 60 s."""
+    stop = time.perf_counter() + WITNESS_SECONDS
+    found = bd.tabu_pairs(ig, r, floor=0, deadline=stop if deadline is None else
+                          min(stop, deadline))
+    if found and bd.pair_cost(ig, found[-1], r) == 0:
+        return found[-1]
+    return None
 
 
 def _search_decision(out: SearchOutcome) -> _Decision:
@@ -365,26 +384,73 @@ def _milp_decision(ig: IndexedGraph, r: int, out: MilpOutcome) -> _Decision:
 
 def _race(ig: IndexedGraph, r: int, deadline: float | None,
           on_progress: Callable[[float, int], None] | None) -> _Decision:
-    """The search and the MILP race, one core each; the first answer wins.
+    """The decision search, the sized search below cap 1 (search.SizedRun) and the MILP
+    race; the first answer wins, the others are cancelled.
 
-    The search wins on sparse and mid-density graphs (and its tree is a checkable
-    certificate); the MILP wins on dense ones, where its LP bound bites (its proof
-    is accepted on trust). Whichever loses is cancelled.
+    The two searches take turns on one core (``_turns``), the MILP has the other. The
+    decision search wins on sparse and mid-density graphs, the sized search on dense
+    ones (ER(50, 0.8), seed 50000, r = 20: 0.4 s, where the MILP took 54 s and the
+    decision search more than 60 s); both trees are checkable certificates. The MILP
+    (its proof is accepted on trust) is the fallback where neither search gets far.
     """
     milp = RobustnessMilp(ig, r, upper=1, decision_only=True, time_limit=_remaining(deadline))
+    sized = SizedRun(ig, r, 1, lower=0)
     try:
         out = decide_r_robust(ig, r, deadline=deadline, on_progress=on_progress,
-                              should_stop=_rival(milp))
+                              should_stop=_turns(sized, _rival(milp)))
     except BaseException:
         milp.cancel()
         raise
     if out.status != "stopped":
         milp.cancel()
         return _search_decision(out)
+    if sized.finished:
+        milp.cancel()
+        return _sized_decision(ig, r, sized)
     if deadline is not None and time.perf_counter() > deadline:
         milp.cancel()
         return _Decision(None, method="search+milp")
     return _milp_decision(ig, r, milp.outcome())
+
+
+def _turns(sized: SizedRun, rival: Callable[[], bool]) -> Callable[[], bool]:
+    """``should_stop`` for a decision search that shares its core with ``sized``: at each
+    poll (between the decision search's slices) the sized search runs until it has had
+    as much time as the decision search; True once it has finished or ``rival`` (the
+    MILP's ``should_stop``) says stop. Either search alone would take at most twice its
+    own time."""
+    spent = [0.0, 0.0]  # decision search, sized search
+    mark = [time.perf_counter()]
+
+    def should_stop() -> bool:
+        now = time.perf_counter()
+        spent[0] += now - mark[0]
+        if spent[1] < spent[0]:
+            sized.run_for(spent[0] - spent[1])
+            spent[1] += time.perf_counter() - now
+        mark[0] = time.perf_counter()
+        return sized.finished or rival()
+
+    return should_stop
+
+
+def _sized_decision(ig: IndexedGraph, r: int, sized: SizedRun) -> _Decision:
+    """r-robustness from the finished sized search below cap 1: a pair of cost 0 (two
+    disjoint r-closed sets) refutes it; none proves it, the recorded tree is the proof
+    (certificates/FORMAT.md, ``cost_search`` with s = 1)."""
+    found = sized.pair()
+    if found is not None:
+        pair = bd.Pair(*found)
+        if not bd.violates(ig, pair, r, 1):
+            raise RESCONError(f"internal error: the sized search's pair does not violate "
+                              f"{r}-robustness")
+        return _Decision(False, pair=pair, method="search")
+    proof: Proof = {"method": "cost_search", "order": sized.order.tolist(),
+                    "info": {"nodes": sized.nodes}}
+    tree = sized.tree()
+    if tree is not None:
+        proof["tree"] = list(tree)
+    return _Decision(True, proof=proof, method="search")
 
 
 RACE_DELAY_SECONDS = 1.0
