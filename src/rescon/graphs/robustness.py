@@ -14,7 +14,7 @@ tree below s = 1 proves r-robustness, if it is small: dense graphs); for s*, the
 subset DP (n ≤ 22), else the two s* branch and bounds of search.min_cost_pair
 (charged-set, sized) raced against the MILP (n ≤ 64), else the MILP; an s* proof the
 checker would take on trust gets the sized search's tree below s* instead, if it is
-small (_replayed).
+small, else the charged tree (one decision tree per set of charged nodes; _replayed).
 
 Before any search, every fact already proven about the same graph in this process
 (facts.py: a bounded cache keyed by node labels and edges) is used through the
