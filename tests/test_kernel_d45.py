@@ -72,7 +72,7 @@ def test_fast_path_refuses_a_missing_non_simple_vertex():
     P = fastpath._certify(H, 4, unit, first, facets)
     vi = next(i for i, t in enumerate(P.tight) if bin(t).count("1") > 4)
     target = P.verts[vi]
-    bases = [fastpath._basis_of(H, [int(first[i]) for i in f], 4) for f in facets]
+    bases = fastpath._bases(H, [[int(first[i]) for i in f] for f in facets], 4)
     keep = [f for f, v in zip(facets, fastpath._solve_all(H, bases, 4), strict=True)
             if v != target]
     assert len(keep) < len(facets)
@@ -148,8 +148,9 @@ def test_extra_rows_of_a_merged_proposal_are_decided_exactly():
     stranger = next(i for i in range(len(first))
                     if i not in facets[simple] and not any(
                         i in f for f, v in zip(facets, fastpath._solve_all(
-                            H, [fastpath._basis_of(H, [int(first[j]) for j in f], 4)
-                                for f in facets], 4), strict=True) if v == vertex))
+                            H, fastpath._bases(H, [[int(first[j]) for j in f]
+                                                   for f in facets], 4), 4),
+                        strict=True) if v == vertex))
     lied = [list(f) for f in facets]
     lied[simple] = [*lied[simple], stranger]
     P = fastpath._certify(H, 4, unit, first, lied)

@@ -186,3 +186,24 @@ def test_a_moved_vertex_is_refused():
         moved += 1
         assert fastpath._certify(H, 4, unit, first, lied) is None
     assert moved > 0
+
+
+def test_bases_pick_independent_rows_of_each_proposal():
+    """k distinct rows of T, independent even when T repeats directions (rows 0-2 are
+    one normal at three scales: a pivoted QR takes at most one of them)."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(6)
+    for k in (3, 4, 5):
+        af = rng.normal(size=(40, k))
+        af[1], af[2] = 3.0 * af[0], -0.5 * af[0]
+        H = SimpleNamespace(af=af)
+        Ts = [[0, 1, 2, *rng.choice(np.arange(3, 40), size=int(rng.integers(k - 1, k + 5)),
+                                    replace=False).tolist()] for _ in range(60)]
+        Ts += [rng.choice(40, size=k, replace=False).tolist() for _ in range(5)]
+        got = fastpath._bases(H, Ts, k)
+        for T, B in zip(Ts, got, strict=True):
+            assert len(set(B)) == k and set(B) <= set(T)
+            assert len(T) > k or B == T
+            assert len({0, 1, 2} & set(B)) <= 1
+            assert np.linalg.svd(af[B], compute_uv=False)[-1] > 1e-6

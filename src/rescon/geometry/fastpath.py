@@ -191,7 +191,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     H.exact_all(S_set)
     where = {h: i for i, h in enumerate(S_set)}
     rows_of = sel.tolist()
-    Ts = [_basis_of(H, [rows_of[i] for i in f], k) for f in facets]
+    Ts = _bases(H, [[rows_of[i] for i in f] for f in facets], k)
     sols = _solve_all(H, Ts, k)
     # None: k dependent rows (a zero-volume piece of a triangulated non-simple vertex),
     # the other proposals or the closure decide
@@ -436,18 +436,32 @@ def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
     return (A.astype(np.int64) * V[:, 1:]).sum(axis=1) - b.astype(np.int64) * V[:, 0]
 
 
-def _basis_of(H, T: list[int], k: int) -> list[int]:
-    """k of the rows T that floats suggest are independent (QR with column pivoting of
-    their unit normals): the rows a merged (non-simple) proposal is solved from. Only
-    these k are tight by construction; the others are decided exactly later."""
-    if len(T) == k:
-        return T
-    from scipy.linalg import qr
-
-    A = H.af[T]
-    A = A / np.linalg.norm(A, axis=1)[:, None]
-    _, _, piv = qr(A.T, pivoting=True, mode="economic")
-    return [T[i] for i in piv[:k]]
+def _bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
+    """For each proposal's rows T, k of them that floats suggest are independent: T
+    itself when it has k rows; else the rows a merged (non-simple) proposal is solved
+    from, by QR with column pivoting of their unit normals (at each step the row of
+    largest norm once the chosen ones are projected out), all proposals of one size at
+    once. Only these k are tight by construction; the others are decided exactly
+    later."""
+    out = list(Ts)
+    sizes: dict[int, list[int]] = {}
+    for p, T in enumerate(Ts):
+        if len(T) > k:
+            sizes.setdefault(len(T), []).append(p)
+    for ps in sizes.values():
+        R = H.af[np.array([Ts[p] for p in ps])]  # (m, t, k)
+        R = R / np.linalg.norm(R, axis=2)[:, :, None]
+        m = np.arange(len(ps))
+        chosen = np.empty((len(ps), k), dtype=np.int64)
+        for j in range(k):
+            norms = (R * R).sum(axis=2)
+            c = chosen[:, j] = norms.argmax(axis=1)
+            q = R[m, c] / np.sqrt(norms[m, c])[:, None]
+            R = R - (R @ q[:, :, None]) * q[:, None, :]
+            R[m, c] = 0.0
+        for p, row in zip(ps, chosen.tolist(), strict=True):
+            out[p] = [Ts[p][i] for i in row]
+    return out
 
 
 def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
