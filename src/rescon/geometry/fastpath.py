@@ -287,7 +287,9 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     row tight; a non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight
     along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆
     tight[u], and then it is the other end of the edge (the line meets P_S in that
-    edge). Found through the (k − 1)-subsets of the tight sets (:class:`_RayIndex`)."""
+    edge). Found through the (k − 1)-subsets of the tight sets (:class:`_RayIndex`).
+    ``start_rays``: for a list of bases, their simplicial cones' rays
+    (:func:`_simplicial_rays`), where the double descriptions start."""
     index = _RayIndex(tight, basis, len(normals), k)
     non_simple = index.non_simple
     starts = start_rays([basis[vi] for vi in non_simple])
