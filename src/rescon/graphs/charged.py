@@ -46,14 +46,15 @@ def count_configurations(n: int, c: int) -> int:
 
 def charged_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = None,
                  max_tokens: int = 4_000_000) -> tuple[int, ...] | None:
-    """The charged tree proving (r, s)-robustness (r ≥ 1), in the order
-    ``search.search_order(ig)``; None beyond ``max_tokens`` tokens, ``MAX_CONFIGS``
-    configurations or ``deadline``; ValueError when a configuration has a violating
-    pair (a pair cheaper than s)."""
+    """The charged tree proving (r, s)-robustness, in the order
+    ``search.search_order(ig)``; None for r < 1, beyond ``max_tokens`` tokens (also when
+    the first configuration's tree times the number of configurations passes twice that),
+    ``MAX_CONFIGS`` configurations or ``deadline``; ValueError when a configuration has
+    a violating pair (a pair cheaper than s)."""
     from ._charged_kernels import OVERFLOW, config_tree
     from .search import _kernel_inputs
 
-    if count_configurations(ig.n, s - 1) > MAX_CONFIGS:
+    if r < 1 or count_configurations(ig.n, s - 1) > MAX_CONFIGS:
         return None
     _, inmask, outmask, order = _kernel_inputs(ig)
     masks = [int(m) for m in inmask]
