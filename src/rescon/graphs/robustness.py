@@ -42,6 +42,7 @@ from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
 from .milp import MilpOutcome, RobustnessMilp, milp_min_cost
 from .search import (
+    FAVOURED_SHARE,
     MAX_SEARCH_NODES,
     CostOutcome,
     SearchOutcome,
@@ -263,7 +264,7 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
     4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M), else, for
     s ≥ 2, the charged tree (charged.charged_tree: one decision tree per set of charged
     nodes; ER(30, 0.5) with s = 2: 2.4–3.5M tokens, where the sized tree has > 30M),
-    each recorded within ``TREE_SECONDS``; the deciding method stays in
+    recorded within ``TREE_SECONDS``, resp. ``CHARGED_SECONDS``; the deciding method stays in
     ``info.decided_by``. Otherwise ``proof`` itself."""
     method = proof["method"]
     if (ig.n > MAX_SEARCH_NODES
@@ -271,9 +272,9 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
                     or method in ("search", "cost_search") and proof.get("tree") is None
                     and proof.get("charged_tree") is None)):
         return proof
-    key, tree = "tree", _recorded(cost_tree, ig, r, s, deadline)
+    key, tree = "tree", _recorded(cost_tree, ig, r, s, deadline, TREE_SECONDS)
     if tree is None and s >= 2:
-        key, tree = "charged_tree", _recorded(charged_tree, ig, r, s, deadline)
+        key, tree = "charged_tree", _recorded(charged_tree, ig, r, s, deadline, CHARGED_SECONDS)
     if tree is None:
         return proof
     return {"method": "cost_search", "order": search_order(ig).tolist(), key: list(tree),
@@ -281,10 +282,10 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
 
 
 def _recorded(record: Callable[..., tuple[int, ...] | None], ig: IndexedGraph, r: int, s: int,
-              deadline: float | None) -> tuple[int, ...] | None:
+              deadline: float | None, seconds: float) -> tuple[int, ...] | None:
     """The tree ``record`` (search.cost_tree or charged.charged_tree) proving
-    (r, s)-robustness within ``TREE_SECONDS``, or None."""
-    stop = time.perf_counter() + TREE_SECONDS
+    (r, s)-robustness within ``seconds``, or None."""
+    stop = time.perf_counter() + seconds
     try:
         return record(ig, r, s, deadline=stop if deadline is None else min(stop, deadline))
     except ValueError as exc:
@@ -387,17 +388,18 @@ def _race(ig: IndexedGraph, r: int, deadline: float | None,
     """The decision search, the sized search below cap 1 (search.SizedRun) and the MILP
     race; the first answer wins, the others are cancelled.
 
-    The two searches take turns on one core (``_turns``), the MILP has the other. The
-    decision search wins on sparse and mid-density graphs, the sized search on dense
-    ones (ER(50, 0.8), seed 50000, r = 20: 0.4 s, where the MILP took 54 s and the
-    decision search more than 60 s); both trees are checkable certificates. The MILP
-    (its proof is accepted on trust) is the fallback where neither search gets far.
+    The two searches take turns on one core (``_turns``, ``_sized_share``), the MILP
+    has the other. The decision search wins on sparse and mid-density graphs, the
+    sized search on dense ones (ER(50, 0.8), seed 50000, r = 20: 0.4 s, where the MILP
+    took 54 s and the decision search more than 60 s); both trees are checkable
+    certificates. The MILP (its proof is accepted on trust) is the fallback where
+    neither search gets far.
     """
     milp = RobustnessMilp(ig, r, upper=1, decision_only=True, time_limit=_remaining(deadline))
     sized = SizedRun(ig, r, 1, lower=0)
     try:
         out = decide_r_robust(ig, r, deadline=deadline, on_progress=on_progress,
-                              should_stop=_turns(sized, _rival(milp)))
+                              should_stop=_turns(sized, _rival(milp), _sized_share(ig)))
     except BaseException:
         milp.cancel()
         raise
@@ -413,20 +415,33 @@ def _race(ig: IndexedGraph, r: int, deadline: float | None,
     return _milp_decision(ig, r, milp.outcome())
 
 
-def _turns(sized: SizedRun, rival: Callable[[], bool]) -> Callable[[], bool]:
+DENSE = 0.65  # arc density from which the sized search is favoured in the race
+
+
+def _sized_share(ig: IndexedGraph) -> float:
+    """The sized search's share of the core it takes turns on with the decision search:
+    ``FAVOURED_SHARE`` on graphs of arc density ≥ ``DENSE`` (ER(40–50, 0.8): the sized
+    search decides ρ in 0.1–10 s, the decision search not in 60 s), else the rest (ER(40,
+    0.5): the decision search in 6 s, the sized search not in 60 s). A wrong guess
+    costs at most 4× the winner's own time."""
+    density = sum(ig.in_degrees) / max(ig.n * (ig.n - 1), 1)
+    return FAVOURED_SHARE if density >= DENSE else 1 - FAVOURED_SHARE
+
+
+def _turns(sized: SizedRun, rival: Callable[[], bool], share: float) -> Callable[[], bool]:
     """``should_stop`` for a decision search that shares its core with ``sized``: at each
     poll (between the decision search's slices) the sized search runs until it has had
-    as much time as the decision search; True once it has finished or ``rival`` (the
-    MILP's ``should_stop``) says stop. Either search alone would take at most twice its
-    own time."""
+    its ``share`` of the time; True once it has finished or ``rival`` (the MILP's
+    ``should_stop``) says stop."""
     spent = [0.0, 0.0]  # decision search, sized search
     mark = [time.perf_counter()]
 
     def should_stop() -> bool:
         now = time.perf_counter()
         spent[0] += now - mark[0]
-        if spent[1] < spent[0]:
-            sized.run_for(spent[0] - spent[1])
+        owed = spent[0] * share / (1 - share) - spent[1]
+        if owed > 0:
+            sized.run_for(owed)
             spent[1] += time.perf_counter() - now
         mark[0] = time.perf_counter()
         return sized.finished or rival()
@@ -659,6 +674,7 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
 
 
 TREE_SECONDS = 2.0  # budget for recording a replayable proof tree (search.cost_tree)
+CHARGED_SECONDS = 4.0  # budget for the charged tree (charged.charged_tree; ~1 s for 3.5M tokens)
 
 
 DEEPEN_CHEAP_SECONDS = 0.1
