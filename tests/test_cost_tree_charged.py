@@ -178,3 +178,14 @@ def test_er30_s_star_certificate_is_fully_checked():
     assert check.verdict == "valid" and check.trusted == ()
     bad = {**rep.certificate, "lower_s": _cut(lower_s)}
     assert rescon.check_certificate(bad).verdict == "invalid"
+
+
+def test_no_charged_tree_beyond_its_limits():
+    """None, never a partial tree: too many configurations, a token budget the first
+    configuration shows to be too small, a passed deadline, r < 1."""
+    ig = index_graph(nx.gnp_random_graph(20, 0.5, directed=True, seed=2))
+    assert count_configurations(20, 5) > 20_000 and charged_tree(ig, 1, 6) is None
+    assert charged_tree(ig, 0, 2) is None
+    full = charged_tree(ig, 1, 2)
+    assert full is not None and charged_tree(ig, 1, 2, max_tokens=len(full) // 4) is None
+    assert charged_tree(ig, 1, 2, deadline=0.0) is None
