@@ -378,8 +378,9 @@ class _RayIndex:
         and at most MAX_TIGHT rows is), else by :meth:`_scan`; None if one has none."""
         if not ray_v:
             return []
-        first = [list(itertools.islice(_bits(Z), self.k - 1)) for Z in ray_z]
-        K = np.array(first, dtype=np.int64).reshape(-1, self.k - 1) @ self.W
+        _, rows = tight_pairs(ray_z)  # by ray, increasing: each ray's first k − 1
+        starts = np.concatenate([[0], np.cumsum([Z.bit_count() for Z in ray_z])[:-1]])
+        K = rows[starts[:, None] + np.arange(self.k - 1)] @ self.W
         lo = np.searchsorted(self.keys, K, side="left").tolist()
         hi = np.searchsorted(self.keys, K, side="right").tolist()
         owners, tight = self.owners.tolist(), self.tight
