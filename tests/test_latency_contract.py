@@ -115,16 +115,14 @@ def test_numpy_scan_decides_as_the_numba_scan(k, extra, kind, seed, F, exact):
     """Same cofactors, same degenerate flags, and every count compared with F the same
     (the numba scan stops a subset early, so only counts ≤ F must be equal)."""
     from rescon.geometry import _candidates, _scan_np
-    from rescon.geometry.halfspaces import _permutations
 
     m = k + extra
     Y, W = _scan_inputs(k, m, kind, seed)
     subsets = _scan_np.k_subsets(m, k)
     assert np.array_equal(subsets, _candidates.k_subsets(m, k, comb(m, k)))
-    perms, signs = _permutations(k - 1)
     c_err, floor = (0.0, 0.0) if exact else (1e-15, 1e-300)
-    a = _candidates.classify(Y, W.astype(np.int64), subsets, perms, signs, c_err, F, floor)
-    b = _scan_np.classify(Y, W, subsets, perms, signs, c_err, F, floor)
+    a = _candidates.classify(Y, W.astype(np.int64), subsets, c_err, F, floor)
+    b = _scan_np.classify(Y, W, subsets, c_err, F, floor)
     assert np.array_equal(a[3], b[3])
     assert np.array_equal(a[4], b[4]) and np.array_equal(a[5], b[5])
     plus_a, minus_a, unc_a = a[:3]

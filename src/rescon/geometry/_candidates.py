@@ -23,133 +23,96 @@ from numba import njit, prange
 from .._rounding import UNIT_ROUNDOFF
 
 
-@njit(cache=True)
-def _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols):
+@njit(cache=True, nogil=True)
+def _cofactors(Y, idx, k, C, Cabs):
     """Cofactors of the last row of [p_1 − p_0; ...; p_{k−1} − p_0; ·] and their
-    absolute-value permanents, into C and Cabs (length k); D ((k−1, k)) and cols
-    (k − 1) are scratch. Closed forms for k = 2, 3."""
-    p0 = idx[0]
-    for i in range(k - 1):
-        for j in range(k):
-            D[i, j] = Y[idx[i + 1], j] - Y[p0, j]
+    absolute-value permanents, into C and Cabs (length k), for k = 2, 3 (closed
+    forms; k ≥ 4: :func:`_prefix_minors` and :func:`_last_row_cofactors`)."""
+    p0, p1 = idx[0], idx[1]
     if k == 2:
-        C[0] = -D[0, 1]
-        C[1] = D[0, 0]
-        Cabs[0] = abs(D[0, 1])
-        Cabs[1] = abs(D[0, 0])
+        C[0] = -(Y[p1, 1] - Y[p0, 1])
+        C[1] = Y[p1, 0] - Y[p0, 0]
+        Cabs[0] = abs(C[0])
+        Cabs[1] = abs(C[1])
         return
-    if k == 3:
-        a0, a1, a2 = D[0, 0], D[0, 1], D[0, 2]
-        b0, b1, b2 = D[1, 0], D[1, 1], D[1, 2]
-        C[0] = a1 * b2 - a2 * b1
-        C[1] = a2 * b0 - a0 * b2
-        C[2] = a0 * b1 - a1 * b0
-        Cabs[0] = abs(a1 * b2) + abs(a2 * b1)
-        Cabs[1] = abs(a2 * b0) + abs(a0 * b2)
-        Cabs[2] = abs(a0 * b1) + abs(a1 * b0)
-        return
-    if k == 4:
-        _cofactors4(D, C, Cabs)
-        return
-    if k == 5:
-        _cofactors5(D, C, Cabs)
-        return
-    for j in range(k):
-        c = 0
-        for t in range(k):
-            if t != j:
-                cols[c] = t
-                c += 1
-        det = 0.0
-        per = 0.0
-        for p in range(perms.shape[0]):
-            prod = 1.0
-            aprod = 1.0
-            for i in range(k - 1):
-                v = D[i, cols[perms[p, i]]]
-                prod *= v
-                aprod *= abs(v)
-            det += psigns[p] * prod
-            per += aprod
-        sign = 1.0 if (k - 1 + j) % 2 == 0 else -1.0
-        C[j] = sign * det
-        Cabs[j] = per
+    p2 = idx[2]
+    a0, a1, a2 = Y[p1, 0] - Y[p0, 0], Y[p1, 1] - Y[p0, 1], Y[p1, 2] - Y[p0, 2]
+    b0, b1, b2 = Y[p2, 0] - Y[p0, 0], Y[p2, 1] - Y[p0, 1], Y[p2, 2] - Y[p0, 2]
+    C[0] = a1 * b2 - a2 * b1
+    C[1] = a2 * b0 - a0 * b2
+    C[2] = a0 * b1 - a1 * b0
+    Cabs[0] = abs(a1 * b2) + abs(a2 * b1)
+    Cabs[1] = abs(a2 * b0) + abs(a0 * b2)
+    Cabs[2] = abs(a0 * b1) + abs(a1 * b0)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _minor2(D, r, a, b):
-    """det and permanent of |·| of rows r, r + 1 and columns a, b of D."""
-    x, y = D[r, a] * D[r + 1, b], D[r, b] * D[r + 1, a]
-    return x - y, abs(x) + abs(y)
+def _expand_last(row, r, mask, mdet, mper):
+    """det and permanent of |·| of the minor on rows 0..r of the difference rows and
+    the columns in ``mask`` (r + 1 of them), expanded along row r (its entries ``row``)
+    over the minors of rows 0..r − 1 on ``mask`` less one column (mdet, mper, indexed
+    by column bitmask): Σ_t (−1)^(r + t) row[c_t] · minor(mask − c_t), c_0 < c_1 < …"""
+    det = 0.0
+    per = 0.0
+    t = 0
+    for col in range(row.shape[0]):
+        if mask >> col & 1:
+            sub = mask ^ (1 << col)
+            term = row[col] * mdet[sub]
+            if (r + t) % 2 == 0:
+                det += term
+            else:
+                det -= term
+            per += abs(row[col]) * mper[sub]
+            t += 1
+    return det, per
 
 
 @njit(cache=True, nogil=True)
-def _cofactors4(D, C, Cabs):
-    """_cofactors for k = 4: each 3 × 3 minor of D (3 × 4) expanded along its first
-    row over the 2 × 2 minors of rows 1, 2 (24 products instead of 4 · 3! · 2; every
-    product of the expansion still passes through fewer roundings than c_err allows)."""
-    m = np.empty((4, 4))
-    p = np.empty((4, 4))
-    for a in range(4):
-        for b in range(a + 1, 4):
-            m[a, b], p[a, b] = _minor2(D, 1, a, b)
-    for j in range(4):
-        det = 0.0
-        per = 0.0
-        sign = 1.0
-        for i in range(4):
-            if i == j:
-                continue
-            a, b = -1, -1
-            for t in range(4):
-                if t != i and t != j:
-                    if a < 0:
-                        a = t
-                    else:
-                        b = t
-            det += sign * D[0, i] * m[a, b]
-            per += abs(D[0, i]) * p[a, b]
-            sign = -sign
-        C[j] = det if (3 + j) % 2 == 0 else -det
-        Cabs[j] = per
+def _prefix_minors(Y, idx, k, R, mdet, mper):
+    """For k ≥ 4: every minor (and permanent of |·|) of the first k − 2 difference rows
+    p_i − p_0 (i = 1..k − 2, into R) on k − 2 of the k columns, into mdet, mper indexed
+    by column bitmask — with the smaller minors on the way: the mask of r + 1 columns
+    holds the minor of rows 0..r (:func:`_expand_last`; mask 0 the empty one, 1), built
+    in increasing order of the masks, so each after the r-column masks it expands over.
+    They depend on p_0..p_{k−2} only: the subsets in lexicographic order share them
+    along runs of the last index. O(k 2^k) steps."""
+    p0 = idx[0]
+    for i in range(k - 2):
+        for j in range(k):
+            R[i, j] = Y[idx[i + 1], j] - Y[p0, j]
+    mdet[0] = 1.0
+    mper[0] = 1.0
+    for mask in range(1, 1 << k):
+        r = _popcount(mask) - 1
+        if r < k - 2:
+            mdet[mask], mper[mask] = _expand_last(R[r], r, mask, mdet, mper)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _popcount(mask):
+    c = 0
+    while mask:
+        mask &= mask - 1
+        c += 1
+    return c
 
 
 @njit(cache=True, nogil=True)
-def _cofactors5(D, C, Cabs):
-    """_cofactors for k = 5: each 4 × 4 minor of D (4 × 5) by the Laplace expansion
-    along rows 0, 1 — Σ over column pairs S of (−1)^(1 + s₁ + s₂) (its 2 × 2 minor on
-    rows 0, 1 and S) (the complementary one on rows 2, 3), the permanents likewise
-    unsigned: 70 products instead of 5 · 4! · 3."""
-    m01 = np.empty((5, 5))
-    p01 = np.empty((5, 5))
-    m23 = np.empty((5, 5))
-    p23 = np.empty((5, 5))
-    for a in range(5):
-        for b in range(a + 1, 5):
-            m01[a, b], p01[a, b] = _minor2(D, 0, a, b)
-            m23[a, b], p23[a, b] = _minor2(D, 2, a, b)
-    cols = np.empty(4, dtype=np.int64)
-    for j in range(5):
-        c = 0
-        for t in range(5):
-            if t != j:
-                cols[c] = t
-                c += 1
-        det = 0.0
-        per = 0.0
-        for u in range(4):
-            for v in range(u + 1, 4):
-                w0, w1 = -1, -1
-                for t in range(4):
-                    if t != u and t != v:
-                        if w0 < 0:
-                            w0 = t
-                        else:
-                            w1 = t
-                term = m01[cols[u], cols[v]] * m23[cols[w0], cols[w1]]
-                det += term if (1 + u + v) % 2 == 0 else -term
-                per += p01[cols[u], cols[v]] * p23[cols[w0], cols[w1]]
-        C[j] = det if (4 + j) % 2 == 0 else -det
+def _last_row_cofactors(Y, idx, k, mdet, mper, last, C, Cabs):
+    """For k ≥ 4, the cofactors C_j = (−1)^(k−1+j) det(D without column j) of the last
+    row of [D; ·], D the k − 1 difference rows, each determinant expanded along D's
+    last row p_{k−1} − p_0 (into ``last``) over the prefix minors of
+    :func:`_prefix_minors`; Cabs likewise, unsigned. Every product passes through
+    k(k − 1)/2 roundings at most (a difference, then per row one product and a sum),
+    fewer than the scan's c_err allows."""
+    p0 = idx[0]
+    for j in range(k):
+        last[j] = Y[idx[k - 1], j] - Y[p0, j]
+    full = (1 << k) - 1
+    for j in range(k):
+        det, per = _expand_last(last, k - 2, full ^ (1 << j), mdet, mper)
+        C[j] = det if (k - 1 + j) % 2 == 0 else -det
         Cabs[j] = per
 
 
@@ -158,16 +121,17 @@ def _cofactors5(D, C, Cabs):
 PARALLEL_MIN_SUBSETS = 5_000
 
 
-def classify(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
+def classify(Y, W, subsets, c_err, F, floor=0.0):
     """:func:`classify_subsets`, on one thread for small inputs."""
     count, k = subsets.shape
     if count >= PARALLEL_MIN_SUBSETS:
-        return classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor)
+        return classify_subsets(Y, W, subsets, c_err, F, floor)
     out = (np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64),
            np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_),
            np.empty((count, k)), np.empty((count, k)))
     M = float(np.abs(Y).max()) if Y.size else 0.0
-    _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, 0, count, *out)
+    _classify_range(Y, np.ascontiguousarray(Y.T), W, subsets, c_err, F, floor, M, 0, count,
+                    *out)
     return out
 
 
@@ -244,21 +208,91 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, floor, F):
 
 
 @njit(cache=True, nogil=True)
-def _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, t0, t1,
+def _scan_all(Y, YT, W, idx, C, Cabs, coarse, c_err, floor, S):
+    """The point scan of _classify_range for k ≥ 4: the orientations s(q) of every
+    point at once into S (coordinate by coordinate over the rows of YT = Yᵀ — loops
+    the compiler vectorises; each s(q) summed in the order j = 0..k−1, as the other
+    scans), their signs against the coarse bound counted without branches, the
+    subset's own points taken out again, and only the points within the coarse bound
+    (or NaN) tested against their precise one. No early stop: the counts are exact."""
+    n, k = Y.shape
+    p0 = idx[0]
+    x, c, yt = Y[p0, 0], C[0], YT[0]
+    for q in range(n):
+        S[q] = (yt[q] - x) * c
+    for j in range(1, k):
+        x, c, yt = Y[p0, j], C[j], YT[j]
+        for q in range(n):
+            S[q] += (yt[q] - x) * c
+    np_, nm, near = _coarse_counts(S, W, coarse, 0, n)
+    for i in range(k):  # the subset's own points
+        a, b, e = _coarse_counts(S, W, coarse, idx[i], idx[i] + 1)
+        np_, nm, near = np_ - a, nm - b, near - e
+    nu = 0
+    if near == 0:
+        return np_, nm, nu
+    for q in range(n):
+        s = S[q]
+        if s > coarse or s < -coarse or _member(idx, q):
+            continue
+        bound = 0.0
+        for j in range(k):
+            bound += abs(Y[q, j] - Y[p0, j]) * Cabs[j]
+        np_, nm, nu = _tally(_side(s, bound * c_err + floor, c_err), W[q], np_, nm, nu)
+    return np_, nm, nu
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _coarse_counts(S, W, coarse, lo, hi):
+    """Weighted numbers of the points lo ≤ q < hi with S[q] > coarse and S[q] < −coarse,
+    and the number of the others (within the bound, or NaN)."""
+    np_, nm, near = 0, 0, 0
+    for q in range(lo, hi):
+        s = S[q]
+        pos = s > coarse
+        neg = s < -coarse
+        w = W[q]
+        np_ += w * pos
+        nm += w * neg
+        near += 1 - pos - neg
+    return np_, nm, near
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _member(idx, q):
+    for i in range(idx.shape[0]):
+        if idx[i] == q:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
                     plus, minus, unc, degenerate, cof, cof_abs):
     """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays)."""
     n, k = Y.shape
     C = np.empty(k)
     Cabs = np.empty(k)
-    D = np.empty((max(k - 1, 1), k))
-    cols = np.empty(max(k - 1, 1), dtype=np.int64)
+    R = np.empty((max(k - 2, 1), k))  # k ≥ 4: the prefix's difference rows,
+    mdet = np.empty(1 << k)  # its minors and their permanents (by column bitmask),
+    mper = np.empty(1 << k)
+    prefix = np.full(max(k - 1, 1), -1)  # and its points
+    last = np.empty(k)
+    S = np.empty(n)
     for t in range(t0, t1):
         idx = subsets[t]
         if k == 1:
             C[0] = 1.0
             Cabs[0] = 1.0
+        elif k <= 3:
+            _cofactors(Y, idx, k, C, Cabs)
         else:
-            _cofactors(Y, idx, k, perms, psigns, C, Cabs, D, cols)
+            for i in range(k - 1):
+                if prefix[i] != idx[i]:
+                    _prefix_minors(Y, idx, k, R, mdet, mper)
+                    prefix[:] = idx[:k - 1]
+                    break
+            _last_row_cofactors(Y, idx, k, mdet, mper, last, C, Cabs)
         zero = True
         coarse = 0.0
         for j in range(k):
@@ -272,20 +306,14 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, t0, t1,
             degenerate[t] = True
             continue
         p0 = idx[0]
-        if k == 3:
-            np_, nm, nu = _scan3(Y, W, idx[0], idx[1], idx[2], C, Cabs, coarse, c_err, floor,
-                                 F)
-            plus[t] = np_
-            minus[t] = nm
-            unc[t] = nu
+        if k >= 3:
+            plus[t], minus[t], unc[t] = (
+                _scan_all(Y, YT, W, idx, C, Cabs, coarse, c_err, floor, S) if k >= 4
+                else _scan3(Y, W, idx[0], idx[1], idx[2], C, Cabs, coarse, c_err, floor, F))
             continue
         np_, nm, nu = 0, 0, 0
         for q in range(n):
-            is_member = False
-            for i in range(k):
-                if idx[i] == q:
-                    is_member = True
-            if is_member:
+            if _member(idx, q):
                 continue
             s = 0.0
             for j in range(k):
@@ -306,7 +334,7 @@ def _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, t0, t1,
 
 
 @njit(cache=True, parallel=True)
-def classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
+def classify_subsets(Y, W, subsets, c_err, F, floor=0.0):
     """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
     on the + side, surely on the − side and uncertain, its cofactors C and their
     permanents |C|, and whether C is surely zero (degenerate subset; only decided
@@ -314,9 +342,10 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
 
     A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
     (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
-    the precise one (both plus ``floor``, 0 when c_err = 0). The scan of a subset stops
-    once both sides surely hold more than F points (it can then bound no valid
-    halfspace), so counts above F are not exact."""
+    the precise one (both plus ``floor``, 0 when c_err = 0). For k ≤ 3 the scan of a
+    subset stops once both sides surely hold more than F points (it can then bound no
+    valid halfspace), so counts above F are not exact; for k ≥ 4 every point is
+    counted (:func:`_scan_all`)."""
     n, k = Y.shape
     count = subsets.shape[0]
     plus = np.zeros(count, dtype=np.int64)
@@ -329,9 +358,10 @@ def classify_subsets(Y, W, subsets, perms, psigns, c_err, F, floor=0.0):
     for q in range(n):
         for j in range(k):
             M = max(M, abs(Y[q, j]))
+    YT = np.ascontiguousarray(Y.T)
     chunks = 64
     for c in prange(chunks):
-        _classify_range(Y, W, subsets, perms, psigns, c_err, F, floor, M, count * c // chunks,
+        _classify_range(Y, YT, W, subsets, c_err, F, floor, M, count * c // chunks,
                         count * (c + 1) // chunks, plus, minus, unc, degenerate, cof,
                         cof_abs)
     return plus, minus, unc, degenerate, cof, cof_abs

@@ -3,8 +3,8 @@
 :func:`classify` returns what :func:`rescon.geometry._candidates.classify` returns — the
 same float orientations s(q) = Σ_j (q − p_0)_j · C_j evaluated in the same order, the
 same coarse and precise rounding bounds, hence the same decisions — vectorised over
-all (subset, point) pairs instead of looped. The numba scan stops a subset once both
-sides hold more than F points, so its counts above F are lower bounds; here every
+all (subset, point) pairs instead of looped. For k ≤ 3 the numba scan stops a subset
+once both sides hold more than F points, so its counts above F are lower bounds; here every
 count is complete, which changes no comparison with F (a count above F stays above
 F). :mod:`.halfspaces` takes this path when the scan is small enough that numba's
 start-up (import, type registries, compiling on a cold cache) would dominate.
@@ -44,12 +44,12 @@ def k_subsets(n: int, k: int) -> np.ndarray:
     return out.reshape(-1, k)
 
 
-def _cofactors(D: np.ndarray, perms: np.ndarray, psigns: np.ndarray
-               ) -> tuple[np.ndarray, np.ndarray]:
+def _cofactors(D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For every subset, the cofactors C of the last row of [D; ·] (D: (T, k−1, k),
     rows p_i − p_0) and their absolute-value permanents |C|, (T, k) each: closed forms
-    for k ≤ 3, else the (k−1)!-term expansion with the signs ``psigns`` of ``perms``,
-    each product formed left to right as in the numba scan."""
+    for k ≤ 3, else each minor expanded along its last row over the minors of the rows
+    above it (by column bitmask), every operation in the order of the numba scan
+    (:func:`._candidates._prefix_minors`, :func:`._candidates._last_row_cofactors`)."""
     T, _, k = D.shape
     if k == 1:
         return np.ones((T, 1)), np.ones((T, 1))
@@ -64,65 +64,35 @@ def _cofactors(D: np.ndarray, perms: np.ndarray, psigns: np.ndarray
                                 np.abs(a2 * b0) + np.abs(a0 * b2),
                                 np.abs(a0 * b1) + np.abs(a1 * b0)])
         return C, Cabs
-    if k in (4, 5):
-        return _cofactors45(D)
+    minors = {0: (np.ones(T), np.ones(T))}
+    for r in range(k - 2):
+        for cols in itertools.combinations(range(k), r + 1):
+            minors[sum(1 << c for c in cols)] = _expand_last(D[:, r], r, cols, minors)
     C, Cabs = np.empty((T, k)), np.empty((T, k))
     for j in range(k):
-        cols = [t for t in range(k) if t != j]
-        det, per = np.zeros(T), np.zeros(T)
-        for p in range(perms.shape[0]):
-            prod, aprod = np.ones(T), np.ones(T)
-            for i in range(k - 1):
-                v = D[:, i, cols[perms[p, i]]]
-                prod = prod * v
-                aprod = aprod * np.abs(v)
-            det = det + psigns[p] * prod
-            per = per + aprod
-        C[:, j] = (1.0 if (k - 1 + j) % 2 == 0 else -1.0) * det
-        Cabs[:, j] = per
-    return C, Cabs
-
-
-def _minor2(D: np.ndarray, r: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
-    """det and permanent of |·| of rows r, r + 1 and columns a, b (as the numba scan)."""
-    x, y = D[:, r, a] * D[:, r + 1, b], D[:, r, b] * D[:, r + 1, a]
-    return x - y, np.abs(x) + np.abs(y)
-
-
-def _cofactors45(D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The closed forms of the numba scan for k = 4, 5 (:func:`._candidates._cofactors4`,
-    :func:`._candidates._cofactors5`), every operation in the same order: k = 4 expands
-    each 3 × 3 minor along row 0 over the 2 × 2 minors of rows 1, 2; k = 5 each 4 × 4
-    minor along rows 0, 1 over the 2 × 2 minors of rows 0, 1 and 2, 3."""
-    T, _, k = D.shape
-    C, Cabs = np.empty((T, k)), np.empty((T, k))
-    pairs = list(itertools.combinations(range(k), 2))
-    top = {ab: _minor2(D, 0, *ab) for ab in pairs} if k == 5 else {}
-    low = {ab: _minor2(D, 1 if k == 4 else 2, *ab) for ab in pairs}
-    for j in range(k):
-        cols = [t for t in range(k) if t != j]
-        det, per = np.zeros(T), np.zeros(T)
-        if k == 4:
-            sign = 1.0
-            for i in cols:
-                m, p = low[tuple(t for t in cols if t != i)]
-                det = det + sign * D[:, 0, i] * m
-                per = per + np.abs(D[:, 0, i]) * p
-                sign = -sign
-        else:
-            for u, v in itertools.combinations(range(4), 2):
-                w0, w1 = (t for t in range(4) if t not in (u, v))
-                term = top[cols[u], cols[v]][0] * low[cols[w0], cols[w1]][0]
-                det = det + (term if (1 + u + v) % 2 == 0 else -term)
-                per = per + top[cols[u], cols[v]][1] * low[cols[w0], cols[w1]][1]
+        det, Cabs[:, j] = _expand_last(D[:, k - 2], k - 2, [c for c in range(k) if c != j],
+                                       minors)
         C[:, j] = det if (k - 1 + j) % 2 == 0 else -det
-        Cabs[:, j] = per
     return C, Cabs
 
 
-def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, perms: np.ndarray,
-             psigns: np.ndarray, c_err: float, F: int, floor: float = 0.0
-             ) -> tuple[np.ndarray, ...]:
+def _expand_last(row: np.ndarray, r: int, cols, minors: dict
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """det and permanent of |·| of the minors on rows 0..r and the columns ``cols``
+    (increasing), along row r (``row``: (T, k)) over ``minors`` (by column bitmask) of
+    the rows above — :func:`._candidates._expand_last`, term by term in its order."""
+    mask = sum(1 << c for c in cols)
+    det, per = np.zeros(len(row)), np.zeros(len(row))
+    for t, c in enumerate(cols):
+        sub_det, sub_per = minors[mask ^ (1 << c)]
+        term = row[:, c] * sub_det
+        det = det + term if (r + t) % 2 == 0 else det - term
+        per = per + np.abs(row[:, c]) * sub_per
+    return det, per
+
+
+def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F: int,
+             floor: float = 0.0) -> tuple[np.ndarray, ...]:
     """(plus, minus, unc, degenerate, cof, cof_abs) for every k-subset, as
     :func:`rescon.geometry._candidates.classify_subsets` defines them.
 
@@ -135,7 +105,7 @@ def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, perms: np.ndarra
     count = len(subsets)
     M = float(np.abs(Y).max()) if Y.size else 0.0
     P0 = Y[subsets[:, 0]]
-    cof, cof_abs = _cofactors(Y[subsets[:, 1:]] - P0[:, None, :], perms, psigns)
+    cof, cof_abs = _cofactors(Y[subsets[:, 1:]] - P0[:, None, :])
     coarse = np.zeros(count)
     for j in range(k):
         coarse = coarse + cof_abs[:, j]

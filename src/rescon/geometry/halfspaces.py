@@ -14,7 +14,6 @@ exact integer arithmetic, so the set returned never depends on a tolerance.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass, field
 from fractions import Fraction
 from math import comb, factorial, gcd
@@ -125,28 +124,23 @@ def candidate_cost(n_unique: int, k: int) -> int:
 def _scan_plan(m: int, k: int, sweep: bool) -> tuple[bool, float, float]:
     """(exact_only, work, bytes) of classifying the C(m, k) candidates by the method
     that will run (:mod:`._budget` units): the angular sweep in the plane,
-    ~m² log₂ m; else the float scan, C(m, k) · (m − k) tests plus, for k ≥ 4, a
-    (k − 1)!-term cofactor expansion per subset — or, when that costs more, every
-    subset in Python integers (Bareiss cofactors, O(k⁴), and an exact scan)."""
+    ~m² log₂ m; else the float scan, C(m, k) · (m − k) tests plus, for k ≥ 4, the
+    k(k − 1) products of a subset's cofactors and the k 2^k steps (and 2^k-entry
+    tables) of the minors of each of its first k − 1 points that it builds
+    (:mod:`._candidates`: at most one per subset, or per (k − 1)-subset of the points)
+    — or, when that costs more, every subset in Python integers (Bareiss cofactors,
+    O(k⁴), and an exact scan)."""
     count = comb(m, k)
     tables = count * (4 * k + 25 + 16 * k)  # subsets, counts, flags, cofactors
     if sweep:
         return False, 4.0 * m * m * max(m.bit_length(), 1), tables
-    expand = (k - 1) * factorial(k - 1) if k >= 4 else 0
+    if k < 4:
+        return False, count * (m - k), tables
+    minors = min(count, comb(m, k - 1)) * k * 2.0**k
     exact = PYTHON_STEP * (k**4 + (m - k) * k)
-    if k >= 4 and exact < expand:
+    if count * exact < count * k * (k - 1) + minors:
         return True, count * exact, tables
-    return False, count * (m - k + expand), tables + 8.0 * k * factorial(max(k - 1, 0))
-
-
-def _permutations(m: int) -> tuple[np.ndarray, np.ndarray]:
-    """All permutations of range(m) (rows) and their signs; one dummy row for m = 0."""
-    if m == 0:
-        return np.zeros((1, 1), dtype=np.int64), np.ones(1)
-    perms = list(itertools.permutations(range(m)))
-    signs = [-1.0 if sum(p[i] > p[j] for i in range(m) for j in range(i + 1, m)) % 2 else 1.0
-             for p in perms]
-    return np.array(perms, dtype=np.int64), np.array(signs)
+    return False, count * (m - k + k * (k - 1)) + minors, tables + 16.0 * 2**k
 
 
 def _exact_float_bits(k: int) -> int:
@@ -257,7 +251,6 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     exact_only, work, nbytes = _scan_plan(m, k, sweep)
     require(f"the safe kernel of {m} distinct points in dimension {k}", work, nbytes,
             "reduce n or d")
-    perms, signs = _permutations(0 if exact_only else k - 1)
     c_err = 0.0 if exact_floats else 4.0 * (3 * k + factorial(k) + 4) * _EPS
     # exact floats: Y holds small integers over a unit ≤ 2^(bits + 32), so no product of
     # k + 1 of them underflows either
@@ -277,8 +270,8 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         cof = cof_abs = np.zeros((count, k))
     else:
         plus, minus, unc, degenerate, cof, cof_abs = classify(
-            np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, perms,
-            signs, c_err, F, floor)
+            np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, c_err, F,
+            floor)
     live = ~degenerate
     sure_plus = live & (plus + unc <= F)
     sure_minus = live & (minus + unc <= F)
