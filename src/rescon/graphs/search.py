@@ -25,6 +25,7 @@ import numpy as np
 from .indexed import IndexedGraph
 
 __all__ = [
+    "FAVOURED_SHARE",
     "MAX_SEARCH_NODES",
     "MAX_TREE_TOKENS",
     "CostOutcome",
