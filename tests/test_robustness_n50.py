@@ -100,3 +100,26 @@ def test_the_race_takes_the_sized_answer_when_the_decision_search_lags(monkeypat
         dec = rb._race(ig, r, None, None)
         assert dec.holds == (leblanc_max_s(G, r) >= 1)
         assert dec.method == "search"
+
+
+def test_dense_is_the_arc_density_threshold():
+    assert rb._dense(index_graph(nx.gnp_random_graph(40, 0.8, directed=True, seed=40000)))
+    assert not rb._dense(index_graph(nx.gnp_random_graph(40, 0.5, directed=True, seed=40000)))
+    assert rb._dense(index_graph(nx.complete_graph(5, create_using=nx.DiGraph)))
+    assert not rb._dense(index_graph(nx.empty_graph(3, create_using=nx.DiGraph)))
+
+
+@pytest.mark.parametrize("dense", [False, True])
+def test_the_density_guess_changes_the_time_split_not_the_answer(monkeypatch, dense):
+    """Either guess (sized or decision/charged search favoured): the race decides
+    r-robustness and the deepening finds s*(r) as brute force does."""
+    monkeypatch.setattr(rb, "_dense", lambda ig: dense)
+    for seed in range(4):
+        G = nx.gnp_random_graph(10, 0.7, directed=True, seed=seed)
+        ig = index_graph(G)
+        for r in range(1, (ig.n + 1) // 2 + 1):
+            expected = leblanc_max_s(G, r)
+            assert rb._race(ig, r, None, None).holds == (expected >= 1)
+            if expected >= 1:
+                out = rb._deepening_search(ig, r, 1, ig.n, None)
+                assert out.status == "done" and out.best == expected

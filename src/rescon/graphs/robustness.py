@@ -415,17 +415,22 @@ def _race(ig: IndexedGraph, r: int, deadline: float | None,
     return _milp_decision(ig, r, milp.outcome())
 
 
-DENSE = 0.65  # arc density from which the sized search is favoured in the race
+DENSE = 0.65  # arc density from which the sized searches are favoured
+
+
+def _dense(ig: IndexedGraph) -> bool:
+    """Arc density ≥ ``DENSE``: where the sized searches win (ER(40–50, 0.8): ρ decided in
+    0.1–10 s, where the decision search takes over 60 s; s* rounds), and below it the
+    decision search and the charged-set search (ER(40, 0.5): ρ in 6 s, where the sized
+    search takes over 60 s; ER(50, 0.3): the s* round below cap 2)."""
+    return sum(ig.in_degrees) >= DENSE * ig.n * (ig.n - 1)
 
 
 def _sized_share(ig: IndexedGraph) -> float:
     """The sized search's share of the core it takes turns on with the decision search:
-    ``FAVOURED_SHARE`` on graphs of arc density ≥ ``DENSE`` (ER(40–50, 0.8): the sized
-    search decides ρ in 0.1–10 s, the decision search not in 60 s), else the rest (ER(40,
-    0.5): the decision search in 6 s, the sized search not in 60 s). A wrong guess
+    ``FAVOURED_SHARE`` on dense graphs (:func:`_dense`), else the rest. A wrong guess
     costs at most 4× the winner's own time."""
-    density = sum(ig.in_degrees) / max(ig.n * (ig.n - 1), 1)
-    return FAVOURED_SHARE if density >= DENSE else 1 - FAVOURED_SHARE
+    return FAVOURED_SHARE if _dense(ig) else 1 - FAVOURED_SHARE
 
 
 def _turns(sized: SizedRun, rival: Callable[[], bool], share: float) -> Callable[[], bool]:
@@ -689,10 +694,11 @@ def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
     step from lower to cap doubles while rounds are cheap (< ``DEEPEN_CHEAP_SECONDS``)
     and falls back to 1 after an expensive one: the search cost grows steeply with the
     cap, and a pair of cost = lower ends a search early. Each round favours the engine
-    that finished the last one (see search.min_cost_pair). Exact: the last search is
+    that finished the last one, the first round the one that wins on graphs of its
+    density (:func:`_dense`; see search.min_cost_pair). Exact: the last search is
     exact below its cap, and every earlier one proved that nothing is cheaper than its
     cap."""
-    step, nodes, favour = 1, 0, None
+    step, nodes, favour = 1, 0, "sized" if _dense(ig) else "charged"
     while True:
         cap = min(lower + step, upper)
         t0 = time.perf_counter()
