@@ -632,25 +632,39 @@ def _tangent_rays(normals: list[tuple[int, ...]], basis: list[int], T: list[int]
     for c, h in enumerate(cuts):
         s = [_dot(normals[h], d) for d, _ in rays]
         zs = [z for _, z in rays]
+        minus = [q for q, sq in enumerate(s) if sq < 0]
         new = []
-        for p, sp in enumerate(s):
-            if sp <= 0:
-                continue
-            for q, sq in enumerate(s):
-                if sq >= 0:
-                    continue
+        for p in (p for p, sp in enumerate(s) if sp > 0):
+            for q in minus:
                 common = zs[p] & zs[q]
-                # adjacent: no third ray tight on all of common (p and q are)
-                if common.bit_count() < k - 2 or sum(
-                        z & common == common for z in zs) > 2:
+                if common.bit_count() < k - 2 or not _adjacent(zs, common):
                     continue
-                d = None if c == len(cuts) - 1 else _primitive_direction(
-                    tuple(sp * x - sq * y for x, y in zip(rays[q][0], rays[p][0],
-                                                          strict=True)))
+                d = None if c == len(cuts) - 1 else _combined(s[p], rays[q][0], s[q],
+                                                              rays[p][0])
                 new.append((d, common | 1 << h))
         rays = [(d, z | (1 << h if v == 0 else 0)) for (d, z), v in zip(rays, s, strict=True)
                 if v <= 0] + new
     return [z for _, z in rays]
+
+
+def _adjacent(zs: list[int], common: int) -> bool:
+    """Two rays tight on the rows ``common`` (both among zs) are adjacent: no third ray
+    of zs is tight on all of them."""
+    count = 0
+    for z in zs:
+        if z & common == common:
+            count += 1
+            if count > 2:
+                return False
+    return True
+
+
+def _combined(sp: int, q: tuple[int, ...], sq: int, p: tuple[int, ...]) -> tuple[int, ...]:
+    """The primitive direction of sp·q − sq·p (sp > 0 > sq: on the cut's hyperplane),
+    its multipliers divided by their gcd first (smaller products)."""
+    g = gcd(sp, sq)
+    sp, sq = sp // g, sq // g
+    return _primitive_direction(tuple(sp * x - sq * y for x, y in zip(q, p, strict=True)))
 
 
 def _dot(a: tuple[int, ...], d: tuple[int, ...]) -> int:
