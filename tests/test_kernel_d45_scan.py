@@ -86,8 +86,8 @@ def test_scan_counts_bracket_the_exact_counts(k, kind, seed):
     subsets = _scan_np.k_subsets(m, k)
     exact = kind == "ties" and np.abs(Y).max() < 8
     c_err, floor = _scan_args(Y, exact)
-    plus, minus, unc, degenerate, _, _ = _candidates.classify(Y, W.astype(np.int64), subsets,
-                                                              c_err, m, floor)
+    plus, minus, unc, degenerate = _candidates.classify(Y, W.astype(np.int64), subsets, c_err,
+                                                        m, floor)
     for t, subset in enumerate(subsets.tolist()):
         p, n_, dep = _exact_counts(Yi, W, subset)
         if exact:
@@ -108,9 +108,8 @@ def test_cofactors_within_their_bound_of_the_exact_ones(k):
     unit = Fraction(Yi[0][0]) / Fraction(float(Y[0, 0])) if Y[0, 0] else None
     assert unit is not None
     subsets = _scan_np.k_subsets(len(Y), k)
-    c_err, floor = _scan_args(Y, False)
-    cof, cof_abs = _candidates.classify(Y, np.ones(len(Y), dtype=np.int64), subsets, c_err,
-                                        1, floor)[4:]
+    c_err = _scan_args(Y, False)[0]
+    cof, cof_abs = _candidates.cofactors(Y, subsets)
     for t, subset in enumerate(subsets.tolist()):
         exact = halfspaces.exact_normal(Yi, subset)  # = C · unit^(k−1)
         for j in range(k):
@@ -122,8 +121,9 @@ def test_cofactors_within_their_bound_of_the_exact_ones(k):
                                       (5, 15, "repeated"), (6, 12, "tiny")])
 def test_parallel_scan_equals_the_numpy_twin_exactly(k, m, kind):
     """Above PARALLEL_MIN_SUBSETS the scan runs in 64 chunks on threads (each chunk
-    builds its own prefix minors); for k ≥ 4 its counts, cofactors and flags are
-    identical to the numpy twin's — and to one thread's."""
+    builds its own prefix minors); for k ≥ 4 its counts and flags are identical to the
+    numpy twin's — and to one thread's; so are the cofactors of any subsets, as the
+    scan computes them."""
     Y = _points(kind, k, m, 3)
     W = np.random.default_rng(m).integers(1, 4, size=m)
     subsets = _scan_np.k_subsets(m, k)
@@ -135,6 +135,9 @@ def test_parallel_scan_equals_the_numpy_twin_exactly(k, m, kind):
     for a, b, c in zip(threads, twin, one, strict=True):
         assert np.array_equal(a, b)
         assert np.array_equal(a[:len(c)], c)
+    some = subsets[np.random.default_rng(k).permutation(len(subsets))[:500]]
+    for a, b in zip(_candidates.cofactors(Y, some), _scan_np.cofactors(Y, some), strict=True):
+        assert np.array_equal(a, b)
 
 
 def test_budget_counts_the_prefix_minors():

@@ -127,12 +127,26 @@ def classify(Y, W, subsets, c_err, F, floor=0.0):
     if count >= PARALLEL_MIN_SUBSETS:
         return classify_subsets(Y, W, subsets, c_err, F, floor)
     out = (np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64),
-           np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_),
-           np.empty((count, k)), np.empty((count, k)))
+           np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_))
     M = float(np.abs(Y).max()) if Y.size else 0.0
     _classify_range(Y, np.ascontiguousarray(Y.T), W, subsets, c_err, F, floor, M, 0, count,
                     *out)
     return out
+
+
+@njit(cache=True)
+def cofactors(Y, subsets):
+    """The cofactors C and their permanents |C| of the subsets (rows), (count, k) each,
+    exactly as the scan (:func:`classify_subsets`) computes them — only for the
+    subsets the caller keeps (the scan stores none: tables of C(n, k) rows cost more
+    to allocate than to fill)."""
+    count, k = subsets.shape
+    cof = np.empty((count, k))
+    cof_abs = np.empty((count, k))
+    scratch = _scratch(k)
+    for t in range(count):
+        _subset_cofactors(Y, subsets[t], scratch, cof[t], cof_abs[t])
+    return cof, cof_abs
 
 
 @njit(cache=True)
@@ -267,37 +281,51 @@ def _member(idx, q):
 
 
 @njit(cache=True, nogil=True)
+def _scratch(k):
+    """Work arrays of :func:`_subset_cofactors`: for k ≥ 4 the current prefix's
+    difference rows, its minors and their permanents (by column bitmask), its points,
+    and the last difference row."""
+    return (np.empty((max(k - 2, 1), k)), np.empty(1 << k), np.empty(1 << k),
+            np.full(max(k - 1, 1), -1), np.empty(k))
+
+
+@njit(cache=True, nogil=True)
+def _subset_cofactors(Y, idx, scratch, C, Cabs):
+    """The cofactors C and permanents Cabs of the subset ``idx``: closed forms for
+    k ≤ 3, else from the minors of its first k − 1 points, rebuilt only when they
+    differ from the previous subset's (``scratch``, :func:`_scratch`)."""
+    k = C.shape[0]
+    if k == 1:
+        C[0] = 1.0
+        Cabs[0] = 1.0
+        return
+    if k <= 3:
+        _cofactors(Y, idx, k, C, Cabs)
+        return
+    R, mdet, mper, prefix, last = scratch
+    for i in range(k - 1):
+        if prefix[i] != idx[i]:
+            _prefix_minors(Y, idx, k, R, mdet, mper)
+            prefix[:] = idx[:k - 1]
+            break
+    _last_row_cofactors(Y, idx, k, mdet, mper, last, C, Cabs)
+
+
+@njit(cache=True, nogil=True)
 def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
-                    plus, minus, unc, degenerate, cof, cof_abs):
+                    plus, minus, unc, degenerate):
     """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays)."""
     n, k = Y.shape
     C = np.empty(k)
     Cabs = np.empty(k)
-    R = np.empty((max(k - 2, 1), k))  # k ≥ 4: the prefix's difference rows,
-    mdet = np.empty(1 << k)  # its minors and their permanents (by column bitmask),
-    mper = np.empty(1 << k)
-    prefix = np.full(max(k - 1, 1), -1)  # and its points
-    last = np.empty(k)
+    scratch = _scratch(k)
     S = np.empty(n)
     for t in range(t0, t1):
         idx = subsets[t]
-        if k == 1:
-            C[0] = 1.0
-            Cabs[0] = 1.0
-        elif k <= 3:
-            _cofactors(Y, idx, k, C, Cabs)
-        else:
-            for i in range(k - 1):
-                if prefix[i] != idx[i]:
-                    _prefix_minors(Y, idx, k, R, mdet, mper)
-                    prefix[:] = idx[:k - 1]
-                    break
-            _last_row_cofactors(Y, idx, k, mdet, mper, last, C, Cabs)
+        _subset_cofactors(Y, idx, scratch, C, Cabs)
         zero = True
         coarse = 0.0
         for j in range(k):
-            cof[t, j] = C[j]
-            cof_abs[t, j] = Cabs[j]
             coarse += Cabs[j]
             if C[j] != 0.0:
                 zero = False
@@ -336,9 +364,9 @@ def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
 @njit(cache=True, parallel=True)
 def classify_subsets(Y, W, subsets, c_err, F, floor=0.0):
     """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
-    on the + side, surely on the − side and uncertain, its cofactors C and their
-    permanents |C|, and whether C is surely zero (degenerate subset; only decided
-    when c_err = 0).
+    on the + side, surely on the − side and uncertain, and whether its cofactors C
+    (:func:`cofactors`) are surely zero (degenerate subset; only decided when
+    c_err = 0).
 
     A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
     (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
@@ -352,8 +380,6 @@ def classify_subsets(Y, W, subsets, c_err, F, floor=0.0):
     minus = np.zeros(count, dtype=np.int64)
     unc = np.zeros(count, dtype=np.int64)
     degenerate = np.zeros(count, dtype=np.bool_)
-    cof = np.empty((count, k))
-    cof_abs = np.empty((count, k))
     M = 0.0
     for q in range(n):
         for j in range(k):
@@ -362,9 +388,8 @@ def classify_subsets(Y, W, subsets, c_err, F, floor=0.0):
     chunks = 64
     for c in prange(chunks):
         _classify_range(Y, YT, W, subsets, c_err, F, floor, M, count * c // chunks,
-                        count * (c + 1) // chunks, plus, minus, unc, degenerate, cof,
-                        cof_abs)
-    return plus, minus, unc, degenerate, cof, cof_abs
+                        count * (c + 1) // chunks, plus, minus, unc, degenerate)
+    return plus, minus, unc, degenerate
 
 
 #: angle error bound of atan2 on a correctly rounded difference vector (radians):
@@ -388,8 +413,6 @@ def sweep_pairs_2d(Y, W, subsets):
     plus = np.zeros(count, dtype=np.int64)
     minus = np.zeros(count, dtype=np.int64)
     unc = np.zeros(count, dtype=np.int64)
-    cof = np.empty((count, 2))
-    cof_abs = np.empty((count, 2))
     # row offset of the pairs (i, ·): pairs are in lexicographic order
     start = np.zeros(n + 1, dtype=np.int64)
     for i in range(n):
@@ -434,14 +457,8 @@ def sweep_pairs_2d(Y, W, subsets):
             minus[row] = right
             # everything else but j itself is uncertain
             unc[row] = total - left - right - W[j]
-            dx = Y[j, 0] - Y[i, 0]
-            dy = Y[j, 1] - Y[i, 1]
-            cof[row, 0] = -dy
-            cof[row, 1] = dx
-            cof_abs[row, 0] = abs(dy)
-            cof_abs[row, 1] = abs(dx)
     degenerate = np.zeros(count, dtype=np.bool_)
-    return plus, minus, unc, degenerate, cof, cof_abs
+    return plus, minus, unc, degenerate
 
 
 def ball_chunks(V: np.ndarray, leaf: int = 32

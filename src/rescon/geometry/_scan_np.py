@@ -17,7 +17,7 @@ from math import comb
 
 import numpy as np
 
-__all__ = ["HUGE", "TINY", "classify", "in_range", "k_subsets", "sets_in_range"]
+__all__ = ["HUGE", "TINY", "classify", "cofactors", "in_range", "k_subsets", "sets_in_range"]
 
 #: nonzero |coordinates| must lie in [TINY, HUGE] for the expansion predicates of
 #: :mod:`._expansions` to be exact: then products of up to four differences neither
@@ -93,7 +93,7 @@ def _expand_last(row: np.ndarray, r: int, cols, minors: dict
 
 def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F: int,
              floor: float = 0.0) -> tuple[np.ndarray, ...]:
-    """(plus, minus, unc, degenerate, cof, cof_abs) for every k-subset, as
+    """(plus, minus, unc, degenerate) for every k-subset, as
     :func:`rescon.geometry._candidates.classify_subsets` defines them.
 
     A point q off the subset is surely on the + side when s(q) > bound, on the − side
@@ -105,7 +105,7 @@ def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F:
     count = len(subsets)
     M = float(np.abs(Y).max()) if Y.size else 0.0
     P0 = Y[subsets[:, 0]]
-    cof, cof_abs = _cofactors(Y[subsets[:, 1:]] - P0[:, None, :])
+    cof, cof_abs = cofactors(Y, subsets)
     coarse = np.zeros(count)
     for j in range(k):
         coarse = coarse + cof_abs[:, j]
@@ -127,4 +127,10 @@ def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F:
     w = W.astype(np.int64)
     plus, minus = pos @ w, neg @ w
     unc = (off & ~pos & ~neg) @ w if c_err != 0.0 else np.zeros(count, dtype=np.int64)
-    return plus, minus, unc, degenerate, cof, cof_abs
+    return plus, minus, unc, degenerate
+
+
+def cofactors(Y: np.ndarray, subsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The cofactors C and their permanents |C| of the subsets (rows), as
+    :func:`rescon.geometry._candidates.cofactors` computes them."""
+    return _cofactors(Y[subsets[:, 1:]] - Y[subsets[:, :1]])

@@ -233,9 +233,9 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     count = comb(m, k)
     small = candidate_cost(m, k) <= SMALL_SCAN  # no numba (the same sets, see SMALL_SCAN)
     if small:
-        from ._scan_np import classify, in_range, k_subsets
+        from ._scan_np import classify, cofactors, in_range, k_subsets
     else:
-        from ._candidates import ANGLE_ERR, classify, k_subsets
+        from ._candidates import ANGLE_ERR, classify, cofactors, k_subsets
         from ._expansions import in_range
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     # k = 1: the sign of a float difference is exact — of exact floats
@@ -260,16 +260,15 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     if sweep:
         from ._candidates import sweep_pairs_2d
 
-        plus, minus, unc, degenerate, cof, cof_abs = sweep_pairs_2d(
+        plus, minus, unc, degenerate = sweep_pairs_2d(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets)
         if separated:
             unc[:] = 0  # on the line: on neither side
     elif exact_only:  # no float filter: every subset is decided exactly below
         plus, minus, degenerate = (np.zeros(count, dtype=t) for t in (np.int64, np.int64, np.bool_))
         unc = np.full(count, int(W.sum()), dtype=np.int64)
-        cof = cof_abs = np.zeros((count, k))
     else:
-        plus, minus, unc, degenerate, cof, cof_abs = classify(
+        plus, minus, unc, degenerate = classify(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, c_err, F,
             floor)
     live = ~degenerate
@@ -287,8 +286,11 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     out = np.concatenate([plus[sure_p], minus[sure_m], n_plus[add_p], n_minus[add_m]])
     through = subsets[idx].astype(np.int64)
     p0 = Y[through[:, 0]] if len(idx) else np.zeros((0, k))
-    af = cof[idx] * sign[:, None]
-    af_abs = cof_abs[idx]
+    if exact_only:
+        af, af_abs, c_err = _rounded_normals(Yi, through, sign)
+    else:
+        af, af_abs = cofactors(np.ascontiguousarray(Y, dtype=np.float64), subsets[idx])
+        af *= sign[:, None]
     if k == 3 and not exact_floats and expansions:
         # nearly collinear triples: their float cofactors' error (relative to the
         # permanents) can exceed a tiny kernel, so take the exact normals, rounded
@@ -301,8 +303,6 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         if len(ill):
             af[ill] = _exact_normals3(Y, through[ill], small) * sign[ill, None]
             af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
-    if exact_only:
-        af, af_abs, c_err = _rounded_normals(Yi, through, sign)
     bf = np.einsum("ij,ij->i", af, p0)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
     if c_err == 0.0 and k >= 3:  # exact rows: drop repeats (coplanar data: one plane many times)
