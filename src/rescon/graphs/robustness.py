@@ -202,12 +202,14 @@ SEED_SEARCH_SECONDS = 1.0
 def _searched_seed_construction(ig: IndexedGraph, r: int, deadline: float | None) -> Proof | None:
     """A construction whose seed (a prefix of a greedy order from the highest-degree
     node) is proven r-robust by a short search: e.g. circulants, whose seeds are
-    path powers rather than cliques."""
+    path powers rather than cliques. Only proper seeds (m < n): a seed of all n nodes
+    would be the race's own decision search, with a second's budget (ER(40, 0.8):
+    1 s lost per decided r)."""
     start = max(range(ig.n), key=lambda i: (ig.in_degrees[i], -i))
     order = bd.greedy_order(ig, start)
     for m in sorted({min(k * r, MAX_SEARCH_NODES, ig.n) for k in SEED_SIZES}):
         closure = bd.closure_order(ig, order[:m], r)
-        if closure is None or m < 2:
+        if closure is None or not 2 <= m < ig.n:
             continue
         stop = time.perf_counter() + SEED_SEARCH_SECONDS
         out = decide_r_robust(ig.induced(order[:m]), r,
