@@ -6,11 +6,14 @@ of disjoint nonempty S1, S2 has reach_r(S1) = S1, reach_r(S2) = S2 or
 that G is r-robust, s*(r) = max s such that G is (r, s)-robust (0 when G is not
 r-robust).
 
-Strategy: polynomial bounds first (witness pairs above; degree, complete and
-construction proofs below); only when they do not meet, an exact method: the
-bitmask branch and bound (n ≤ 64, its search tree is the certificate) raced against
-the improved MILP for ρ (when neither leaves a replayable proof, the s* sized search's
-tree below s = 1 proves r-robustness, if it is small: dense graphs); for s*, the
+Strategy: polynomial bounds first (witness pairs above, among them two disjoint
+r-closed sets found by the tabu walks of bounds.tabu_pairs; degree, complete and
+construction proofs below); only when they do not meet, an exact method: for ρ, the
+bitmask branch and bound (n ≤ 64, its search tree is the certificate) taking turns
+on one core with the s* sized search below s = 1 (its tree is the certificate; it
+wins on dense graphs), raced against the improved MILP on the other (when no search
+leaves a replayable proof, the sized search's tree below s = 1 proves r-robustness,
+if it is small); for s*, the
 subset DP (n ≤ 22), else the two s* branch and bounds of search.min_cost_pair
 (charged-set, sized) raced against the MILP (n ≤ 64), else the MILP; an s* proof the
 checker would take on trust gets the sized search's tree below s* instead, if it is
