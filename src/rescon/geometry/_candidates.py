@@ -47,24 +47,25 @@ def _cofactors(Y, idx, k, C, Cabs):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _expand_last(row, r, mask, mdet, mper):
-    """det and permanent of |·| of the minor on rows 0..r of the difference rows and
-    the columns in ``mask`` (r + 1 of them), expanded along row r (its entries ``row``)
-    over the minors of rows 0..r − 1 on ``mask`` less one column (mdet, mper, indexed
-    by column bitmask): Σ_t (−1)^(r + t) row[c_t] · minor(mask − c_t), c_0 < c_1 < …"""
+def _expand_last(R, r, mask, mdet, mper):
+    """det and permanent of |·| of the minor on the difference rows R[0..r] and the
+    columns in ``mask`` (r + 1 of them), expanded along row r over the minors of rows
+    0..r − 1 on ``mask`` less one column (mdet, mper, indexed by column bitmask):
+    Σ_t (−1)^(r + t) R[r, c_t] · minor(mask − c_t), c_0 < c_1 < …"""
     det = 0.0
     per = 0.0
-    t = 0
-    for col in range(row.shape[0]):
+    plus = r % 2 == 0  # the sign of the next term: (−1)^(r + t) > 0
+    for col in range(R.shape[1]):
         if mask >> col & 1:
             sub = mask ^ (1 << col)
-            term = row[col] * mdet[sub]
-            if (r + t) % 2 == 0:
+            v = R[r, col]
+            term = v * mdet[sub]
+            if plus:
                 det += term
             else:
                 det -= term
-            per += abs(row[col]) * mper[sub]
-            t += 1
+            per += abs(v) * mper[sub]
+            plus = not plus
     return det, per
 
 
@@ -86,7 +87,7 @@ def _prefix_minors(Y, idx, k, R, mdet, mper):
     for mask in range(1, 1 << k):
         r = _popcount(mask) - 1
         if r < k - 2:
-            mdet[mask], mper[mask] = _expand_last(R[r], r, mask, mdet, mper)
+            mdet[mask], mper[mask] = _expand_last(R, r, mask, mdet, mper)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -98,20 +99,20 @@ def _popcount(mask):
     return c
 
 
-@njit(cache=True, nogil=True)
-def _last_row_cofactors(Y, idx, k, mdet, mper, last, C, Cabs):
+@njit(cache=True, nogil=True, inline="always")
+def _last_row_cofactors(Y, idx, k, R, mdet, mper, C, Cabs):
     """For k ≥ 4, the cofactors C_j = (−1)^(k−1+j) det(D without column j) of the last
     row of [D; ·], D the k − 1 difference rows, each determinant expanded along D's
-    last row p_{k−1} − p_0 (into ``last``) over the prefix minors of
+    last row p_{k−1} − p_0 (into R[k − 2]) over the prefix minors of
     :func:`_prefix_minors`; Cabs likewise, unsigned. Every product passes through
     k(k − 1)/2 roundings at most (a difference, then per row one product and a sum),
     fewer than the scan's c_err allows."""
     p0 = idx[0]
     for j in range(k):
-        last[j] = Y[idx[k - 1], j] - Y[p0, j]
+        R[k - 2, j] = Y[idx[k - 1], j] - Y[p0, j]
     full = (1 << k) - 1
     for j in range(k):
-        det, per = _expand_last(last, k - 2, full ^ (1 << j), mdet, mper)
+        det, per = _expand_last(R, k - 2, full ^ (1 << j), mdet, mper)
         C[j] = det if (k - 1 + j) % 2 == 0 else -det
         Cabs[j] = per
 
@@ -221,7 +222,7 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, floor, F):
     return np_, nm, nu
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _scan_all(Y, YT, W, idx, C, Cabs, coarse, c_err, floor, S):
     """The point scan of _classify_range for k ≥ 4: the orientations s(q) of every
     point at once into S (coordinate by coordinate over the rows of YT = Yᵀ — loops
@@ -282,14 +283,14 @@ def _member(idx, q):
 
 @njit(cache=True, nogil=True)
 def _scratch(k):
-    """Work arrays of :func:`_subset_cofactors`: for k ≥ 4 the current prefix's
-    difference rows, its minors and their permanents (by column bitmask), its points,
-    and the last difference row."""
-    return (np.empty((max(k - 2, 1), k)), np.empty(1 << k), np.empty(1 << k),
-            np.full(max(k - 1, 1), -1), np.empty(k))
+    """Work arrays of :func:`_subset_cofactors`: for k ≥ 4 the difference rows (the
+    current prefix's, then the subset's last), the prefix's minors and their
+    permanents (by column bitmask), and its points."""
+    return (np.empty((max(k - 1, 1), k)), np.empty(1 << k), np.empty(1 << k),
+            np.full(max(k - 1, 1), -1))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _subset_cofactors(Y, idx, scratch, C, Cabs):
     """The cofactors C and permanents Cabs of the subset ``idx``: closed forms for
     k ≤ 3, else from the minors of its first k − 1 points, rebuilt only when they
@@ -302,13 +303,14 @@ def _subset_cofactors(Y, idx, scratch, C, Cabs):
     if k <= 3:
         _cofactors(Y, idx, k, C, Cabs)
         return
-    R, mdet, mper, prefix, last = scratch
+    R, mdet, mper, prefix = scratch
     for i in range(k - 1):
         if prefix[i] != idx[i]:
             _prefix_minors(Y, idx, k, R, mdet, mper)
-            prefix[:] = idx[:k - 1]
+            for j in range(k - 1):
+                prefix[j] = idx[j]
             break
-    _last_row_cofactors(Y, idx, k, mdet, mper, last, C, Cabs)
+    _last_row_cofactors(Y, idx, k, R, mdet, mper, C, Cabs)
 
 
 @njit(cache=True, nogil=True)
