@@ -99,7 +99,7 @@ def _popcount(mask):
     return c
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _last_row_cofactors(Y, idx, k, R, mdet, mper, C, Cabs):
     """For k ≥ 4, the cofactors C_j = (−1)^(k−1+j) det(D without column j) of the last
     row of [D; ·], D the k − 1 difference rows, each determinant expanded along D's
@@ -131,7 +131,7 @@ def classify(Y, W, subsets, c_err, F, floor=0.0):
            np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.bool_))
     M = float(np.abs(Y).max()) if Y.size else 0.0
     _classify_range(Y, np.ascontiguousarray(Y.T), W, subsets, c_err, F, floor, M, 0, count,
-                    *out)
+                    *out, np.empty((0, k)), np.empty((0, k)))
     return out
 
 
@@ -144,9 +144,9 @@ def cofactors(Y, subsets):
     count, k = subsets.shape
     cof = np.empty((count, k))
     cof_abs = np.empty((count, k))
-    scratch = _scratch(k)
-    for t in range(count):
-        _subset_cofactors(Y, subsets[t], scratch, cof[t], cof_abs[t])
+    none = np.zeros(0, dtype=np.int64)
+    _classify_range(Y, Y, none, subsets, 0.0, 0, 0.0, 0.0, 0, count, none, none, none,
+                    np.zeros(0, dtype=np.bool_), cof, cof_abs)
     return cof, cof_abs
 
 
@@ -282,49 +282,42 @@ def _member(idx, q):
 
 
 @njit(cache=True, nogil=True)
-def _scratch(k):
-    """Work arrays of :func:`_subset_cofactors`: for k ≥ 4 the difference rows (the
-    current prefix's, then the subset's last), the prefix's minors and their
-    permanents (by column bitmask), and its points."""
-    return (np.empty((max(k - 1, 1), k)), np.empty(1 << k), np.empty(1 << k),
-            np.full(max(k - 1, 1), -1))
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _subset_cofactors(Y, idx, scratch, C, Cabs):
-    """The cofactors C and permanents Cabs of the subset ``idx``: closed forms for
-    k ≤ 3, else from the minors of its first k − 1 points, rebuilt only when they
-    differ from the previous subset's (``scratch``, :func:`_scratch`)."""
-    k = C.shape[0]
-    if k == 1:
-        C[0] = 1.0
-        Cabs[0] = 1.0
-        return
-    if k <= 3:
-        _cofactors(Y, idx, k, C, Cabs)
-        return
-    R, mdet, mper, prefix = scratch
-    for i in range(k - 1):
-        if prefix[i] != idx[i]:
-            _prefix_minors(Y, idx, k, R, mdet, mper)
-            for j in range(k - 1):
-                prefix[j] = idx[j]
-            break
-    _last_row_cofactors(Y, idx, k, R, mdet, mper, C, Cabs)
-
-
-@njit(cache=True, nogil=True)
 def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
-                    plus, minus, unc, degenerate):
-    """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays)."""
+                    plus, minus, unc, degenerate, cof, cof_abs):
+    """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays) — or,
+    when ``cof`` has rows, only the subsets' cofactors and permanents, into cof and
+    cof_abs (:func:`cofactors`: the same code computes them)."""
     n, k = Y.shape
     C = np.empty(k)
     Cabs = np.empty(k)
-    scratch = _scratch(k)
+    # k ≥ 4: the difference rows (the current prefix's, then the subset's last), the
+    # prefix's minors and their permanents (by column bitmask), and its points
+    R = np.empty((max(k - 1, 1), k))
+    mdet = np.empty(1 << k)
+    mper = np.empty(1 << k)
+    prefix = np.full(max(k - 1, 1), -1)
     S = np.empty(n)
     for t in range(t0, t1):
         idx = subsets[t]
-        _subset_cofactors(Y, idx, scratch, C, Cabs)
+        if k >= 4:
+            same = True
+            for i in range(k - 1):
+                same = same and prefix[i] == idx[i]
+            if not same:
+                _prefix_minors(Y, idx, k, R, mdet, mper)
+                for i in range(k - 1):
+                    prefix[i] = idx[i]
+            _last_row_cofactors(Y, idx, k, R, mdet, mper, C, Cabs)
+        elif k > 1:
+            _cofactors(Y, idx, k, C, Cabs)
+        else:
+            C[0] = 1.0
+            Cabs[0] = 1.0
+        if len(cof):
+            for j in range(k):
+                cof[t, j] = C[j]
+                cof_abs[t, j] = Cabs[j]
+            continue
         zero = True
         coarse = 0.0
         for j in range(k):
@@ -390,7 +383,8 @@ def classify_subsets(Y, W, subsets, c_err, F, floor=0.0):
     chunks = 64
     for c in prange(chunks):
         _classify_range(Y, YT, W, subsets, c_err, F, floor, M, count * c // chunks,
-                        count * (c + 1) // chunks, plus, minus, unc, degenerate)
+                        count * (c + 1) // chunks, plus, minus, unc, degenerate,
+                        np.empty((0, k)), np.empty((0, k)))
     return plus, minus, unc, degenerate
 
 
