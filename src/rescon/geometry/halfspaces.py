@@ -131,7 +131,7 @@ def _scan_plan(m: int, k: int, sweep: bool) -> tuple[bool, float, float]:
     — or, when that costs more, every subset in Python integers (Bareiss cofactors,
     O(k⁴), and an exact scan)."""
     count = comb(m, k)
-    tables = count * (4 * k + 25 + 16 * k)  # subsets, counts, flags, cofactors
+    tables = count * (4 * k + 25)  # subsets, counts, flags
     if sweep:
         return False, 4.0 * m * m * max(m.bit_length(), 1), tables
     if k < 4:
