@@ -7,8 +7,9 @@ r-closed member splits as S_k = U_k ∪ Q_k: Q_k = reach_r(S_k) (the charged nod
 less than s iff, for every *configuration* (Q1, Q2) of disjoint sets with
 |Q1| + |Q2| ≤ s − 1, no two disjoint nonempty sets U1, U2 avoiding Q1 ∪ Q2 are closed
 for the thresholds t1, t2: an r-robustness decision with per-node, per-side thresholds,
-searched as ``_kernels.decide_step`` searches r-robustness, plus one leaf for maximal
-pairs (certificates/FORMAT.md, ``cost_search`` with a ``charged_tree``).
+searched as ``_kernels.decide_step`` searches r-robustness, with its primitives (which
+take per-node thresholds), plus one leaf for maximal pairs (certificates/FORMAT.md,
+``cost_search`` with a ``charged_tree``).
 """
 
 from __future__ import annotations
@@ -16,59 +17,18 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._kernels import U1, ZERO, branch_node, low_index, popcount
+from ._kernels import (
+    U1,
+    ZERO,
+    branch_node,
+    core_after_removal,
+    low_index,
+    popcount,
+    size_bound,
+    tightest_member,
+)
 
 OVERFLOW, WITNESS = -1, -2  # config_tree's results besides a token count
-
-
-@njit(cache=True, nogil=True)
-def threshold_core(U: np.uint64, removed: np.uint64, inmask: np.ndarray, outmask: np.ndarray,
-                   t: np.ndarray) -> np.uint64:
-    """The largest A ⊆ U \\ removed whose members i have < t[i] in-neighbours outside A,
-    for U such a set (closed) itself: only the out-neighbours of removed nodes can have
-    gained outside in-neighbours, so peel from a worklist. Such sets are closed under
-    union, so the result is unique."""
-    U &= ~removed
-    work = ZERO
-    m = removed
-    while m:
-        u = low_index(m)
-        m &= ~(U1 << np.uint64(u))
-        work |= outmask[u]
-    work &= U
-    while work:
-        i = low_index(work)
-        b = U1 << np.uint64(i)
-        work &= ~b
-        if popcount(inmask[i] & ~U) >= t[i]:
-            U &= ~b
-            work |= outmask[i] & U
-    return U
-
-
-@njit(cache=True, nogil=True)
-def _sizes_fail(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, t1: np.ndarray,
-                t2: np.ndarray) -> bool:
-    """True when a closed U1 ⊇ S (thresholds t1) and a nonempty closed U2 ⊆ Q (t2)
-    cannot both fit, disjoint, in W: |U1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − t1[i] + 1)⁺,
-    |U2| ≥ min_{j∈Q} max(1, d_j − t2[j] + 2)."""
-    extra = 0
-    m = S
-    while m:
-        i = low_index(m)
-        m &= ~(U1 << np.uint64(i))
-        e = popcount(inmask[i] & ~S) - t1[i] + 1
-        if e > extra:
-            extra = e
-    need2 = 1 << 30
-    m = Q
-    while m:
-        j = low_index(m)
-        m &= ~(U1 << np.uint64(j))
-        e = max(1, popcount(inmask[j]) - t2[j] + 2)
-        if e < need2:
-            need2 = e
-    return popcount(S) + extra + need2 > popcount(W)
 
 
 @njit(cache=True, nogil=True)
@@ -95,8 +55,8 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
 
     Leaves: -1 when Q = ∅, -2 when S ⊄ P, -3 when the sizes cannot fit, -4 when S is
     ``_crowded`` for R; otherwise the member of S with ≥ t1 outside in-neighbours whose
-    candidates N(i) ∩ P \\ S exceed its need by the least gets one of them
-    (``branch_node``): u into S first, then into X."""
+    candidates N(i) ∩ P \\ S exceed its need by the least (``tightest_member``) gets
+    one of them (``branch_node``): u into S first, then into X."""
     n = inmask.shape[0]
     cap = 2 * n + 2
     stS = np.empty(cap, dtype=np.uint64)
@@ -115,7 +75,7 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
             leaf = -1
         elif S & ~P:
             leaf = -2
-        elif _sizes_fail(S, Q, P | Q, inmask, t1, t2):
+        elif size_bound(S, Q, P | Q, inmask, t1, t2):
             leaf = -3
         elif _crowded(S, R, inmask, t1):
             leaf = -4
@@ -123,19 +83,7 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
             tokens[ntok] = leaf
             ntok += 1
             continue
-        best_slack = n + 1
-        best_cand = ZERO
-        m = S
-        while m:
-            i = low_index(m)
-            m &= ~(U1 << np.uint64(i))
-            outside = popcount(inmask[i] & ~S)
-            if outside >= t1[i]:
-                cand = inmask[i] & P & ~S
-                slack = popcount(cand) - (outside - t1[i] + 1)
-                if slack < best_slack:
-                    best_slack = slack
-                    best_cand = cand
+        best_cand = tightest_member(S, S, P, inmask, t1, n)[1]
         if best_cand == ZERO:
             return WITNESS
         u = branch_node(best_cand, Q, inmask, outmask)
@@ -143,9 +91,9 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
         ntok += 1
         bu = U1 << np.uint64(u)
         stS[sp], stX[sp], stQ[sp] = S, X | bu, Q  # second: u out of U1
-        stP[sp] = threshold_core(P, bu, inmask, outmask, t1)
+        stP[sp] = core_after_removal(P & ~bu, bu, inmask, outmask, t1)
         stS[sp + 1], stX[sp + 1], stP[sp + 1] = S | bu, X, P  # first: u in U1
-        stQ[sp + 1] = threshold_core(Q, bu & Q, inmask, outmask, t2)
+        stQ[sp + 1] = core_after_removal(Q & ~bu, bu & Q, inmask, outmask, t2)
         sp += 2
     return ntok
 
@@ -161,24 +109,25 @@ def config_tree(inmask: np.ndarray, outmask: np.ndarray, order: np.ndarray, t1: 
     WITNESS."""
     n = inmask.shape[0]
     full = (U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO
-    C1 = threshold_core(full, gone, inmask, outmask, t1)
-    C2 = C1 if sym else threshold_core(full, gone, inmask, outmask, t2)
+    C1 = core_after_removal(full & ~gone, gone, inmask, outmask, t1)
+    C2 = C1 if sym else core_after_removal(full & ~gone, gone, inmask, outmask, t2)
     B = gone
     for k in range(n):
         b0 = U1 << np.uint64(order[k])
         if b0 & gone:
             continue
-        ntok = _subtree(b0, B, B & ~gone, C1, threshold_core(C2, b0 & C2, inmask, outmask, t2),
-                        inmask, outmask, t1, t2, tokens, ntok)
+        ntok = _subtree(b0, B, B & ~gone, C1,
+                        core_after_removal(C2 & ~b0, b0 & C2, inmask, outmask, t2), inmask,
+                        outmask, t1, t2, tokens, ntok)
         if ntok < 0:
             return ntok
         if not sym:
             ntok = _subtree(b0, B, B & ~gone, C2,
-                            threshold_core(C1, b0 & C1, inmask, outmask, t1), inmask, outmask,
-                            t2, t1, tokens, ntok)
+                            core_after_removal(C1 & ~b0, b0 & C1, inmask, outmask, t1), inmask,
+                            outmask, t2, t1, tokens, ntok)
             if ntok < 0:
                 return ntok
         B |= b0
-        C1 = threshold_core(C1, b0 & C1, inmask, outmask, t1)
-        C2 = C1 if sym else threshold_core(C2, b0 & C2, inmask, outmask, t2)
+        C1 = core_after_removal(C1 & ~b0, b0 & C1, inmask, outmask, t1)
+        C2 = C1 if sym else core_after_removal(C2 & ~b0, b0 & C2, inmask, outmask, t2)
     return ntok

@@ -4,12 +4,20 @@ A set of nodes is a ``uint64`` whose bit i stands for node i; ``inmask[i]`` is t
 set of in-neighbours of i. All kernels are resumable: their whole state lives in
 arrays owned by the Python driver, so a search can run in slices, report progress
 and stop at a time limit without losing what it proved.
+
+The decision search's primitives (``core_after_removal``, ``size_bound``,
+``tightest_member``) take per-node thresholds t: a set is closed when each member i has
+fewer than t[i] in-neighbours outside it. The decision search passes the integer r
+(t ≡ r, compiled apart: no per-node loads in its hot loops); the charged-set search
+(``_charged_kernels``) passes the array t(i) = r + |N(i) ∩ Q|, and every statement below
+made for r holds with r replaced by t[i] at each node i.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 U1 = np.uint64(1)
 ZERO = np.uint64(0)
@@ -40,6 +48,19 @@ def low_index(x: np.uint64) -> np.int64:
     return popcount((x & (~x + U1)) - U1)
 
 
+def threshold(t: int | np.ndarray, i: int) -> int:
+    """Node i's threshold: t[i] for per-node thresholds, t itself for one for all."""
+    return t if np.ndim(t) == 0 else t[i]
+
+
+@overload(threshold, inline="always")
+def _threshold(t, i):
+    """Compiled :func:`threshold`, chosen by t's type."""
+    if isinstance(t, types.Integer):
+        return lambda t, i: t
+    return lambda t, i: t[i]
+
+
 @njit(cache=True, nogil=True)
 def core(U: np.uint64, inmask: np.ndarray, r: int) -> np.uint64:
     """Largest r-closed subset of U: peel every i ∈ U with |N(i) \\ U| ≥ r.
@@ -63,9 +84,11 @@ def core(U: np.uint64, inmask: np.ndarray, r: int) -> np.uint64:
 
 @njit(cache=True, nogil=True)
 def core_after_removal(U: np.uint64, removed: np.uint64, inmask: np.ndarray,
-                       outmask: np.ndarray, r: int) -> np.uint64:
-    """core(U) when U is a closed set minus ``removed``: only out-neighbours of
-    removed nodes can have gained outside in-neighbours, so peel from a worklist."""
+                       outmask: np.ndarray, t: int | np.ndarray) -> np.uint64:
+    """The largest A ⊆ U whose members i have < t[i] in-neighbours outside A, when U is
+    such a set (closed for the thresholds t) minus ``removed``: only out-neighbours of
+    removed nodes can have gained outside in-neighbours, so peel from a worklist. Such
+    sets are closed under union, so the result is unique; with t ≡ r it is core(U)."""
     work = ZERO
     m = removed
     while m:
@@ -77,27 +100,29 @@ def core_after_removal(U: np.uint64, removed: np.uint64, inmask: np.ndarray,
         i = low_index(work)
         b = U1 << np.uint64(i)
         work &= ~b
-        if popcount(inmask[i] & ~U) >= r:
+        if popcount(inmask[i] & ~U) >= threshold(t, i):
             U &= ~b
             work |= outmask[i] & U
     return U
 
 
 @njit(cache=True, nogil=True)
-def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, r: int) -> bool:
-    """True when a closed S1 ⊇ S and a nonempty closed S2 ⊆ Q cannot both fit,
-    disjoint, in W = core(V \\ X) ∪ core(V \\ S \\ B).
+def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray,
+               t1: int | np.ndarray, t2: int | np.ndarray) -> bool:
+    """True when a closed S1 ⊇ S (thresholds t1) and a nonempty closed S2 ⊆ Q
+    (thresholds t2) cannot both fit, disjoint, in W = core(V \\ X) ∪ core(V \\ S \\ B).
 
     S1 holds S and, for each i ∈ S, ≥ |N(i) \\ S| − r + 1 more of i's in-neighbours:
     |S1| ≥ |S| + max_{i∈S} (|N(i) \\ S| − r + 1)⁺. A closed set holding j holds
     ≥ d_j − r + 1 of j's in-neighbours: |S2| ≥ min_{j∈Q} max(1, d_j − r + 2).
+    (r: t1[i] for i ∈ S, t2[j] for j ∈ Q.)
     """
     extra = 0
     m = S
     while m:
         i = low_index(m)
         m &= ~(U1 << np.uint64(i))
-        e = popcount(inmask[i] & ~S) - r + 1
+        e = popcount(inmask[i] & ~S) - threshold(t1, i) + 1
         if e > extra:
             extra = e
     need2 = 1 << 30
@@ -105,7 +130,7 @@ def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray, r: 
     while m:
         j = low_index(m)
         m &= ~(U1 << np.uint64(j))
-        e = popcount(inmask[j]) - r + 2
+        e = popcount(inmask[j]) - threshold(t2, j) + 2
         if e < need2:
             need2 = e
     if need2 < 1:
@@ -141,10 +166,11 @@ def prefix_mask(order: np.ndarray, k: int) -> np.uint64:
 
 @njit(cache=True, nogil=True)
 def tightest_member(members: np.uint64, S: np.uint64, allowed: np.uint64,
-                    inmask: np.ndarray, r: int, n: int):
-    """Among ``members`` (⊆ S) with ≥ r in-neighbours outside S, the one whose
-    candidates (in-neighbours in ``allowed`` \\ S) exceed its need (|N(i) \\ S| − r + 1)
-    by the least. Returns (slack, candidates); (n + 1, 0) when there is none."""
+                    inmask: np.ndarray, t: int | np.ndarray, n: int):
+    """Among ``members`` (⊆ S) i with ≥ t[i] in-neighbours outside S, the one whose
+    candidates (in-neighbours in ``allowed`` \\ S) exceed its need
+    (|N(i) \\ S| − t[i] + 1) by the least. Returns (slack, candidates); (n + 1, 0) when
+    there is none."""
     best_slack = n + 1
     best_cand = ZERO
     m = members
@@ -152,9 +178,10 @@ def tightest_member(members: np.uint64, S: np.uint64, allowed: np.uint64,
         i = low_index(m)
         m &= ~(U1 << np.uint64(i))
         outside = popcount(inmask[i] & ~S)
-        if outside >= r:
+        ti = threshold(t, i)
+        if outside >= ti:
             cand = inmask[i] & allowed & ~S
-            slack = popcount(cand) - (outside - r + 1)
+            slack = popcount(cand) - (outside - ti + 1)
             if slack < best_slack:
                 best_slack = slack
                 best_cand = cand
@@ -241,7 +268,7 @@ def decide_step(
             leaf = -1
         elif S & ~P:
             leaf = -2
-        elif size_bound(S, Q, P | Q, inmask, r):
+        elif size_bound(S, Q, P | Q, inmask, r, r):
             leaf = -3
         if leaf != 0:
             if record:
