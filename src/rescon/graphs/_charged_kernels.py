@@ -22,9 +22,9 @@ from ._kernels import (
     ZERO,
     branch_node,
     core_after_removal,
+    leaf_code,
     low_index,
     popcount,
-    size_bound,
     tightest_member,
 )
 
@@ -53,8 +53,8 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
     token count, OVERFLOW when ``tokens`` is full or WITNESS when the state is a
     violating pair.
 
-    Leaves: -1 when Q = ∅, -2 when S ⊄ P, -3 when the sizes cannot fit, -4 when S is
-    ``_crowded`` for R; otherwise the member of S with ≥ t1 outside in-neighbours whose
+    Leaves: -1 when Q = ∅, -2 when S ⊄ P, -3 when the sizes cannot fit (``leaf_code``),
+    -4 when S is ``_crowded`` for R; otherwise the member of S with ≥ t1 outside in-neighbours whose
     candidates N(i) ∩ P \\ S exceed its need by the least (``tightest_member``) gets
     one of them (``branch_node``): u into S first, then into X."""
     n = inmask.shape[0]
@@ -70,14 +70,8 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
             return OVERFLOW
         sp -= 1
         S, X, P, Q = stS[sp], stX[sp], stP[sp], stQ[sp]
-        leaf = 0
-        if Q == ZERO:
-            leaf = -1
-        elif S & ~P:
-            leaf = -2
-        elif size_bound(S, Q, P | Q, inmask, t1, t2):
-            leaf = -3
-        elif _crowded(S, R, inmask, t1):
+        leaf = leaf_code(S, P, Q, inmask, t1, t2)
+        if leaf == 0 and _crowded(S, R, inmask, t1):
             leaf = -4
         if leaf != 0:
             tokens[ntok] = leaf

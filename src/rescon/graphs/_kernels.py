@@ -138,6 +138,21 @@ def size_bound(S: np.uint64, Q: np.uint64, W: np.uint64, inmask: np.ndarray,
     return popcount(S) + extra + need2 > popcount(W)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def leaf_code(S: np.uint64, P: np.uint64, Q: np.uint64, inmask: np.ndarray,
+              t1: int | np.ndarray, t2: int | np.ndarray) -> int:
+    """The leaf token of a decision state (S, P, Q), 0 when it is none
+    (certificates/FORMAT.md): -1 when Q = ∅ (no room for S2), -2 when S ⊄ P (no closed
+    S1 ⊇ S), -3 when the sizes cannot fit (``size_bound``)."""
+    if Q == ZERO:
+        return -1
+    if S & ~P:
+        return -2
+    if size_bound(S, Q, P | Q, inmask, t1, t2):
+        return -3
+    return 0
+
+
 @njit(cache=True, nogil=True)
 def branch_node(cand: np.uint64, Q: np.uint64, inmask: np.ndarray, outmask: np.ndarray) -> np.int64:
     """The candidate that, put into S1, takes an in-neighbour from the most nodes of
@@ -215,7 +230,7 @@ def decide_step(
     outside both). A state (S, X) asks for a closed S1 ⊇ S avoiding X; S2 is
     implicit: it must lie in Q = core(V \\ S \\ B), and S1 in P = core(V \\ X).
     Leaves (certificates/FORMAT.md): -1 when Q = ∅, -2 when S ⊄ P, -3 when the
-    sizes cannot fit (``size_bound``). Otherwise a member i of S with ≥ r outside
+    sizes cannot fit (``leaf_code``). Otherwise a member i of S with ≥ r outside
     in-neighbours needs one more of them inside: take the member with the least
     slack and branch on one of its candidates u ∈ N(i) ∩ P \\ S (``branch_node``),
     include first, then exclude. A state without such a member is closed and,
@@ -263,13 +278,7 @@ def decide_step(
             Q = core_after_removal(Q & ~stack[sp, SK_DQ], stack[sp, SK_DQ], inmask, outmask, r)
         depth = stack_depth[sp]
         done += 1
-        leaf = 0
-        if Q == ZERO:
-            leaf = -1
-        elif S & ~P:
-            leaf = -2
-        elif size_bound(S, Q, P | Q, inmask, r, r):
-            leaf = -3
+        leaf = leaf_code(S, P, Q, inmask, r, r)
         if leaf != 0:
             if record:
                 tokens[ntok] = leaf
