@@ -313,7 +313,9 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     hs = Halfspaces(Yi, through, sign, af, bf, af_abs, b_abs, out, c_err, box)
     # an affinely dependent subset has every other point within the rounding bound,
     # so only subsets with no point surely off their hyperplane can be degenerate
-    suspect = [h for h in np.flatnonzero(plus[idx] + minus[idx] == 0) if not any(hs.exact(h)[0])]
+    # (their zero normal has no primitive form: exact_normal, not hs.exact)
+    suspect = [h for h in np.flatnonzero(plus[idx] + minus[idx] == 0)
+               if not any(exact_normal(Yi, through[h]))]
     if suspect:
         keep = np.setdiff1d(np.arange(len(hs)), suspect)
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
