@@ -323,8 +323,12 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         poly = _clip(P, hull, F)
         verts, order, V = _lifted_vertices(poly, hull, P)
         incidence = poly.incidence()
+        # one constraint per halfspace: the fast path keeps every row (through other
+        # data points) that states the same primitive (a, b)
+        first = {(tuple(poly.a[h]), poly.b[h]): h for h in sorted(incidence, reverse=True)}
         ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
-                   for h in sorted(incidence)}
+                   for h in sorted(first.values())}
+        incidence = {h: incidence[h] for h in ambient}
         constraints = tuple(ambient.values())
     if not len(V):
         exact = _Exact((), constraints, eqs)
