@@ -131,6 +131,14 @@ def oracle(G: nx.Graph) -> Oracle:
     return Oracle(nodes, masks, rho, s_star)
 
 
+@pytest.fixture
+def fresh_facts():
+    """Decide each test's graphs afresh (graphs/facts.py caches proofs across calls)."""
+    from rescon.graphs.facts import clear_cache
+
+    clear_cache()
+
+
 @pytest.fixture(scope="session")
 def brute():
     """The brute-force oracle as a fixture: ``brute(G) -> Oracle``."""

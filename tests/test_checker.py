@@ -143,6 +143,16 @@ def complete_edges(n):
 # --------------------------------------------------------------------------- #
 
 
+def digraph(n: int, edges):
+    """The networkx digraph on nodes 0..n-1 with ``edges``."""
+    import networkx as nx
+
+    G = nx.DiGraph()
+    G.add_nodes_from(range(n))
+    G.add_edges_from(edges)
+    return G
+
+
 def graph_json(n, edges):
     return {"n": n, "edges": [[u, v] for u, v in edges]}
 

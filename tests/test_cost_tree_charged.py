@@ -15,23 +15,16 @@ from hypothesis import strategies as st
 import rescon
 from rescon.graphs import robustness as rb
 from rescon.graphs.charged import charged_tree, configurations, count_configurations
-from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import search_order
-from tests.test_checker import C, _validator, in_masks, is_robust, rand_edges, rho_and_s
+from tests.test_checker import C, _validator, digraph, in_masks, is_robust, rand_edges, rho_and_s
 from tests.test_rho_tree import _cut_branch
 
-
-@pytest.fixture(autouse=True)
-def _fresh_facts():
-    clear_cache()
+pytestmark = pytest.mark.usefixtures("fresh_facts")
 
 
 def _graph(n, edges):
-    G = nx.DiGraph()
-    G.add_nodes_from(range(n))
-    G.add_edges_from(edges)
-    return index_graph(G)
+    return index_graph(digraph(n, edges))
 
 
 def _proof(ig, tree):

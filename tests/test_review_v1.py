@@ -21,19 +21,12 @@ from rescon.graphs.charged import charged_tree
 from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import SearchOutcome, SizedRun, cost_tree, search_order
-from tests.test_checker import C, in_masks, is_robust, rand_edges, rho_and_s
+from tests.test_checker import C, digraph, in_masks, is_robust, rand_edges, rho_and_s
+
+pytestmark = pytest.mark.usefixtures("fresh_facts")
 
 
-@pytest.fixture(autouse=True)
-def _fresh_facts():
-    clear_cache()
-
-
-def _graph(n, edges):
-    G = nx.DiGraph()
-    G.add_nodes_from(range(n))
-    G.add_edges_from(edges)
-    return G
+_graph = digraph
 
 
 def _cert(n, edges, r, s, order, tree, key="charged_tree"):

@@ -13,15 +13,10 @@ import pytest
 import rescon
 from rescon.errors import RESCONError
 from rescon.graphs import bounds as bd
-from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.robustness import _Decision, _replayable
 
-
-@pytest.fixture(autouse=True)
-def _fresh_facts():
-    """Each test decides its graphs afresh (facts.py caches proofs across calls)."""
-    clear_cache()
+pytestmark = pytest.mark.usefixtures("fresh_facts")
 
 
 def _cut_branch(proof):
