@@ -102,6 +102,17 @@ def _out_mask_array(ig: IndexedGraph) -> np.ndarray:
     return out
 
 
+def _grown(buffer: np.ndarray, room: int) -> np.ndarray | None:
+    """A full token buffer doubled (capped at ``room``, its old tokens kept), or None
+    when it already holds ``room`` tokens: the caller then drops the tree."""
+    size = buffer.shape[0]
+    if size >= room:
+        return None
+    grown = np.empty(min(2 * size, room), dtype=np.int32)
+    grown[:size] = buffer
+    return grown
+
+
 def _bits(mask: int) -> frozenset[int]:
     return frozenset(i for i in range(int(mask).bit_length()) if (int(mask) >> i) & 1)
 
@@ -181,13 +192,10 @@ class PartRun:
                           max_nodes, self.progress)
             if self.state[K.ST_STATUS] != K.NEED_ROOM:
                 return int(self.state[K.ST_STATUS])
-            size = self.buffer.shape[0]
-            if size >= self.room:
-                self.record, self.buffer = False, np.empty(1, dtype=np.int32)
-            else:
-                grown = np.empty(min(2 * size, self.room), dtype=np.int32)
-                grown[:size] = self.buffer
-                self.buffer = grown
+            grown = _grown(self.buffer, self.room)
+            if grown is None:
+                self.record, grown = False, np.empty(1, dtype=np.int32)
+            self.buffer = grown
 
     @property
     def nodes(self) -> int:
@@ -407,13 +415,10 @@ class SizedRun:
             status = int(run.state[K.CS_STATUS])
             if status != K.NEED_ROOM:
                 return status
-            size = self.tokens.shape[0]
-            if size >= self.max_tokens:
-                self.recording, self.tokens = False, np.empty(1, dtype=np.int32)
-            else:
-                grown = np.empty(min(2 * size, self.max_tokens), dtype=np.int32)
-                grown[:size] = self.tokens
-                self.tokens = grown
+            grown = _grown(self.tokens, self.max_tokens)
+            if grown is None:
+                self.recording, grown = False, np.empty(1, dtype=np.int32)
+            self.tokens = grown
 
     def run_for(self, seconds: float) -> None:
         """Advance slice by slice for about ``seconds`` (or until finished)."""
