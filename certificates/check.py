@@ -280,8 +280,9 @@ def _size(x: Any, where: str) -> int:
 
 def _mask_work(n: int, entries: int, where: str) -> None:
     """Refuse (unchecked) a graph / support whose n + entries mask operations on n-bit
-    masks (:func:`_mask_cost`, each reading one entry or one node) exceed
-    MAX_GRAPH_WORK: node sets are n-bit masks, so a large sparse graph costs n (n + m)."""
+    masks (each reading one entry or one node; counted in operations on 1024-bit
+    masks) exceed MAX_GRAPH_WORK: node sets are n-bit masks, so a large sparse graph
+    costs n (n + m)."""
     work = (n + entries) * max(1, -(-n // 1024))
     if work > MAX_GRAPH_WORK:
         raise Unchecked("size limit", f"{where}: n = {n} with {entries} entries needs work "
@@ -330,48 +331,6 @@ def reach(g: Graph, S: int, r: int) -> int:
             out |= low
         m ^= low
     return out
-
-
-def core(g: Graph, U: int, r: int, meter: list[int] | None = None) -> int:
-    """core_r(U): peel every i in U with |N(i) \\ U| >= r until none is left.
-
-    The result is the largest closed subset of U (closed sets are union-closed and
-    removability is monotone, so the peeling order does not matter). Monotonicity also
-    means that after one scan of U only the out-neighbours of removed nodes need a
-    recount: O(|U| + sum of their out-degrees) mask operations (a pass-by-pass peel
-    costs |U| per pass and up to |U| passes). ``meter[0]``, when given, is increased by
-    the number of mask operations, each weighted by the words of an n-bit mask
-    (:func:`_mask_cost`)."""
-    inmask = g.inmask
-    outmask = g.outmask()
-    todo = []
-    m = U
-    while m:
-        low = m & -m
-        m ^= low
-        if (inmask[low.bit_length() - 1] & ~U).bit_count() >= r:
-            todo.append(low.bit_length() - 1)
-    ops = U.bit_count() + 2  # the scan, and the call itself
-    for i in todo:
-        U ^= 1 << i
-    while todo:
-        m = outmask[todo.pop()] & U
-        while m:
-            low = m & -m
-            m ^= low
-            ops += 1
-            j = low.bit_length() - 1
-            if (inmask[j] & ~U).bit_count() >= r:
-                U ^= low
-                todo.append(j)
-    if meter is not None:
-        meter[0] += _mask_cost(g, ops)
-    return U
-
-
-def _mask_cost(g: Graph, ops: int) -> int:
-    """``ops`` operations on n-bit masks, counted in operations on 1024-bit ones."""
-    return ops * max(1, -(-g.n // 1024))
 
 
 def _pair_failure(g: Graph, r: int, s: int, S1: int, S2: int) -> str | None:
@@ -634,17 +593,16 @@ class _Replay:
     ``work`` counts steps, each a few operations on packed sets of n·w bits and
     weighted by ⌈n·w / 1024⌉: one per token, per round of :meth:`shrink` and per node
     whose out-neighbours it subtracts, per member of S at a -3 leaf, and n + |E| + n
-    to set up the tables and the first root (plus the mask operations of its
-    :func:`core`); besides, one step per 64 bits of memory: the table ``less`` (up
-    to n·w bits per node with out-neighbours) and the stack (at most n + 1 levels, as
-    each fixes one more node in S ∪ X, each with up to four packed sets of its own:
-    S or X with the new node, and a re-peeled set with its D), so memory stays below
-    64·MAX_SEARCH_WORK bits.
+    to set up the tables and the first root; besides, one step per 64 bits of memory:
+    the table ``less`` (up to n·w bits per node with out-neighbours) and the stack
+    (at most n + 1 levels, as each fixes one more node in S ∪ X, each with up to four
+    packed sets of its own: S or X with the new node, and a re-peeled set with its D),
+    so memory stays below 64·MAX_SEARCH_WORK bits.
     """
 
     def __init__(self, g: Graph, r: int, where: str) -> None:
         n = g.n
-        self.g, self.r, self.where = g, r, where
+        self.g, self.where = g, where
         self.w = w = n.bit_length() + 1
         self.deg = deg = [mk.bit_count() for mk in g.inmask]
         self.ones = (1 << w) - 1

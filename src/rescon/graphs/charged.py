@@ -54,17 +54,18 @@ def charged_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = N
     from ._charged_kernels import OVERFLOW, config_tree
     from .search import _kernel_inputs
 
-    if r < 1 or count_configurations(ig.n, s - 1) > MAX_CONFIGS:
+    count = count_configurations(ig.n, s - 1)
+    if r < 1 or count > MAX_CONFIGS:
         return None
     _, inmask, outmask, order = _kernel_inputs(ig)
-    masks = [int(m) for m in inmask]
+    masks = ig.in_masks()
     tokens = np.empty(max_tokens, dtype=np.int32)
-    ntok, count = 0, count_configurations(ig.n, s - 1)
+    ntok = 0
     for index, (Q1, Q2) in enumerate(configurations(ig.n, s - 1)):
         if index == 1 and ntok * count > 2 * max_tokens:
             return None  # each configuration costs about as much as the first: too many
-        t1, t2 = (np.array([r + (m & _mask(Q)).bit_count() for m in masks], dtype=np.int64)
-                  for Q in (Q1, Q2))
+        t1, t2 = (np.array([r + (m & q).bit_count() for m in masks], dtype=np.int64)
+                  for q in (_mask(Q1), _mask(Q2)))
         ntok = config_tree(inmask, outmask, order, t1, t2, not Q1, np.uint64(_mask(Q1 + Q2)),
                            tokens, ntok)
         if ntok == OVERFLOW:
