@@ -38,7 +38,7 @@ import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
 from .exact import cross_all
-from .polytope import ExactPolytope, members_of, tight_pairs
+from .polytope import ExactPolytope, _bits, members_of, tight_pairs
 
 __all__ = ["certified_kernel"]
 
@@ -320,7 +320,6 @@ class _RayIndex:
     def __init__(self, tight: list[int], basis: list[list[int]], n_rows: int, k: int
                  ) -> None:
         self.tight, self.k = tight, k
-        self.weights = [n_rows**i for i in range(k - 1)]
         self._members: dict[int, list[int]] | None = None
         counts = np.array([t.bit_count() for t in tight], dtype=np.int64)
         self.simple = np.flatnonzero(counts == k)
@@ -328,7 +327,7 @@ class _RayIndex:
         self.simple_rows = np.sort(np.array([basis[vi] for vi in self.simple.tolist()],
                                             dtype=np.int64).reshape(-1, k), axis=1)
         wide = np.int64 if n_rows ** (k - 1) < 2**62 else object  # the keys fit int64?
-        self.W = np.array(self.weights, dtype=wide)
+        self.W = np.array([n_rows**i for i in range(k - 1)], dtype=wide)
         keys, owners = [], []
         groups = [(self.simple, self.simple_rows)]
         keyed = [vi for vi in self.non_simple if counts[vi] <= MAX_TIGHT]
@@ -674,10 +673,3 @@ def _dot(a: tuple[int, ...], d: tuple[int, ...]) -> int:
 def _primitive_direction(d: tuple[int, ...]) -> tuple[int, ...]:
     g = gcd(*d)
     return tuple(v // g for v in d) if g > 1 else d
-
-
-def _bits(t: int):
-    while t:
-        low = t & -t
-        yield low.bit_length() - 1
-        t ^= low
