@@ -240,7 +240,10 @@ def log_floor(*series: Any) -> float | None:
         return None
     pos = vals[vals > 0.0]
     m = float(pos.min()) if pos.size else 10.0 * np.finfo(float).eps
-    return max(10.0 ** (math.floor(math.log10(m)) - 1), float(np.nextafter(0.0, 1.0)))
+    e = math.floor(math.log10(m)) - 1
+    while e > -324 and 10.0**e > m / 10:  # log10 rounds up just below a power of ten
+        e -= 1
+    return max(10.0**e, float(np.nextafter(0.0, 1.0)))
 
 
 def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str | None = None,
