@@ -189,33 +189,27 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     S_set = np.unique(sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
                                       count=sum(map(len, facets)))]).tolist()
     H.exact_all(S_set)
-    where = {h: i for i, h in enumerate(S_set)}
+    S = np.asarray(S_set, dtype=np.int64)
     rows_of = sel.tolist()
     Ts = _bases(H, [[rows_of[i] for i in f] for f in facets], k)
     sols = _solve_all(H, Ts, k)
     # None: k dependent rows (a zero-volume piece of a triangulated non-simple vertex),
     # the other proposals or the closure decide
-    kept = [p for p, v in enumerate(sols) if v is not None]
-    if not kept:
+    kept = np.array([p for p, v in enumerate(sols) if v is not None], dtype=np.int64)
+    if not len(kept):
         return None
     index: dict[tuple[int, ...], int] = {}  # equal points, equal primitive (w, y)
-    verts: list[tuple[int, ...]] = []
-    tight: list[int] = []
-    of_proposal: list[int] = []
-    basis: list[list[int]] = []  # per vertex: k independent rows tight at it (positions in S)
-    for p in kept:
-        i = index.setdefault(sols[p], len(verts))
-        of_proposal.append(i)
-        bits = [where[h] for h in Ts[p]]
-        if i == len(verts):
-            verts.append(sols[p])
-            tight.append(sum(1 << g for g in bits))
-            basis.append(bits)
-        else:
-            tight[i] |= sum(1 << g for g in bits)
+    of_proposal = np.fromiter((index.setdefault(sols[p], len(index)) for p in kept.tolist()),
+                              dtype=np.int64, count=len(kept))
+    verts = list(index)
+    T_kept = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)[kept]
+    # per vertex: k independent rows tight at it (positions in S), its first proposal's
+    basis = np.searchsorted(S, T_kept[np.unique(of_proposal, return_index=True)[1]]).tolist()
+    # (vertex, position in S) of the rows tight by construction; more are found below
+    tight_v = [np.repeat(of_proposal, k)]
+    tight_h = [np.searchsorted(S, T_kept).ravel()]
     # h · len(facets) + i: row h tight at vertex i by construction
-    known = (np.array([Ts[p] for p in kept], dtype=np.int64) * len(facets)
-             + np.array(of_proposal, dtype=np.int64)[:, None]).ravel()
+    known = (T_kept * len(facets) + of_proposal[:, None]).ravel()
     # exact feasibility, and the complete tight sets within S: floats of the exact
     # vertices (correctly rounded, int / int) with a rounding bound, plus the underflow
     # term, decide the clear cases; inf or NaN is never "clear"
@@ -242,26 +236,21 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     pair = rows[near_r] * len(facets) + near_v
     fresh = known[np.minimum(np.searchsorted(known, pair), len(known) - 1)] != pair
     near_r, near_v = near_r[fresh], near_v[fresh]
-    slacks = _int64_slacks(H, scale, verts, rows[near_r], near_v)
-    if slacks is not None:  # small integers: all undecided pairs at once
-        if (slacks > 0).any():
-            return None
-        for h, vi in zip(rows[near_r][slacks == 0], near_v[slacks == 0], strict=True):
-            if int(h) in where:
-                tight[int(vi)] |= 1 << where[int(h)]
-        near_r = near_v = ()
-    H.exact_all(np.unique(rows[near_r]).tolist())
-    for r, vi in zip(near_r, near_v, strict=True):
-        h, vi = int(rows[r]), int(vi)
-        if h in where and tight[vi] >> where[h] & 1:
-            continue
-        a, b = H.exact(h)
-        w, *y = verts[vi]
-        slack = sum(map(operator.mul, a, y)) - b * w
-        if slack > 0:
-            return None
-        if slack == 0 and h in where:
-            tight[vi] |= 1 << where[h]
+    hs = rows[near_r]
+    slacks = _int64_slacks(H, scale, verts, hs, near_v)
+    if slacks is None:  # in Python integers
+        H.exact_all(np.unique(hs).tolist())
+        slacks = np.array([_slack(H.exact(h), verts[vi])
+                           for h, vi in zip(hs.tolist(), near_v.tolist(), strict=True)],
+                          dtype=object)
+    if (slacks > 0).any():
+        return None
+    on = slacks == 0
+    at = np.minimum(np.searchsorted(S, hs[on]), len(S) - 1)
+    in_S = S[at] == hs[on]
+    tight_v.append(near_v[on][in_S])
+    tight_h.append(at[in_S])
+    tight = _bitsets(np.concatenate(tight_v), np.concatenate(tight_h), len(verts), len(S))
     normals = [H.exact(h)[0] for h in S_set]
     edges = _closed(tight, basis, normals, k,
                     lambda bases: _simplicial_rays(H, S_set, normals, bases, k))
@@ -277,6 +266,22 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     P.edges = edges
     P._fv = Vx
     return P
+
+
+def _slack(row: tuple[tuple[int, ...], int], v: tuple[int, ...]) -> int:
+    """a·y − b·w for the row (a, b) and the homogeneous point v = (w, y)."""
+    (a, b), (w, *y) = row, v
+    return sum(map(operator.mul, a, y)) - b * w
+
+
+def _bitsets(vs: np.ndarray, hs: np.ndarray, n: int, width: int) -> list[int]:
+    """For each of n vertices the bitset (a Python int) of the positions hs[i] < width
+    paired with it (vs[i]): a boolean table packed to bytes, one int per row."""
+    nbytes = max((width + 7) // 8, 1)
+    table = np.zeros((n, 8 * nbytes), dtype=np.bool_)
+    table[vs, hs] = True
+    buf = np.packbits(table, axis=1, bitorder="little").tobytes()
+    return [int.from_bytes(buf[i:i + nbytes], "little") for i in range(0, n * nbytes, nbytes)]
 
 
 def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
@@ -492,10 +497,13 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
         X[sure] = _meet(H, E, B[sure], at[sure], k)
     if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
         X[~sure] = cross_all(E[at[~sure]])
-    for p, row in enumerate(X.tolist()):
-        if row[0] != 0:
-            g = gcd(*row) if row[0] > 0 else -gcd(*row)
-            out[p] = tuple(v // g for v in row)
+    met = np.flatnonzero(X[:, 0] != 0)
+    if len(met):  # primitive, x_0 > 0: divided by ±gcd, all rows at once
+        X = X[met]
+        g = np.gcd.reduce(X, axis=1)
+        for p, row in zip(met.tolist(), (X // np.where(X[:, 0] > 0, g, -g)[:, None]).tolist(),
+                          strict=True):
+            out[p] = tuple(row)
     return out
 
 
