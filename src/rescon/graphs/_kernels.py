@@ -468,7 +468,10 @@ CS_SP, CS_ROOT, CS_STATUS, CS_NODES, CS_BEST, CS_END = 0, 1, 2, 3, 4, 5
 # the sized search's current size combination (|S1|, |S2|; 0: no root started yet)
 # and its number of recorded tokens
 CS_S1, CS_S2, CS_NTOK = 6, 7, 8
-COST_STATE_LEN = 9
+# 1: the sized search ends when its stack empties (a part of pending frames alone, as
+# the distributed s* search splits it off)
+CS_ALONE = 9
+COST_STATE_LEN = 10
 # uint64 buffer: current B, best S1, best S2
 CB_B, CB_W1, CB_W2 = 0, 1, 2
 
@@ -824,7 +827,8 @@ def min_cost_sized_step(
             state[CS_STATUS] = NEED_ROOM
             break
         if sp == 0:
-            if state[CS_BEST] <= lower or not next_sizes(state, order, n, ubuf):
+            if state[CS_BEST] <= lower or state[CS_ALONE] != 0 or not next_sizes(
+                    state, order, n, ubuf):
                 state[CS_STATUS] = UNSAT
                 break
             stack[0, 0] = U1 << np.uint64(order[state[CS_ROOT] - 1])

@@ -1,4 +1,5 @@
-"""The exact decision search "is G r-robust?" split into independent subtrees on Dask.
+"""The exact searches — the decision "is G r-robust?" and s*(r) — split into independent
+subtrees on Dask.
 
 The search (:func:`rescon.graphs.search.decide_r_robust`) is a depth-first
 branch and bound whose whole state is a stack of pending frames and the next root.
@@ -34,6 +35,41 @@ serial search, checkable as one certificate. Work stays balanced however unbalan
 the subtrees are (the first roots hold most of the work): a part never runs longer
 than one task before its rest is shared out again.
 
+**The s*(r) search** (:func:`search.min_cost_pair`: the sized and the charged-set
+branch and bounds over the same roots, sharing the incumbent ``best``, the cheapest
+pair's cost found so far, at first the cap ``upper``) splits engine by engine in the
+same way (:func:`search.split_cost_part`), with two differences: a state's subtree
+depends on its frame and on the context a part carries (:class:`search.CostPart`: the
+root's B; the sized search's size combination (s1, s2), whose stack empties before the
+next one starts), and on the incumbent, which only prunes.
+
+**Claim (s*).** Let the parts of an engine's search run, each below an incumbent of
+its own (the best known when it was submitted; it falls as the part finds pairs), and
+let b be the least of ``upper`` and the costs of the pairs they find. Then
+b = min(upper, s*) over the searched roots, the serial search's answer; and for the
+sized search, unless a part ended early at a pair of cost ≤ ``lower``, the tokens
+assembled as in the claim above form a tree the checker accepts below cap s = b
+(certificates/FORMAT.md, ``cost_search``).
+
+*Proof.* By the argument above, the pairs are partitioned among the frames, the rest of
+the root (its later size combinations) and the later roots, each searched by exactly one
+part, in the kernel's (and the checker's) order. A state is pruned only when its lower
+bound reaches the part's incumbent at that moment, the cost of a found pair or
+``upper``, hence ≥ b. A cheapest pair p is therefore found, or pruned below an
+incumbent ≤ cost(p): either way b ≤ min(upper, cost(p)); and b ≥ min(upper, s*), being
+``upper`` or a pair's cost. Each leaf of a sized tree is a state whose bound reached its
+incumbent (≥ b), or a complete labelling whose bound is its pair's cost (≥ s* ≥ b); the
+checker's bound is at least the kernel's (which stops counting once it reaches the
+incumbent), so every leaf passes at cap b, and the subtrees, each complete, cover the
+roots and size combinations in order. ∎
+
+The states differ from the serial search's (pruning depends on when a part learns of
+the incumbent); the answer does not. A part runs for at most ``COST_TASK_NODES``
+states; as many run as the cluster has threads, and a free thread takes the next part
+of the engine furthest below its due share of the task seconds (search.min_cost_pair's
+turns), with the incumbent as it is then. The first engine to finish answers; the
+sized engine's tree is the ``cost_search`` certificate when it fits ``MAX_TREE_TOKENS``.
+
 The cluster is the one sweeps use (rescon._dask): an embedded LocalCluster of
 ``workers`` processes or a running scheduler's address, opened only when a search
 outlasts ``LOCAL_NODES`` states in this process, inside :func:`searches_on`.
@@ -57,19 +93,25 @@ from ..errors import InputError, SolverError
 from .search import (
     MAX_SEARCH_NODES,
     MAX_TREE_TOKENS,
+    CostOutcome,
+    CostPart,
+    CostPartRun,
     PartRun,
     SearchOutcome,
     SearchPart,
+    split_cost_part,
     split_part,
 )
 
-__all__ = ["LOCAL_NODES", "TASK_NODES", "active", "finish_on_cluster", "searches_for",
-           "searches_on"]
+__all__ = ["COST_TASK_NODES", "LOCAL_NODES", "TASK_NODES", "active", "finish_cost_on_cluster",
+           "finish_on_cluster", "searches_for", "searches_on"]
 
 #: states a search expands in this process before it goes to the cluster (~0.1 s)
 LOCAL_NODES = 500_000
 #: states one task expands before it returns the rest of its part (~0.3–0.5 s)
 TASK_NODES = 2_000_000
+#: states one s* task expands before it returns the rest of its part
+COST_TASK_NODES = 500_000
 #: frames of a stopped part that become parts of their own (the bottom, shallowest ones)
 SPLIT_SINGLES = 4
 #: seconds between checks of the deadline and ``should_stop`` while tasks run
@@ -107,9 +149,10 @@ def active() -> _Cluster | None:
 
 @contextmanager
 def searches_on(scheduler: str | None = None, workers: int | None = None) -> Iterator[None]:
-    """Within the block, decision searches that outlast ``LOCAL_NODES`` states finish
-    on Dask: the scheduler at address ``scheduler``, or an embedded LocalCluster of
-    ``workers`` processes. Neither given, or ``workers=0``: nothing changes (serial).
+    """Within the block, exact searches (decision and s*) that outlast ``LOCAL_NODES``
+    states finish on Dask: the scheduler at address ``scheduler``, or an embedded
+    LocalCluster of ``workers`` processes. Neither given, or ``workers=0``: nothing
+    changes (serial).
 
     Raises InputError for both given or a bad count, MissingDependency without dask
     (checked on entry, not when a search first needs the cluster)."""
@@ -274,3 +317,139 @@ def finish_on_cluster(
     finally:
         client.cancel(list(running))
     return SearchOutcome("robust", r, order, None, tree.assemble(), nodes, 1.0)
+
+
+# --------------------------------------------------------------------------- #
+# the s*(r) search
+# --------------------------------------------------------------------------- #
+
+
+@dataclass(frozen=True)
+class CostPartResult:
+    """What an s* task returns: the incumbent after the part, the pair of that cost when
+    the part found it (None: it found nothing cheaper than it was given), the sized
+    tree's tokens (None when not recorded), states, refuted share and seconds, and the
+    rest of the part (None when it finished)."""
+
+    best: int
+    pair: tuple[frozenset[int], frozenset[int]] | None
+    tokens: np.ndarray | None
+    nodes: int
+    progress: float
+    seconds: float
+    rest: CostPart | None
+
+
+def run_cost_part(masks: tuple[np.ndarray, np.ndarray, np.ndarray], engine: str, r: int,
+                  lower: int, part: CostPart, best: int, room: int,
+                  max_nodes: int) -> CostPartResult:
+    """Run the s* ``engine`` over ``part`` below the incumbent ``best`` for at most
+    ``max_nodes`` states, recording fewer than ``room`` tokens (on a worker)."""
+    from . import _kernels as K
+
+    run = CostPartRun((K, *masks), engine, r, lower, part, best, room - 1 if room else 0)
+    status = run.advance(max_nodes)
+    return CostPartResult(run.best, run.pair(), run.recorded(), run.nodes, run.progress,
+                          run.seconds, run.rest() if status == K.RUNNING else None)
+
+
+class _Engine:
+    """One s* engine's parts on the cluster: those waiting (a stack, the next in preorder
+    on top), how many run, its tree (the sized engine's, recorded while it fits), its
+    task seconds (its turns) and counts."""
+
+    def __init__(self, run: CostPartRun) -> None:
+        self.name, self.n = run.engine, run.inmask.shape[0]
+        self.tree = _Tree(run.recording)
+        self.waiting: list[tuple[int, CostPart]] = []
+        self.running = 0
+        self.seconds, self.nodes, self.progress = run.seconds, run.nodes, run.progress
+        self._ids = itertools.count(1)
+        self.share(0, run.recorded(), run.rest())
+
+    def share(self, pid: int, tokens: np.ndarray | None, rest: CostPart | None) -> None:
+        """Part ``pid`` has run: its tokens into the tree, its rest's parts to wait."""
+        parts = [] if rest is None else split_cost_part(rest, SPLIT_SINGLES, self.n)
+        children = [next(self._ids) for _ in parts]
+        self.tree.add(pid, tokens, children)
+        self.waiting.extend(reversed(list(zip(children, parts, strict=True))))
+
+    def take(self, res: CostPartResult) -> None:
+        self.running -= 1
+        self.nodes += res.nodes
+        self.progress += res.progress
+        self.seconds += res.seconds
+
+    @property
+    def finished(self) -> bool:
+        return not self.waiting and not self.running
+
+
+def finish_cost_on_cluster(
+    cluster: _Cluster,
+    runs: list[CostPartRun],
+    due: dict[str, float],
+    best: int,
+    pair: tuple[frozenset[int], frozenset[int]] | None,
+    *,
+    deadline: float | None = None,
+    on_progress: Callable[[float, int], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> CostOutcome:
+    """Finish the s* search of ``runs`` (both engines, started in this process below the
+    incumbent ``best`` of ``pair``, neither finished) on the cluster: each engine's rest
+    split into parts (module docstring), as many running as the cluster has threads;
+    a free thread takes the next part of the engine furthest below its ``due`` share of
+    the task seconds, with the incumbent as it is then. The first engine whose parts
+    have all finished answers, as in search.min_cost_pair; so does a pair of cost
+    ``lower``. Its ``best`` is the serial search's; the sized engine's tree, assembled
+    from its parts, proves it."""
+    from distributed import wait
+
+    client = cluster.client()
+    first = runs[0]
+    masks, lower = (first.inmask, first.outmask, first.order), first.lower
+    order = tuple(first.order.tolist())
+    slots = max(sum(client.nthreads().values()), 1)
+    engines = [_Engine(run) for run in runs]
+    running: dict[Any, tuple[_Engine, int]] = {}
+    found_by = ""  # the engine that found the incumbent (it answers when that is lower)
+
+    def counts() -> tuple[float, int]:
+        return max(e.progress for e in engines), sum(e.nodes for e in engines)
+
+    try:
+        while best > lower and not any(e.finished for e in engines):
+            while len(running) < slots and any(e.waiting for e in engines):
+                eng = min((e for e in engines if e.waiting),
+                          key=lambda e: e.seconds / due[e.name])
+                pid, part = eng.waiting.pop()
+                eng.running += 1
+                running[client.submit(run_cost_part, masks, eng.name, first.r, lower, part,
+                                      best, eng.tree.room(), COST_TASK_NODES,
+                                      pure=False)] = (eng, pid)
+            try:
+                done = wait(list(running), timeout=POLL_SECONDS,
+                            return_when="FIRST_COMPLETED").done
+            except TimeoutError:  # none finished: check the deadline
+                done = set()
+            for fut in done:
+                eng, pid = running.pop(fut)
+                res = _result(fut)
+                eng.take(res)
+                if res.best < best:
+                    best, pair, found_by = res.best, res.pair, eng.name
+                eng.share(pid, res.tokens, res.rest)
+            if on_progress is not None:
+                on_progress(*counts())
+            if (deadline is not None and time.perf_counter() > deadline) or (
+                should_stop is not None and should_stop()
+            ):
+                return CostOutcome("stopped", best, pair, counts()[1], order)
+    finally:
+        client.cancel(list(running))
+    winner = next((e for e in engines if e.finished), None)
+    tree = winner.tree.assemble() if winner is not None and best > lower else None
+    return CostOutcome("done", best, pair, counts()[1], order,
+                       engine=found_by if winner is None else winner.name,
+                       tree=None if winner is None or winner.name != "sized" else tree)

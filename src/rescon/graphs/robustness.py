@@ -666,7 +666,8 @@ def _milp_s_result(ig: IndexedGraph, r: int, out: MilpOutcome, lower: int, upper
 def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, upper: int,
                         proof: Proof, pair: bd.Pair | None) -> _SStar:
     """s*(r) from the s* branch and bounds (see search.min_cost_pair); its proof gets
-    the sized search's tree in :func:`_s_star` (:func:`_replayed`)."""
+    the sized search's tree recorded by the search (on a Dask cluster), else in
+    :func:`_s_star` (:func:`_replayed`)."""
     if out.pair is not None:
         found = bd.Pair(*out.pair)
         cost = bd.pair_cost(ig, found, r)
@@ -674,8 +675,10 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
             raise RESCONError(f"internal error: the s* search returned a pair of cost {cost} "
                               f"for a claimed {out.best}")
         upper, pair = cost, found
-    search_proof = {"method": "cost_search", "order": list(out.order),
-                    "info": {"nodes": out.nodes}}
+    search_proof: Proof = {"method": "cost_search", "order": list(out.order),
+                           "info": {"nodes": out.nodes}}
+    if out.tree is not None:  # recorded on a Dask cluster (search.min_cost_pair)
+        search_proof["tree"] = list(out.tree)
     if out.status == "stopped":
         if out.floor > lower:  # finished deepening rounds proved more than the bounds
             lower, proof = out.floor, search_proof
@@ -702,8 +705,11 @@ def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
     that finished the last one, the first round the one that wins on graphs of its
     density (:func:`_dense`; see search.min_cost_pair). Exact: the last search is
     exact below its cap, and every earlier one proved that nothing is cheaper than its
-    cap."""
+    cap. A recorded tree (search.min_cost_pair on a Dask cluster) proves the last
+    round's answer, or the floor when that round stopped or ended at a pair of cost
+    ``lower`` (then the previous round's tree, below cap = lower, is the proof)."""
     step, nodes, favour = 1, 0, "sized" if _dense(ig) else "charged"
+    floor_tree = None  # the tree of the last round that proved s*(r) ≥ lower
     while True:
         cap = min(lower + step, upper)
         t0 = time.perf_counter()
@@ -712,10 +718,13 @@ def _deepening_search(ig: IndexedGraph, r: int, lower: int, upper: int,
         favour = out.engine
         nodes += out.nodes
         if out.status == "stopped" or out.pair is not None or cap == upper:
-            return replace(out, nodes=nodes, best=out.best if out.pair is not None else upper,
-                           floor=lower)
+            best = out.best if out.pair is not None else upper
+            tree = out.tree
+            if tree is None and (out.status == "stopped" or best == lower):
+                tree = floor_tree
+            return replace(out, nodes=nodes, best=best, floor=lower, tree=tree)
         cheap = time.perf_counter() - t0 < DEEPEN_CHEAP_SECONDS
-        lower, step = cap, 2 * step if cheap else 1
+        lower, step, floor_tree = cap, 2 * step if cheap else 1, out.tree
 
 
 def _race_s(ig: IndexedGraph, r: int, lower: int, upper: int, proof: Proof,
@@ -777,10 +786,12 @@ def robustness(
     time_limit : seconds; when reached, returns proven bounds with ``exact=False``.
     undirected : treat the edges of a DiGraph as undirected.
     progress : show a progress bar (default: when stderr is a terminal).
-    scheduler, workers : finish the exact decision searches that outlast a fraction
-        of a second on Dask, split into independent subtrees (graphs/distributed.py;
-        same answers, same certificate): the scheduler at this address, or an
-        embedded LocalCluster of ``workers`` processes (0: serial). n ≤ 64.
+    scheduler, workers : finish the exact searches (decision and s*) that outlast a
+        fraction of a second on Dask, split into independent subtrees
+        (graphs/distributed.py; same answers; the decision's certificate is the serial
+        one, s* proofs carry the sized tree assembled from the parts when it fits):
+        the scheduler at this address, or an embedded LocalCluster of ``workers``
+        processes (0: serial). n ≤ 64.
 
     Returns
     -------
@@ -913,7 +924,7 @@ def is_rs_robust(
     Parameters
     ----------
     r : int ≥ 0.  s : int, 1 ≤ s ≤ n.
-    scheduler, workers : the decision searches on Dask, as in :func:`robustness`.
+    scheduler, workers : the exact searches on Dask, as in :func:`robustness`.
 
     Raises
     ------
@@ -1017,7 +1028,7 @@ def max_s(
     workers: int | None = None,
 ) -> int:
     """s*(r) = max s such that G is (r, s)-robust; 0 when G is not r-robust.
-    ``scheduler``, ``workers``: the decision searches on Dask, as in :func:`robustness`.
+    ``scheduler``, ``workers``: the exact searches on Dask, as in :func:`robustness`.
 
     Raises
     ------

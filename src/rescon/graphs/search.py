@@ -28,20 +28,24 @@ __all__ = [
     "FAVOURED_SHARE",
     "MAX_SEARCH_NODES",
     "MAX_TREE_TOKENS",
+    "COST_ENGINES",
     "CostOutcome",
+    "CostPart",
+    "CostPartRun",
     "SearchOutcome",
     "SizedRun",
     "cost_tree",
     "decide_r_robust",
     "min_cost_pair",
     "search_order",
+    "split_cost_part",
+    "whole_cost_part",
 ]
 
 MAX_SEARCH_NODES = 64
 FAVOURED_SHARE = 0.75  # of the wall time, for min_cost_pair's favoured engine
 MAX_TREE_TOKENS = 4_000_000
 _SLICE = 20_000
-_NO_TOKENS = np.empty(1, dtype=np.int32)
 
 
 @dataclass(frozen=True)
@@ -150,14 +154,20 @@ def split_part(part: SearchPart, singles: int) -> list[SearchPart]:
     tree: the top frames above the ``singles`` bottom ones together, each of those alone
     (the bottom frames are the shallowest: they hold most of the work), then the roots.
     Empty parts are left out."""
-    k = part.frames.shape[0]
-    cut = max(k - singles, 0)
-    pieces = [(cut, k)] + [(i, i + 1) for i in range(cut - 1, -1, -1)]
     parts = [SearchPart(part.frames[a:b], part.depths[a:b], part.end, part.end)
-             for a, b in pieces if b > a]
+             for a, b in _frame_pieces(part.frames.shape[0], singles)]
     if part.root < part.end:
         parts.append(SearchPart(part.frames[:0], part.depths[:0], part.root, part.end))
     return parts
+
+
+def _frame_pieces(k: int, singles: int) -> list[tuple[int, int]]:
+    """Slices of a stack of k frames (bottom first), in preorder: the frames above the
+    ``singles`` bottom ones together (the top of the stack runs first), then each of the
+    bottom ones alone, the upper first. Empty slices are left out."""
+    cut = min(singles, k)
+    pieces = [(cut, k)] + [(i, i + 1) for i in range(cut - 1, -1, -1)]
+    return [(a, b) for a, b in pieces if b > a]
 
 
 class PartRun:
@@ -282,7 +292,10 @@ class CostOutcome:
     when < ``upper``, with ``pair`` the cheapest pair; otherwise s*(r) = ``upper``)
     or "stopped" (``best`` is still an upper bound). ``floor``: every pair is proven to
     cost at least this much (rounds of a deepening search that finished; 0 if none).
-    ``engine``: the search that finished ("sized" or "charged"; "" when stopped)."""
+    ``engine``: the search that finished ("sized" or "charged"; "" when stopped).
+    ``tree``: a recorded sized tree (certificates/FORMAT.md, ``cost_search``) proving
+    that every pair costs at least ``best`` ("done") or ``floor`` ("stopped"); recorded
+    only for searches run inside ``distributed.searches_on``, else None."""
 
     status: str
     best: int
@@ -291,21 +304,190 @@ class CostOutcome:
     order: tuple[int, ...]
     floor: int = 0
     engine: str = ""
+    tree: tuple[int, ...] | None = None
 
 
 class _CostRun:
-    """The arrays one resumable s* kernel advances (stack, depths, state, witness
-    buffer, refuted share) and the wall time it has used so far."""
+    """The arrays one resumable s* kernel advances (stack with room for ``frames``
+    pending frames, depths, state, witness buffer, refuted share)."""
 
-    def __init__(self, K, n: int, roots: tuple[int, int], upper: int) -> None:
-        self.stack = np.zeros((3 * n + 3, K.COST_STACK_WIDTH), dtype=np.uint64)
-        self.depth = np.zeros(3 * n + 3, dtype=np.int64)
+    def __init__(self, K, n: int, roots: tuple[int, int], upper: int, frames: int = 0) -> None:
+        self.stack = np.zeros((3 * n + 3 + frames, K.COST_STACK_WIDTH), dtype=np.uint64)
+        self.depth = np.zeros(3 * n + 3 + frames, dtype=np.int64)
         self.state = np.zeros(K.COST_STATE_LEN, dtype=np.int64)
         self.state[K.CS_ROOT], self.state[K.CS_END] = roots
         self.state[K.CS_BEST] = upper
         self.ubuf = np.zeros(3, dtype=np.uint64)
         self.progress = np.zeros(1, dtype=np.float64)
-        self.seconds = 0.0
+
+
+COST_ENGINES = ("sized", "charged")
+
+
+@dataclass(frozen=True)
+class CostPart:
+    """An independent piece of one s* engine's search: the subtrees of ``frames`` (rows of
+    the kernel's stack, bottom first, ``depths`` their depths), pending states of the root
+    order[root − 1] (the sized search's: of its size combination (s1, s2)); then, unless
+    ``alone``, the rest of that root (the sized search's size combinations after
+    (s1, s2)) and the roots ``root``, ..., ``end`` − 1. s1 = 0: no root started. The
+    subtrees compose as the decision search's do (proof: graphs/distributed.py)."""
+
+    frames: np.ndarray
+    depths: np.ndarray
+    root: int
+    end: int
+    s1: int = 0
+    s2: int = 0
+    alone: bool = False
+
+
+def whole_cost_part(n: int, roots: range | None = None) -> CostPart:
+    """The part of an s* search over ``roots`` (default all n): no pending frame."""
+    from ._kernels import COST_STACK_WIDTH
+
+    first, end = _root_range(roots, n)
+    return CostPart(np.zeros((0, COST_STACK_WIDTH), dtype=np.uint64),
+                    np.zeros(0, dtype=np.int64), first, end)
+
+
+def split_cost_part(part: CostPart, singles: int, n: int) -> list[CostPart]:
+    """``part`` as consecutive parts whose trees, concatenated in list order, are its
+    tree (as :func:`split_part`): the top frames above the ``singles`` bottom ones
+    together, each of those alone, then the rest of the root (the sized search's size
+    combinations after (s1, s2), if any), then the next roots. Empty parts are left out."""
+    parts = [CostPart(part.frames[a:b], part.depths[a:b], part.root, part.root, part.s1,
+                      part.s2, alone=True)
+             for a, b in _frame_pieces(part.frames.shape[0], singles)]
+    if part.alone:
+        return parts
+    none = (part.frames[:0], part.depths[:0])
+    if part.s1 > 0 and part.s1 + 2 <= n - part.root + 1:  # a size combination is left
+        parts.append(CostPart(*none, part.root, part.root, part.s1, part.s2))
+    if part.root < part.end:
+        parts.append(CostPart(*none, part.root, part.end))
+    return parts
+
+
+class CostPartRun:
+    """A resumable run of one s* engine over a :class:`CostPart`: ``engine`` "sized"
+    (``_kernels.min_cost_sized_step``) or "charged" (``_kernels.min_cost_step``), below
+    the incumbent ``best`` (a pair's cost, or a cap), ending at the first pair of cost
+    ≤ ``lower``. The sized search's tree is recorded while it has at most ``max_tokens``
+    tokens (``recording`` turns False beyond, the search goes on; 0: not recorded)."""
+
+    def __init__(self, inputs: tuple, engine: str, r: int, lower: int, part: CostPart,
+                 best: int, max_tokens: int = 0) -> None:
+        if engine not in COST_ENGINES:
+            raise ValueError(f"engine must be one of {COST_ENGINES}; got {engine!r}")
+        self.K, self.inmask, self.outmask, self.order = inputs
+        K, n, k = self.K, self.inmask.shape[0], part.frames.shape[0]
+        self.engine, self.r, self.lower, self.upper = engine, r, lower, best
+        if engine == "sized":
+            self.mmask, self.mout = K.non_in_masks(self.inmask)
+        self.run = run = _CostRun(K, n, (part.root, part.root if part.alone else part.end),
+                                  best, k)
+        run.stack[:k], run.depth[:k] = part.frames, part.depths
+        state = run.state
+        state[K.CS_SP], state[K.CS_S1], state[K.CS_S2] = k, part.s1, part.s2
+        state[K.CS_ALONE] = part.alone
+        if part.root > 0:  # the started root's B (a root not yet started sets its own)
+            run.ubuf[K.CB_B] = K.prefix_mask(self.order, part.root - 1)
+        self.max_tokens = max_tokens if engine == "sized" else 0
+        self.recording = self.max_tokens > 0
+        self.tokens = np.empty(min(1 << 12, self.max_tokens) if self.recording else 1,
+                               dtype=np.int32)
+        self.seconds = 0.0  # wall time in advance(), for turns between engines
+
+    def advance(self, max_nodes: int) -> int:
+        """Expand up to ``max_nodes`` more states; the kernel's status (RUNNING: not
+        finished). A full token buffer doubles, up to ``max_tokens``; beyond, the tree
+        is dropped."""
+        K, run = self.K, self.run
+        t0 = time.perf_counter()
+        try:
+            while True:
+                run.state[K.CS_STATUS] = K.RUNNING
+                args = (self.r, self.lower, run.stack, run.depth, run.state, run.ubuf,
+                        max_nodes, run.progress)
+                if self.engine == "charged":
+                    K.min_cost_step(self.inmask, self.outmask, self.order, *args)
+                else:
+                    K.min_cost_sized_step(self.inmask, self.mmask, self.mout, self.order,
+                                          *args, self.tokens, self.recording)
+                status = int(run.state[K.CS_STATUS])
+                if status != K.NEED_ROOM:
+                    return status
+                grown = _grown(self.tokens, self.max_tokens)
+                if grown is None:
+                    self.recording, grown = False, np.empty(1, dtype=np.int32)
+                self.tokens = grown
+        finally:
+            self.seconds += time.perf_counter() - t0
+
+    def run_for(self, seconds: float) -> None:
+        """Advance slice by slice for about ``seconds`` (or until finished)."""
+        stop = time.perf_counter() + seconds
+        while not self.finished and time.perf_counter() < stop:
+            self.advance(_SLICE)
+
+    @property
+    def finished(self) -> bool:
+        return int(self.run.state[self.K.CS_STATUS]) != self.K.RUNNING
+
+    @property
+    def best(self) -> int:
+        """The incumbent: the cheapest pair's cost found so far, or the one it was given."""
+        return int(self.run.state[self.K.CS_BEST])
+
+    @best.setter
+    def best(self, value: int) -> None:
+        self.run.state[self.K.CS_BEST] = value
+
+    @property
+    def nodes(self) -> int:
+        return int(self.run.state[self.K.CS_NODES])
+
+    @property
+    def progress(self) -> float:
+        """The share of the part's search space refuted so far."""
+        return float(self.run.progress[0])
+
+    def pair(self) -> tuple[frozenset[int], frozenset[int]] | None:
+        """The last pair this run found (cost ``best`` right after it found it), None
+        while it found none cheaper than the incumbent it started with."""
+        if self.best >= self.upper:
+            return None
+        return _bits(self.run.ubuf[self.K.CB_W1]), _bits(self.run.ubuf[self.K.CB_W2])
+
+    def recorded(self) -> np.ndarray | None:
+        """The tokens recorded so far (None when not recorded or dropped)."""
+        if not self.recording:
+            return None
+        return self.tokens[: self.run.state[self.K.CS_NTOK]].copy()
+
+    def tree(self) -> tuple[int, ...] | None:
+        """:meth:`recorded` as a tuple."""
+        tokens = self.recorded()
+        return None if tokens is None else tuple(tokens.tolist())
+
+    def rest(self) -> CostPart:
+        """What is left of the part: its pending frames, the rest of its root, its roots."""
+        K, state = self.K, self.run.state
+        sp = int(state[K.CS_SP])
+        return CostPart(self.run.stack[:sp].copy(), self.run.depth[:sp].copy(),
+                        int(state[K.CS_ROOT]), int(state[K.CS_END]), int(state[K.CS_S1]),
+                        int(state[K.CS_S2]), bool(state[K.CS_ALONE]))
+
+
+def _dues(favour: str | None) -> dict[str, float]:
+    """Each engine's due share of the time: equal, or ``FAVOURED_SHARE`` for ``favour``."""
+    if favour is None:
+        return dict.fromkeys(COST_ENGINES, 0.5)
+    if favour not in COST_ENGINES:
+        raise ValueError(f"favour must be one of {sorted(COST_ENGINES)} or None; got "
+                         f"{favour!r}")
+    return {e: FAVOURED_SHARE if e == favour else 1 - FAVOURED_SHARE for e in COST_ENGINES}
 
 
 def min_cost_pair(
@@ -335,55 +517,48 @@ def min_cost_pair(
     n ≤ 64. ``on_progress`` and ``roots`` as in :func:`decide_r_robust` (a part's
     ``best`` bounds only the pairs whose first node lies in its roots; s*(r) is the
     least over the parts).
+
+    Inside ``distributed.searches_on(...)``, a search still running after
+    ``distributed.LOCAL_NODES`` states is finished on the Dask cluster, split into
+    parts (:func:`rescon.graphs.distributed.finish_cost_on_cluster`; same ``best``), and
+    the sized search records its tree (``CostOutcome.tree``).
     """
-    K, inmask, outmask, order = _kernel_inputs(ig)
-    n = ig.n
-    mmask, mout = K.non_in_masks(inmask)
-    span = _root_range(roots, n)
-    charged, sized = _CostRun(K, n, span, upper), _CostRun(K, n, span, upper)
-    engines = {"sized": sized, "charged": charged}
-    due = {run: 0.5 for run in engines.values()}
-    if favour is not None:
-        if favour not in engines:
-            raise ValueError(f"favour must be one of {sorted(engines)} or None; got {favour!r}")
-        due = {run: FAVOURED_SHARE if run is engines[favour] else 1 - FAVOURED_SHARE
-               for run in engines.values()}
+    from . import distributed
 
-    def advance(run: _CostRun) -> None:
-        args = (r, lower, run.stack, run.depth, run.state, run.ubuf, _SLICE, run.progress)
-        if run is sized:
-            K.min_cost_sized_step(inmask, mmask, mout, order, *args, _NO_TOKENS, False)
-        else:
-            K.min_cost_step(inmask, outmask, order, *args)
-
-    best, owner, status = upper, sized, "done"
+    inputs = _kernel_inputs(ig)
+    K, order = inputs[0], tuple(inputs[3].tolist())
+    due = _dues(favour)
+    part = whole_cost_part(ig.n, roots)
+    cluster = distributed.active()
+    room = MAX_TREE_TOKENS if cluster is not None else 0
+    runs = [CostPartRun(inputs, "sized", r, lower, part, upper, room),
+            CostPartRun(inputs, "charged", r, lower, part, upper)]
+    best, pair = upper, None
     while True:
-        run = min((sized, charged), key=lambda c: c.seconds / due[c])
-        run.state[K.CS_BEST] = best
-        t0 = time.perf_counter()
-        advance(run)
-        run.seconds += time.perf_counter() - t0
-        if run.state[K.CS_BEST] < best:
-            best, owner = int(run.state[K.CS_BEST]), run
+        run = min(runs, key=lambda c: c.seconds / due[c.engine])
+        run.best = best
+        status = run.advance(_SLICE)
+        if run.best < best:
+            best, pair = run.best, run.pair()
         if on_progress is not None:
-            on_progress(float(max(sized.progress[0], charged.progress[0])),
-                        int(sized.state[K.CS_NODES] + charged.state[K.CS_NODES]))
-        if run.state[K.CS_STATUS] != K.RUNNING:
+            on_progress(max(c.progress for c in runs), sum(c.nodes for c in runs))
+        if status != K.RUNNING:
             break
         if (deadline is not None and time.perf_counter() > deadline) or (
             should_stop is not None and should_stop()
         ):
-            status = "stopped"
-            break
-    pair = None
-    if best < upper:
-        pair = (_bits(owner.ubuf[K.CB_W1]), _bits(owner.ubuf[K.CB_W2]))
-    nodes = int(sized.state[K.CS_NODES] + charged.state[K.CS_NODES])
-    engine = "" if status == "stopped" else "sized" if run is sized else "charged"
-    return CostOutcome(status, best, pair, nodes, tuple(order.tolist()), engine=engine)
+            return CostOutcome("stopped", best, pair, sum(c.nodes for c in runs), order)
+        if (cluster is not None and best > lower
+                and sum(c.nodes for c in runs) >= distributed.LOCAL_NODES):
+            return distributed.finish_cost_on_cluster(
+                cluster, runs, due, best, pair, deadline=deadline, on_progress=on_progress,
+                should_stop=should_stop)
+    tree = run.tree() if best > lower else None  # else it ended early: a partial tree
+    return CostOutcome("done", best, pair, sum(c.nodes for c in runs), order,
+                       engine=run.engine, tree=tree)
 
 
-class SizedRun:
+class SizedRun(CostPartRun):
     """A resumable run of the sized search (``_kernels.min_cost_sized_step``) over all
     roots below cap ``s``: does some pair whose sets both keep an r-closed member cost
     less than s? It ends at the first pair of cost ≤ ``lower`` (a proven lower bound;
@@ -395,61 +570,9 @@ class SizedRun:
 
     def __init__(self, ig: IndexedGraph, r: int, s: int, *, lower: int = -1,
                  max_tokens: int = MAX_TREE_TOKENS) -> None:
-        K, self.inmask, _, order = _kernel_inputs(ig)
-        self.K, self.order, self.r, self.s, self.lower = K, order, r, s, lower
-        self.mmask, self.mout = K.non_in_masks(self.inmask)
-        self.run = _CostRun(K, ig.n, (0, ig.n), s)
-        self.max_tokens, self.recording = max_tokens, max_tokens > 0
-        self.tokens = np.empty(min(1 << 12, max_tokens) if self.recording else 1, dtype=np.int32)
-
-    def advance(self, max_nodes: int) -> int:
-        """Expand up to ``max_nodes`` more states; the kernel's status (RUNNING: not
-        finished). A full token buffer doubles, up to ``max_tokens``; beyond, the tree
-        is dropped."""
-        K, run = self.K, self.run
-        while True:
-            run.state[K.CS_STATUS] = K.RUNNING
-            K.min_cost_sized_step(self.inmask, self.mmask, self.mout, self.order, self.r,
-                                  self.lower, run.stack, run.depth, run.state, run.ubuf,
-                                  max_nodes, run.progress, self.tokens, self.recording)
-            status = int(run.state[K.CS_STATUS])
-            if status != K.NEED_ROOM:
-                return status
-            grown = _grown(self.tokens, self.max_tokens)
-            if grown is None:
-                self.recording, grown = False, np.empty(1, dtype=np.int32)
-            self.tokens = grown
-
-    def run_for(self, seconds: float) -> None:
-        """Advance slice by slice for about ``seconds`` (or until finished)."""
-        stop = time.perf_counter() + seconds
-        while not self.finished and time.perf_counter() < stop:
-            self.advance(_SLICE)
-
-    @property
-    def finished(self) -> bool:
-        return int(self.run.state[self.K.CS_STATUS]) != self.K.RUNNING
-
-    @property
-    def best(self) -> int:
-        """The cheapest pair's cost found so far (s while none is cheaper than s)."""
-        return int(self.run.state[self.K.CS_BEST])
-
-    @property
-    def nodes(self) -> int:
-        return int(self.run.state[self.K.CS_NODES])
-
-    def pair(self) -> tuple[frozenset[int], frozenset[int]] | None:
-        """The cheapest pair found (cost ``best``), None while none is cheaper than s."""
-        if self.best >= self.s:
-            return None
-        return _bits(self.run.ubuf[self.K.CB_W1]), _bits(self.run.ubuf[self.K.CB_W2])
-
-    def tree(self) -> tuple[int, ...] | None:
-        """The tokens recorded so far (None once the tree was dropped)."""
-        if not self.recording:
-            return None
-        return tuple(self.tokens[: self.run.state[self.K.CS_NTOK]].tolist())
+        super().__init__(_kernel_inputs(ig), "sized", r, lower, whole_cost_part(ig.n), s,
+                         max_tokens)
+        self.s = s
 
 
 def cost_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = None,
