@@ -9,6 +9,7 @@ certificate (``safe_kernel``, or ``kernel_empty`` with Farkas multipliers).
 
 from __future__ import annotations
 
+import functools
 import operator
 import time
 from collections.abc import Callable
@@ -37,7 +38,7 @@ from .exact import (
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .points import kernel_point_of
-from .polytope import ExactPolytope, clip_to_fixpoint
+from .polytope import ExactPolytope, _bits, clip_to_fixpoint
 
 __all__ = ["SafeKernel", "kernel_point", "kernel_points", "safe_kernel"]
 
@@ -248,20 +249,29 @@ def _unit_rows(rows: list[tuple[tuple[Fraction, ...], Fraction]], d: int
     if not rows:
         return np.zeros((0, d)), np.zeros(0)
     tops = [_max_abs(a) for a, _ in rows]
-    A = _direction_floats([a for a, _ in rows], tops)
-    norm = np.linalg.norm(A, axis=1)
-    return A / norm[:, None], _unit_offsets([bb / top for (_, bb), top in zip(rows, tops)],
-                                            norm, "a facet")
+    offsets = [bb / top for (_, bb), top in zip(rows, tops, strict=True)]
+    return _normalised(_direction_floats([a for a, _ in rows], tops),
+                       [(x.numerator, x.denominator) for x in offsets], "a facet")
 
 
-def _unit_offsets(offsets: list[Fraction], norms: np.ndarray, what: str) -> np.ndarray:
-    """b / ‖a‖ for exact offsets b and the float norms of their rows, each rounded once
-    from the exact quotient: it overflows only when the plane's distance from the
-    origin does, and then no float row can state it — InputError naming ``what``."""
+def _normalised(D: np.ndarray, offsets: list[tuple[int, int]], what: str
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The rows D / ‖D‖ and their offsets p/q / ‖D‖ (``offsets``: integer pairs (p, q),
+    q > 0), for rows D of directions a / t and offsets b / t (any t > 0)."""
+    norm = np.linalg.norm(D, axis=1)
+    return D / norm[:, None], _unit_offsets(offsets, norm, what)
+
+
+def _unit_offsets(offsets: list[tuple[int, int]], norms: np.ndarray, what: str) -> np.ndarray:
+    """b / ‖a‖ for exact offsets b = p/q (integer pairs, q > 0) and the float norms of
+    their rows, each rounded once from the exact quotient: it overflows only when the
+    plane's distance from the origin does, and then no float row can state it —
+    InputError naming ``what``."""
     try:
-        return np.array([b.numerator * den / (b.denominator * num)  # int / int, rounded once
-                         for b, (num, den) in zip(offsets, map(float.as_integer_ratio,
-                                                                norms.tolist()))],
+        return np.array([p * den / (q * num)  # int / int, rounded once
+                         for (p, q), (num, den) in zip(offsets, map(float.as_integer_ratio,
+                                                                     norms.tolist()),
+                                                        strict=True)],
                         dtype=np.float64)
     except OverflowError:
         raise InputError(f"X: {what} of the safe kernel lies farther than 1.8e308 from the "
@@ -323,6 +333,7 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         poly = _clip(P, hull, F)
         verts, order, V = _lifted_vertices(poly, hull, P)
         incidence = poly.incidence()
+        sizes = {h: len(members) for h, members in incidence.items()}
         # one constraint per halfspace: the fast path keeps every row (through other
         # data points) that states the same primitive (a, b)
         first = {(tuple(poly.a[h]), poly.b[h]): h for h in sorted(incidence, reverse=True)}
@@ -340,11 +351,17 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         dim, origin, basis, Aeq, beq, kernel_eqs = _full_affine(V[0].copy(), d)
     else:
         dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts.get(), d, False)
-    facets = _relative_facets(poly, incidence, ambient, dim) if poly is not None else []
+    facets: list = []
+    A, b = _unit_rows(facets, d)
     if poly is not None:
+        ids, D, tops = _facet_order(poly, hull, _relative_facets(poly, incidence, sizes, dim), d)
+        facets = [ambient[h] for h in ids]
         constraints = _needed_rows(poly, incidence, ambient, facets)
-    A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts.get()[0]) if kernel_eqs
-                      else facets, d)
+        if kernel_eqs:
+            A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts.get()[0]), d)
+        elif ids:
+            A, b = _normalised(D, [(poly.b[h], P.scale * top) for h, top in zip(ids, tops)],
+                               "a facet")
     exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
 
     def certificate() -> dict[str, Any]:
@@ -546,43 +563,64 @@ def _affine_of(verts, d: int, full: bool):
         Aeq = _direction_floats(ns)
         norms = np.linalg.norm(Aeq, axis=1)
         Aeq /= norms[:, None]
-        beq = _unit_offsets([b / max(map(abs, a)) for a, b in kernel_eqs], norms,
+        beq = _unit_offsets([(x.numerator, x.denominator) for x in
+                             (b / max(map(abs, a)) for a, b in kernel_eqs)], norms,
                             "the affine hull")
     else:
         Aeq, beq = np.zeros((0, d)), np.zeros(0)
     return dim, origin, basis, Aeq, beq, kernel_eqs
 
 
-def _relative_facets(poly: ExactPolytope, incidence: dict, ambient: dict, dim: int):
-    """Constraints whose tight vertices span a (dim − 1)-face: the facets of Ψ relative
-    to its affine hull (implicit equalities, tight everywhere, are left out), as
-    ``ambient[h]`` (the constraint h in the original coordinates), ordered by their
-    directions a / max|a_j| — an order that does not depend on how the polytope was
-    built, nor on a scaling of X by 2^j (so neither do the rows A, b, nor the float
-    guides that read them).
+def _relative_facets(poly: ExactPolytope, incidence: dict[int, list[int]],
+                     sizes: dict[int, int], dim: int) -> list[int]:
+    """The constraints h (keys of ``incidence``, increasing) whose faces
+    F_h = {v : h tight at v} are facets of Ψ relative to its affine hull; ``sizes``:
+    the number of vertices tight on each row of ``poly`` (every row tight somewhere).
 
-    A constraint tight at a simple vertex v of a full-dimensional Ψ (exactly dim tight
-    constraints) is a facet: near v, Ψ is v + the simplicial cone {d : a_h·d ≤ 0, h
-    tight at v}, whose face on any one of its rows is (dim − 1)-dimensional."""
+    Every facet of a polytope {y : a_i·y ≤ b_i} is F_g for some row g that is not an
+    implicit equality (tight at every vertex), and F_h of such a row is a proper face,
+    so the facets are the F_h maximal under inclusion. The rows g tight at every vertex
+    of F_h — the AND of those vertices' exact tight sets — have F_g ⊇ F_h; so F_h is a
+    facet iff each of them has F_g = F_h (as many vertices) or is an implicit equality.
+    A combinatorial test on the exact incidences: no rank is computed."""
     if dim == 0:
         return []
     nv = len(poly.verts)
-    simple = {i for i, t in enumerate(poly.tight) if t.bit_count() == dim} if (
-        dim == poly.k) else set()
+    tight = poly.tight
     out = []
     for h, members in sorted(incidence.items()):
-        # a face tight on h (not on every vertex) has dimension ≤ dim − 1, so it is a
-        # facet iff its dimension is at least dim − 1
-        if len(members) >= dim and len(members) < nv and (
-                not simple.isdisjoint(members) or poly.clear_rank(members) >= dim - 1
-                or poly.face_dim(members) == dim - 1):
-            out.append(ambient[h])
-    if not out:
-        return []
-    tops = [_max_abs(a) for a, _ in out]
-    order = _lex_order(_direction_floats([a for a, _ in out], tops),
-                       lambda i: tuple(v / tops[i] for v in out[i][0]))
-    return [out[i] for i in order]
+        m = len(members)
+        if m < dim or m == nv:  # a facet has ≥ dim vertices; h is an implicit equality
+            continue
+        common = functools.reduce(operator.and_, map(tight.__getitem__, members))
+        if all(sizes[g] == m or sizes[g] == nv for g in _bits(common)):
+            out.append(h)
+    return out
+
+
+def _facet_order(poly: ExactPolytope, hull: AffineHull, ids: list[int], d: int
+                 ) -> tuple[list[int], np.ndarray, list[int]]:
+    """The rows ``ids`` ordered by their ambient directions a / max|a_j|
+    (lexicographic, exact) — an order that does not depend on how the polytope was
+    built, nor on a scaling of X by 2^j (so neither do the rows A, b, nor the float
+    guides that read them) — with those directions as floats (each entry a_j / top
+    correctly rounded, int / int) and the tops max|a_j|, in that order."""
+    rows = [_scattered(poly.a[h], hull.coords, d) for h in ids]
+    tops = [max(map(abs, a)) for a in rows]
+    D = np.array([[v / top for v in a] for a, top in zip(rows, tops, strict=True)],
+                 dtype=np.float64).reshape(len(rows), d)
+    order = _lex_order(D, lambda i: tuple(Fraction(v, tops[i]) for v in rows[i]))
+    return [ids[i] for i in order], D[order], [tops[i] for i in order]
+
+
+def _scattered(a: tuple[int, ...], coords: tuple[int, ...], d: int) -> tuple[int, ...]:
+    """The pivot-coordinate row a as an ambient integer row (zeros off ``coords``)."""
+    if coords == tuple(range(d)):
+        return a
+    full = [0] * d
+    for t, c in enumerate(coords):
+        full[c] = a[t]
+    return tuple(full)
 
 
 def _needed_rows(poly: ExactPolytope, incidence: dict, ambient: dict, facets: list) -> tuple:

@@ -311,36 +311,6 @@ class ExactPolytope:
         :func:`members_of`."""
         return members_of(self.tight)
 
-    def clear_rank(self, members: list[int]) -> int:
-        """A lower bound on the affine dimension of the vertices ``members``: the
-        singular values of their float differences that exceed the rounding
-        perturbation (Weyl: the exact matrix differs by ‖E‖₂ ≤ √(size) · (8ε ·
-        (max|x| + ‖D‖₂) + the underflow term)), each certifying one dimension."""
-        if len(members) < 2:
-            return 0
-        fv = self._float_array()[members]
-        D = fv[1:] - fv[0]
-        sv = np.linalg.svd(D, compute_uv=False)
-        top = float(np.abs(fv).max())
-        perturb = np.sqrt(D.size) * (8.0 * _EPS * (top + sv[0])
-                                     + underflow_floor(self.k, top))
-        return int((sv > 16.0 * perturb).sum())
-
-    def face_dim(self, members: list[int]) -> int:
-        """Affine dimension of the vertices ``members``: read off the float SVD when
-        every possible dimension is certified (:meth:`clear_rank`), else by exact
-        elimination."""
-        if not members:
-            return -1
-        if len(members) == 1:
-            return 0
-        if self.clear_rank(members) == min(len(members) - 1, self.k):
-            return min(len(members) - 1, self.k)
-        w0, *y0 = self.verts[members[0]]
-        rows = [[yi * w0 - y0i * self.verts[m][0]
-                 for yi, y0i in zip(self.verts[m][1:], y0, strict=True)] for m in members[1:]]
-        return bareiss_rank(rows)[0]
-
 
 def clip_to_fixpoint(P: ExactPolytope, H, scale: int, first: np.ndarray | None = None
                      ) -> None:

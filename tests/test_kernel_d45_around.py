@@ -1,0 +1,76 @@
+"""Safe kernels in d = 4-5 (issue 13 §3): the work around the certification — the
+facet test, the float rows, the candidate scan, the row maxima and the proposal —
+checked against brute force in exact arithmetic and against the exact clipping."""
+
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from rescon.geometry import kernel as km
+from rescon.geometry.exact import affine_hull, exact_points, nullspace_exact
+
+
+def _cell24(centres: int = 0) -> np.ndarray:
+    """The 24-cell's vertices (±e_i ± e_j; 6 rows tight at each) and ``centres``
+    copies of its centre."""
+    pts = sorted({tuple(s * (t == i) + u * (t == j) for t in range(4))
+                  for i, j in itertools.combinations(range(4), 2)
+                  for s in (1, -1) for u in (1, -1)})
+    return np.vstack([np.array(pts, dtype=float), np.zeros((centres, 4))])
+
+
+def _flat_data(seed: int, d: int, n: int) -> np.ndarray:
+    """Small integer points whose kernel (for the F of FLAT) is flat in aff X."""
+    rng = np.random.default_rng(seed)
+    rng.integers(d + 3, 14)
+    return rng.integers(-2, 3, size=(n, d)).astype(float)
+
+
+def _gaussian(d: int, n: int, seed: int = 0) -> np.ndarray:
+    return np.random.default_rng([seed, d, n]).normal(size=(n, d))
+
+
+#: (name, X, F): simple and very non-simple vertices, kernels flat in aff X (dim 1-3)
+POLYTOPES = [
+    ("gaussian4", _gaussian(4, 18), 2),
+    ("gaussian5", _gaussian(5, 12), 1),
+    ("cell24", _cell24(4), 4),
+    ("lattice", np.array(list(itertools.product((0, 1, 2), repeat=4)), dtype=float), 5),
+    ("flat-dim3", _flat_data(77, 4, 7), 1),
+    ("flat-dim2", _flat_data(207, 4, 7), 1),
+    ("flat-dim1", _flat_data(69, 4, 7), 1),
+    ("flat-aff-X", np.column_stack([np.round(3 * _gaussian(3, 20)),
+                                    np.zeros(20)]), 2),
+]
+
+
+def _exact_rank(points: list[tuple[Fraction, ...]]) -> int:
+    """Affine dimension of exact points (brute force: a Fraction null space)."""
+    diffs = [[x - y for x, y in zip(p, points[0], strict=True)] for p in points[1:]]
+    return len(points[0]) - len(nullspace_exact(diffs)) if diffs else 0
+
+
+@pytest.mark.parametrize("fast", [True, False])
+@pytest.mark.parametrize("name,X,F", POLYTOPES, ids=[p[0] for p in POLYTOPES])
+def test_relative_facets_are_the_faces_of_dimension_dim_minus_one(name, X, F, fast,
+                                                                   monkeypatch):
+    """The combinatorial facet test (maximal faces by their exact vertex sets) keeps
+    exactly the rows whose tight vertices span a (dim − 1)-flat (exact ranks), on the
+    fast path's polytope and on the exact clipping's."""
+    if not fast:
+        monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
+    P = exact_points(X)
+    hull = affine_hull(P)
+    poly = km._clip(P, hull, F)
+    verts = poly.fraction_vertices()
+    dim = _exact_rank(verts)
+    incidence = poly.incidence()
+    sizes = {h: len(m) for h, m in incidence.items()}
+    want = [h for h, m in sorted(incidence.items())
+            if len(m) < len(verts) and _exact_rank([verts[v] for v in m]) == dim - 1]
+    assert want
+    assert km._relative_facets(poly, incidence, sizes, dim) == want
