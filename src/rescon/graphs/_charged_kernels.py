@@ -22,26 +22,12 @@ from ._kernels import (
     ZERO,
     branch_node,
     core_after_removal,
+    crowded,
     leaf_code,
-    low_index,
-    popcount,
     tightest_member,
 )
 
 OVERFLOW, WITNESS = -1, -2  # config_tree's results besides a token count
-
-
-@njit(cache=True, nogil=True)
-def _crowded(S: np.uint64, R: np.uint64, inmask: np.ndarray, t: np.ndarray) -> bool:
-    """True when a node j of R has more than d_j − t[j] in-neighbours in S (then U1 ⊇ S
-    could take j: no maximal pair leaves j outside)."""
-    m = R
-    while m:
-        j = low_index(m)
-        m &= ~(U1 << np.uint64(j))
-        if popcount(inmask[j] & S) > popcount(inmask[j]) - t[j]:
-            return True
-    return False
 
 
 @njit(cache=True, nogil=True)
@@ -54,7 +40,7 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
     violating pair.
 
     Leaves: -1 when Q = ∅, -2 when S ⊄ P, -3 when the sizes cannot fit (``leaf_code``),
-    -4 when S is ``_crowded`` for R; otherwise the member of S with ≥ t1 outside in-neighbours whose
+    -4 when S is ``crowded`` for R; otherwise the member of S with ≥ t1 outside in-neighbours whose
     candidates N(i) ∩ P \\ S exceed its need by the least (``tightest_member``) gets
     one of them (``branch_node``): u into S first, then into X."""
     n = inmask.shape[0]
@@ -71,7 +57,7 @@ def _subtree(S0: np.uint64, B: np.uint64, R: np.uint64, P0: np.uint64, Q0: np.ui
         sp -= 1
         S, X, P, Q = stS[sp], stX[sp], stP[sp], stQ[sp]
         leaf = leaf_code(S, P, Q, inmask, t1, t2)
-        if leaf == 0 and _crowded(S, R, inmask, t1):
+        if leaf == 0 and crowded(S, R, inmask, t1):
             leaf = -4
         if leaf != 0:
             tokens[ntok] = leaf

@@ -154,6 +154,29 @@ def leaf_code(S: np.uint64, P: np.uint64, Q: np.uint64, inmask: np.ndarray,
 
 
 @njit(cache=True, nogil=True)
+def crowded(S: np.uint64, R: np.uint64, inmask: np.ndarray, t: int | np.ndarray) -> bool:
+    """True when a node j of R has more than d_j − t[j] in-neighbours in S, i.e. fewer
+    than t[j] outside S ∪ {j}: j would be closed in S1 ∪ {j} for any S1 ⊇ S.
+
+    Maximality (the prune of the searches that own no recorded leaf for it): adding such
+    a j ∉ S1 ∪ S2 to S1 charges nothing (j's outside in-neighbours stay < t[j]) and can
+    only uncharge members of S1 (they gain an inside in-neighbour); the members of S2
+    keep theirs. So every pair, repeatedly saturated, becomes one whose cost (number of
+    charged members) is no larger, whose sets keep their closed members, and where no
+    node outside S1 ∪ S2 has more than d_j − t[j] in-neighbours in S1 or in S2
+    (saturation ends: S1 ∪ S2 grows). Searching only such *maximal* pairs loses no
+    minimum and no violating pair; a state with S ⊆ S1 and R known to avoid S1 ∪ S2
+    (earlier roots, excluded nodes S2 cannot take) holds none when crowded."""
+    m = R
+    while m:
+        j = low_index(m)
+        m &= ~(U1 << np.uint64(j))
+        if popcount(inmask[j] & S) > popcount(inmask[j]) - threshold(t, j):
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
 def branch_node(cand: np.uint64, Q: np.uint64, inmask: np.ndarray, outmask: np.ndarray) -> np.int64:
     """The candidate that, put into S1, takes an in-neighbour from the most nodes of
     Q (so S2's room shrinks fastest); ties: fewest in-neighbours."""
@@ -230,7 +253,10 @@ def decide_step(
     outside both). A state (S, X) asks for a closed S1 ⊇ S avoiding X; S2 is
     implicit: it must lie in Q = core(V \\ S \\ B), and S1 in P = core(V \\ X).
     Leaves (certificates/FORMAT.md): -1 when Q = ∅, -2 when S ⊄ P, -3 when the
-    sizes cannot fit (``leaf_code``). Otherwise a member i of S with ≥ r outside
+    sizes cannot fit (``leaf_code``); without a recorded tree (the checker replays
+    none of it) also when S is ``crowded`` for X \\ Q (nodes in neither set of any
+    pair below: S2 ⊆ Q, and Q only shrinks; ER(40, 0.5), r = 11: 20M states, 15M
+    with it). Otherwise a member i of S with ≥ r outside
     in-neighbours needs one more of them inside: take the member with the least
     slack and branch on one of its candidates u ∈ N(i) ∩ P \\ S (``branch_node``),
     include first, then exclude. A state without such a member is closed and,
@@ -279,6 +305,8 @@ def decide_step(
         depth = stack_depth[sp]
         done += 1
         leaf = leaf_code(S, P, Q, inmask, r, r)
+        if leaf == 0 and not record and crowded(S, X & ~Q, inmask, r):
+            leaf = -4
         if leaf != 0:
             if record:
                 tokens[ntok] = leaf
@@ -508,7 +536,11 @@ def min_cost_step(
       M ⊆ core at threshold r + b − k of V \\ X with C ∪ F counted inside;
     * in both cores, a node with r in-neighbours where its set cannot reach (S ∪ B for
       S2, X for S1) is peeled whatever the charges (``core_hard``): the charges only
-      excuse in-neighbours that may still join the set.
+      excuse in-neighbours that may still join the set;
+    * only maximal pairs are searched (``crowded``: a pair and its saturation are found
+      in their own roots, sides swapped if need be): a node of B, outside both sets,
+      with more than d − r in-neighbours in S prunes (ER(40, 0.5), r = 11, below cap 2:
+      root 1 took 90M states, 12M with this prune).
 
     An unmarked member of S with ≥ r outside in-neighbours is charged or marked
     closed (two branches); a member of M with ≥ r outside in-neighbours takes one of
@@ -553,7 +585,7 @@ def min_cost_step(
             if popcount(inmask[i] & X) >= r:
                 F |= U1 << np.uint64(i)
         budget = state[CS_BEST] - 1 - nc - popcount(F)
-        prune = budget < 0
+        prune = budget < 0 or crowded(S, B, inmask, r)
         if not prune:
             # S2 needs ≥ k charges when core_{r+k−1}(V \ S \ B) is empty
             rest = full & ~S & ~B
@@ -737,6 +769,29 @@ def sized_lower_bound(L1: np.uint64, L2: np.uint64, L0: np.uint64, s1: int, s2: 
 
 
 @njit(cache=True, nogil=True)
+def sized_crowded(L1: np.uint64, L2: np.uint64, L0: np.uint64, s1: int, s2: int,
+                  inmask: np.ndarray, mmask: np.ndarray, need: np.ndarray, n: int) -> bool:
+    """True when every completion of the partial labelling (as in ``sized_lower_bound``)
+    leaves a node of L0 with ≥ need[u] = d_u − r + 1 in-neighbours in S1 or in S2: u
+    would be closed in that set plus u, so no completion is a maximal pair
+    (``crowded``). S_k takes its c_k = s_k − |L_k| nodes still to come from the
+    unlabelled A, of which only A ∩ M(u) do not send to u (u ∉ A): |N(u) ∩ S_k| ≥
+    |N(u) ∩ L_k| + (c_k − |A ∩ M(u)|)⁺."""
+    A = ~(L1 | L2 | L0) & ((U1 << np.uint64(n)) - U1 if n < 64 else ~ZERO)
+    c1 = s1 - popcount(L1)
+    c2 = s2 - popcount(L2)
+    m = L0
+    while m:
+        u = low_index(m)
+        m &= ~(U1 << np.uint64(u))
+        away = popcount(A & mmask[u])
+        if (popcount(inmask[u] & L1) + max(c1 - away, 0) >= need[u]
+                or popcount(inmask[u] & L2) + max(c2 - away, 0) >= need[u]):
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
 def sized_branch_node(A: np.uint64, L1: np.uint64, L2: np.uint64, mmask: np.ndarray,
                       mout: np.ndarray) -> np.int64:
     """The unlabelled node with the most non-arcs to or from the labelled members of
@@ -809,7 +864,9 @@ def min_cost_sized_step(
     sets are complete. A state whose ``sized_lower_bound`` reaches the incumbent is
     pruned; else the node of ``sized_branch_node`` is labelled S1, S2 or R (three
     children). A state without unlabelled nodes is a pair whose exact cost the bound
-    gives; a cheaper one becomes the incumbent.
+    gives; a cheaper one becomes the incumbent. Without a recorded tree (the checker
+    replays none of it), only maximal pairs are searched: a ``sized_crowded`` state is
+    pruned too (ER(50, 0.8), r = 20, below cap 3: 22M states, 18M with it).
 
     With ``record``, each expanded state appends a token (certificates/FORMAT.md,
     ``cost_search`` tree): its branch node, or -1 for a leaf; status NEED_ROOM when
@@ -845,6 +902,9 @@ def min_cost_sized_step(
         s1 = state[CS_S1]
         s2 = state[CS_S2]
         bound = sized_lower_bound(L1, L2, L0, s1, s2, inmask, mmask, need, state[CS_BEST], n)
+        if bound < state[CS_BEST] and not record and sized_crowded(L1, L2, L0, s1, s2,
+                                                                   inmask, mmask, need, n):
+            bound = n + 1
         A = full & ~(L1 | L2 | L0)
         if bound < state[CS_BEST] and A == ZERO:
             state[CS_BEST] = bound
