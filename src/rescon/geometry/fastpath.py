@@ -360,12 +360,7 @@ class _RayIndex:
             return []
         k, B = self.k, self.simple_rows
         K = np.stack([np.delete(B, j, axis=1) @ self.W for j in range(k)], axis=1)
-        lo = np.searchsorted(self.keys, K, side="left")
-        hi = np.searchsorted(self.keys, K, side="right")
-        own = self.simple[:, None]
-        first = self.owners[lo]
-        second = self.owners[np.minimum(lo + 1, len(self.owners) - 1)]
-        other = np.where(first != own, first, np.where(hi - lo >= 2, second, -1))
+        other = self._other_owner(K, self.simple[:, None])
         out = other.tolist()
         for s in np.flatnonzero((other < 0).any(axis=1)).tolist():  # none registered: scan
             vi = int(self.simple[s])
@@ -383,20 +378,36 @@ class _RayIndex:
         if not ray_v:
             return []
         _, rows = tight_pairs(ray_z)  # by ray, increasing: each ray's first k − 1
-        starts = np.concatenate([[0], np.cumsum([Z.bit_count() for Z in ray_z])[:-1]])
+        counts = np.array([Z.bit_count() for Z in ray_z], dtype=np.int64)
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         K = rows[starts[:, None] + np.arange(self.k - 1)] @ self.W
+        # Z of k − 1 rows is its key: every owner of the key holds Z
+        out = np.where(counts == self.k - 1,
+                       self._other_owner(K, np.asarray(ray_v, dtype=np.int64)), -1).tolist()
         lo = np.searchsorted(self.keys, K, side="left").tolist()
         hi = np.searchsorted(self.keys, K, side="right").tolist()
         owners, tight = self.owners.tolist(), self.tight
-        out = []
-        for v, Z, a, b in zip(ray_v, ray_z, lo, hi, strict=True):
-            u = next((u for u in owners[a:b] if u != v and tight[u] & Z == Z), None)
+        for i in (i for i, u in enumerate(out) if u < 0):
+            v, Z = ray_v[i], ray_z[i]
+            u = next((u for u in owners[lo[i]:hi[i]] if u != v and tight[u] & Z == Z), None)
             if u is None:
                 u = self._scan(v, Z)
                 if u is None:
                     return None
-            out.append(u)
+            out[i] = u
         return out
+
+    def _other_owner(self, K: np.ndarray, own: np.ndarray) -> np.ndarray:
+        """For each key of K, a vertex registered under it other than ``own`` (which
+        broadcasts against K), or −1 if there is none: the first of its run, else the
+        second."""
+        lo = np.searchsorted(self.keys, K, side="left")
+        hi = np.searchsorted(self.keys, K, side="right")
+        last = len(self.owners) - 1
+        first = self.owners[np.minimum(lo, last)]
+        second = self.owners[np.minimum(lo + 1, last)]
+        return np.where((hi > lo) & (first != own), first,
+                        np.where(hi - lo >= 2, second, -1))
 
     def _scan(self, vi: int, Z: int) -> int | None:
         """A vertex u ≠ vi with Z ⊆ tight[u] among those on Z's rarest row."""
@@ -543,38 +554,35 @@ def _meet(H, E: np.ndarray, R: np.ndarray, at: np.ndarray, k: int,
     points (with ``direction``: x_0 = 0 and y the null direction of the k − 1 normals).
 
     Take a group G of the rows whose hyperplanes share a set Q of k − |G| + 1 data
-    points (two rows through k − 1 common points; else G one row, Q its k points):
-    the points of Q are affinely independent, so flat(Q) (projective: its points at
-    infinity too) has dimension k − |G|, the dimension of ⋂_G H_h (independent rows),
-    and flat(Q) ⊆ ⋂_G H_h: they are equal and hold the answer. So x = Σ_{q ∈ Q} λ_q
-    (1, q) with M λ = 0 for the other rows, M_{hq} = e_h·(1, q) (brackets of k + 1
-    data points; 1 for the row at infinity): λ is the cross product of M
-    (:func:`.exact.cross_all`), nonzero as M has full rank (the rows, the one at
-    infinity included, are independent, so x spans their null space)."""
+    points (the largest such group; else G one row, Q its k points): the points of Q
+    are affinely independent, so flat(Q) (projective: its points at infinity too) has
+    dimension k − |G|, the dimension of ⋂_G H_h (independent rows), and flat(Q) ⊆
+    ⋂_G H_h: they are equal and hold the answer. So x = Σ_{q ∈ Q} λ_q (1, q) with
+    M λ = 0 for the other rows, M_{hq} = e_h·(1, q) (brackets of k + 1 data points; 1
+    for the row at infinity): λ is the cross product of M (:func:`.exact.cross_all`),
+    nonzero as M has full rank (the rows, the one at infinity included, are
+    independent, so x spans their null space). A larger group leaves a smaller M: two
+    rows through k − 1 common points leave a (k − 2) × (k − 1) one, three through
+    k − 2 a (k − 3) × (k − 2) one."""
     r = R.shape[1]
     pts = H.through[R]  # (P, r, k): the data points of each row
-    pairs = list(itertools.combinations(range(r), 2))
-    group = np.full(len(R), -1)
-    for g, (i, j) in enumerate(pairs):
-        common = (pts[:, i, :, None] == pts[:, j, None, :]).any(axis=2).sum(axis=1)
-        group[(group < 0) & (common == k - 1)] = g
+    # member[p, i, j, q]: point q of row i lies on row j too
+    member = (pts[:, :, None, :, None] == pts[:, None, :, None, :]).any(axis=4)
+    groups = [G for size in range(r, 1, -1) for G in itertools.combinations(range(r), size)]
+    choice = np.full(len(R), len(groups))  # len(groups): no group, one row and its k points
+    for g, G in enumerate(groups):
+        common = member[:, G[0], list(G)].all(axis=1).sum(axis=1)
+        choice[(choice == len(groups)) & (common == k - len(G) + 1)] = g
+    groups.append((0,))
     L = _object_rows([(1, *y) for y in H.Yi], k + 1)
     X = np.empty((len(R), k + 1), dtype=object)
     extra = np.full((len(R), int(direction)), len(E) - 1)  # the row at infinity
-    paired = group >= 0
-    if paired.any():
-        g = group[paired]
-        ij = np.array(pairs, dtype=np.int64)[g]
-        rest = np.array([[c for c in range(r) if c not in pair] for pair in pairs],
-                        dtype=np.int64).reshape(len(pairs), r - 2)[g]
-        first = pts[paired, ij[:, 0]]  # (P', k)
-        inside = (first[:, :, None] == pts[paired, ij[:, 1]][:, None, :]).any(axis=2)
-        Q = first[inside].reshape(-1, k - 1)
-        others = np.hstack([np.take_along_axis(at[paired], rest, axis=1), extra[paired]])
-        X[paired] = _through(E, L, others, Q)
-    if not paired.all():
-        X[~paired] = _through(E, L, np.hstack([at[~paired, 1:], extra[~paired]]),
-                              pts[~paired, 0])
+    for g in np.unique(choice).tolist():
+        G, these = groups[g], np.flatnonzero(choice == g)
+        first = pts[these, G[0]]  # (P', k): Q is made of its points on every row of G
+        Q = first[member[these, G[0]][:, list(G)].all(axis=1)].reshape(len(these), -1)
+        rest = [c for c in range(r) if c not in G]
+        X[these] = _through(E, L, np.hstack([at[these][:, rest], extra[these]]), Q)
     return X
 
 
