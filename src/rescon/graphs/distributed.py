@@ -55,9 +55,11 @@ assembled as in the claim above form a tree the checker accepts below cap s = b
 the root (its later size combinations) and the later roots, each searched by exactly one
 part, in the kernel's (and the checker's) order. A state is pruned only when its lower
 bound reaches the part's incumbent at that moment, the cost of a found pair or
-``upper``, hence ≥ b. A cheapest pair p is therefore found, or pruned below an
-incumbent ≤ cost(p): either way b ≤ min(upper, cost(p)); and b ≥ min(upper, s*), being
-``upper`` or a pair's cost. Each leaf of a sized tree is a state whose bound reached its
+``upper``, hence ≥ b, or when no maximal pair lies below it (``_kernels.crowded``,
+only where no tree is recorded; some cheapest pair is maximal). A cheapest maximal
+pair p is therefore found, or pruned below an incumbent ≤ cost(p): either way
+b ≤ min(upper, cost(p)); and b ≥ min(upper, s*), being ``upper`` or a pair's cost.
+Each leaf of a sized tree is a state whose bound reached its
 incumbent (≥ b), or a complete labelling whose bound is its pair's cost (≥ s* ≥ b); the
 checker's bound is at least the kernel's (which stops counting once it reaches the
 incumbent), so every leaf passes at cap b, and the subtrees, each complete, cover the
