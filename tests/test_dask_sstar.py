@@ -248,6 +248,22 @@ def test_a_deadline_stops_the_split_s_star_search_with_bounds_on_the_truth(clust
     assert out.status == "stopped" and out.floor <= 10 <= out.best
 
 
+@pytest.mark.slow
+def test_a_time_limited_max_s_on_the_cluster_gives_bounds_on_the_truth(cluster):
+    """The public API, 2 s for s*(16) = 10 on ER(40, 0.8) (13 s on the cluster): the
+    proven bounds in the error hold the truth, and the limit is kept."""
+    import re
+
+    G = nx.gnp_random_graph(40, 0.8, seed=40000, directed=True)
+    clear_cache()
+    t0 = time.perf_counter()
+    with pytest.raises(rescon.TimeLimitReached) as info:
+        rescon.max_s(G, 16, time_limit=2.0, scheduler=cluster)
+    assert time.perf_counter() - t0 < 5
+    low, high = map(int, re.search(r"(\d+) ≤ s\*\(16\) ≤ (\d+)", str(info.value)).groups())
+    assert low <= 10 <= high
+
+
 def test_a_search_that_ends_locally_starts_no_cluster():
     ig = index_graph(nx.gnp_random_graph(12, 0.8, seed=1, directed=True))
     with distributed.searches_on(workers=2):

@@ -112,8 +112,8 @@ __all__ = ["COST_TASK_NODES", "LOCAL_NODES", "TASK_NODES", "active", "finish_cos
 LOCAL_NODES = 500_000
 #: states one task expands before it returns the rest of its part (~0.3–0.5 s)
 TASK_NODES = 2_000_000
-#: states one s* task expands before it returns the rest of its part
-COST_TASK_NODES = 500_000
+#: states one s* task expands before it returns the rest of its part (~0.3 s: ER(40, 0.8))
+COST_TASK_NODES = 2_000_000
 #: frames of a stopped part that become parts of their own (the bottom, shallowest ones)
 SPLIT_SINGLES = 4
 #: seconds between checks of the deadline and ``should_stop`` while tasks run
