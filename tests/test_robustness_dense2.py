@@ -197,3 +197,50 @@ def test_pruned_searches_agree_with_the_dp_on_2000_digraphs():
     rng = random.Random(1)
     for _ in range(2000):
         _agree_with_the_dp(rng.randint(4, 11), rng.choice(DENSITIES), rng.randrange(10**6))
+
+
+def _robust_graph():
+    """A 12-node digraph and r = ρ ≥ 2 (r-robust, so the race proves it)."""
+    for seed in range(100):
+        ig = index_graph(nx.gnp_random_graph(12, 0.6, directed=True, seed=seed))
+        inmask = np.array(ig.in_masks(), dtype=np.uint64)
+        rho = max(r for r in range(0, 7) if r == 0 or K.min_pair_cost(inmask, r)[0] >= 1)
+        if rho >= 2:
+            return ig, rho
+    raise AssertionError("no 12-node digraph with ρ ≥ 2")
+
+
+def _no_cost_tree(*args, **kwargs):
+    raise AssertionError("the sized tree was recorded again from scratch")
+
+
+def test_race_resumes_its_sized_search_for_the_tree(monkeypatch):
+    """The decision search wins the race without a tree (its tree dropped): the race's
+    own sized search below s = 1 is resumed and its tree is the proof, valid for the
+    checker; _replayed does not record it again."""
+    from rescon import check_certificate
+    from rescon.graphs import robustness as rb
+
+    ig, r = _robust_graph()
+    monkeypatch.setattr(se, "MAX_TREE_TOKENS", 1)
+    monkeypatch.setattr(rb, "cost_tree", _no_cost_tree)
+    dec = rb._replayable(ig, r, rb._race(ig, r, None, None), None)
+    assert dec.holds and dec.proof["method"] == "cost_search" and dec.proof["tree"]
+    assert dec.proof["info"]["decided_by"] == "search"
+    cert = rb._check_result(ig, r, 1, dec, 0.0).certificate
+    assert check_certificate(cert).verdict == "valid"
+
+
+def test_race_keeps_an_overflowed_sized_search_from_replaying(monkeypatch):
+    """When the race's sized search dropped its tree, the proof stays the decision
+    search's (without a tree) and no sized tree is recorded from scratch."""
+    from functools import partial
+
+    from rescon.graphs import robustness as rb
+
+    ig, r = _robust_graph()
+    monkeypatch.setattr(se, "MAX_TREE_TOKENS", 1)
+    monkeypatch.setattr(rb, "SizedRun", partial(se.SizedRun, max_tokens=2))
+    monkeypatch.setattr(rb, "cost_tree", _no_cost_tree)
+    dec = rb._replayable(ig, r, rb._race(ig, r, None, None), None)
+    assert dec.holds and dec.proof["method"] == "search" and dec.proof["tree"] is None

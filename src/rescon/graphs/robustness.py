@@ -165,6 +165,7 @@ class _Decision:
     proof: Proof | None = None
     pair: bd.Pair | None = None
     method: str = "bounds"
+    replay_tried: bool = False  # the sized tree below s = 1 was tried already (_race)
 
 
 def _check_method_size(method: str, n: int) -> None:
@@ -253,7 +254,7 @@ def _decide_r(
 def _replayable(ig: IndexedGraph, r: int, dec: _Decision, deadline: float | None) -> _Decision:
     """``dec`` with its proof of r-robustness made replayable where that is cheap
     (:func:`_replayed`, s = 1); a refutation is kept. The answer never changes."""
-    if not dec.holds or dec.proof is None:
+    if not dec.holds or dec.proof is None or dec.replay_tried:
         return dec
     proof = _replayed(ig, r, 1, dec.proof, deadline)
     return dec if proof is dec.proof else replace(dec, proof=proof)
@@ -410,14 +411,38 @@ def _race(ig: IndexedGraph, r: int, deadline: float | None,
         raise
     if out.status != "stopped":
         milp.cancel()
-        return _search_decision(out)
+        return _resumed(ig, r, _search_decision(out), sized, deadline)
     if sized.finished:
         milp.cancel()
         return _sized_decision(ig, r, sized)
     if deadline is not None and time.perf_counter() > deadline:
         milp.cancel()
         return _Decision(None, method="search+milp")
-    return _milp_decision(ig, r, milp.outcome())
+    return _resumed(ig, r, _milp_decision(ig, r, milp.outcome()), sized, deadline)
+
+
+def _resumed(ig: IndexedGraph, r: int, dec: _Decision, sized: SizedRun,
+             deadline: float | None) -> _Decision:
+    """``dec`` from the decision search or the MILP, its proof of r-robustness made
+    replayable by the race's own sized search below s = 1 where that is cheap: the run is
+    resumed for up to ``TREE_SECONDS`` (its tree is the one search.cost_tree would
+    record from scratch), and its tree, if it fits, becomes the proof, as in
+    :func:`_replayed` (which is not tried again: a tree that overflowed in the race, or
+    did not end within the budget resumed, would not from scratch either)."""
+    if not dec.holds or dec.proof is None or dec.proof.get("tree") is not None:
+        return dec
+    if sized.recording and not sized.finished:
+        stop = time.perf_counter() + TREE_SECONDS
+        sized.run_for((stop if deadline is None else min(stop, deadline)) - time.perf_counter())
+    tree = sized.tree() if sized.finished else None
+    if tree is None:
+        return replace(dec, replay_tried=True)
+    if sized.pair() is not None:
+        raise RESCONError(f"internal error: {r}-robustness was proven, but the sized search "
+                          "found two disjoint closed sets")
+    proof = {"method": "cost_search", "order": sized.order.tolist(), "tree": list(tree),
+             "info": {**dec.proof.get("info", {}), "decided_by": dec.proof["method"]}}
+    return replace(dec, proof=proof, replay_tried=True)
 
 
 DENSE = 0.65  # arc density from which the sized searches are favoured
