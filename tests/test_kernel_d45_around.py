@@ -74,3 +74,43 @@ def test_relative_facets_are_the_faces_of_dimension_dim_minus_one(name, X, F, fa
             if len(m) < len(verts) and _exact_rank([verts[v] for v in m]) == dim - 1]
     assert want
     assert km._relative_facets(poly, incidence, sizes, dim) == want
+
+
+def _exact_matrix_rank(rows: list[list[int]]) -> int:
+    if not rows:
+        return 0
+    return len(rows[0]) - len(nullspace_exact([[Fraction(v) for v in r] for r in rows]))
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_rank_mod_p_bounds_the_exact_rank_and_equals_it_off_multiples_of_p(seed):
+    """The rank modulo p never exceeds the exact rank; it equals it when no minor is a
+    multiple of p — and a matrix whose full minors are all multiples of p has a
+    smaller rank modulo p than over the integers."""
+    from rescon.geometry.polytope import PRIME, _rank_mod
+
+    rng = np.random.default_rng(seed)
+    m, k = int(rng.integers(1, 7)), int(rng.integers(1, 6))
+    B = rng.integers(-3, 4, size=(m, k)).tolist()
+    rows = [[v * 2**int(rng.integers(0, 400)) + int(rng.integers(0, 2)) * PRIME * 3**200
+             for v in r] for r in B]
+    assert _rank_mod(rows, PRIME) <= _exact_matrix_rank(rows)
+    assert _rank_mod(B, PRIME) == _exact_matrix_rank(B)
+    scaled = [[PRIME * v for v in B[0]], *B[1:]]  # its first row ≡ 0 modulo p
+    assert _rank_mod(scaled, PRIME) == _exact_matrix_rank(B[1:])
+    assert _exact_matrix_rank(scaled) == _exact_matrix_rank(B)
+
+
+def test_dim_gets_the_exact_rank_when_it_drops_only_modulo_p():
+    """Vertices whose floats cannot certify their rank (offset 2^60: the differences
+    round away) and whose only full minor is p: the rank modulo p is 1, the
+    dimension is 2 (exact elimination decides); without the factor p the rank
+    modulo p already proves 2."""
+    from rescon.geometry.polytope import PRIME, ExactPolytope
+
+    M = 2**60
+    for step, want in ((PRIME, 2), (PRIME + 1, 2), (0, 1)):
+        P = ExactPolytope(2)
+        P.verts = [(1, M, M), (1, M + step, M), (1, M - 512, M + (step != 0))]
+        P.tight = [0, 0, 0]
+        assert P.dim() == want

@@ -410,18 +410,30 @@ def _scaled_floats(poly: ExactPolytope, scale: int) -> np.ndarray:
                     dtype=np.float64).reshape(len(poly.verts), poly.k)
 
 
-def _lex_order(V: np.ndarray, exact: Callable[[int], tuple[Fraction, ...]]) -> list[int]:
-    """The indices of the rows of V ordered as the exact points they round (``exact(i)``)
-    in lexicographic order: correct rounding is monotone (fl(s) < fl(t) implies
-    s < t), so the floats order all rows but those whose first coordinates round
-    alike, and only those runs are sorted exactly (by :func:`_lex_key`)."""
-    order = np.lexsort(V.T[::-1])
-    first = V[order, 0]
+def _lex_order(V: np.ndarray, exact: Callable[[int], tuple[Fraction, ...]],
+               rows: np.ndarray | None = None, col: int = 0) -> list[int]:
+    """The indices of the rows of V (those in ``rows``, by default all) ordered as the
+    exact points they round (``exact(i)``) in lexicographic order, V's columns before
+    ``col`` being equal on them: correct rounding is monotone (fl(s) < fl(t) implies
+    s < t), so the floats of column ``col`` order all rows but those that round alike
+    there. A run of those whose exact values are equal too (entries ±1 of directions
+    scaled by their largest |entry|) is ordered on the next column in the same way;
+    any other run is sorted exactly (by :func:`_lex_key`)."""
+    if rows is None:
+        rows = np.arange(len(V))
+    order = rows[np.argsort(V[rows, col], kind="stable")]
+    first = V[order, col]
     cuts = [0, *(np.flatnonzero(first[1:] != first[:-1]) + 1).tolist(), len(order)]
     out: list[int] = []
-    for lo, hi in zip(cuts[:-1], cuts[1:]):
-        run = order[lo:hi].tolist()
-        out += run if len(run) == 1 else sorted(run, key=lambda i: _lex_key(exact(i)))
+    for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
+        if hi - lo == 1:
+            out.append(int(order[lo]))
+            continue
+        run = {int(i): exact(int(i)) for i in order[lo:hi]}
+        if col + 1 < V.shape[1] and len({x[col] for x in run.values()}) == 1:
+            out += _lex_order(V, exact, order[lo:hi], col + 1)
+        else:
+            out += sorted(run, key=lambda i: _lex_key(run[i][col:]))
     return out
 
 

@@ -53,11 +53,11 @@ def tight_pairs(tight: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """(vertex, row) for every set bit of the bitsets ``tight``, ordered by vertex then
     row: the bitsets' bytes side by side, only the nonzero bytes unpacked."""
     width = max((max(tight, default=0).bit_length() + 7) // 8, 1)
-    buf = np.frombuffer(b"".join(t.to_bytes(width, "little") for t in tight),
-                        dtype=np.uint8).reshape(len(tight), width)
-    vi, byte = np.nonzero(buf)
-    pair, bit = np.nonzero(np.unpackbits(buf[vi, byte][:, None], axis=1, bitorder="little"))
-    return vi[pair], byte[pair] * 8 + bit
+    buf = np.frombuffer(b"".join(t.to_bytes(width, "little") for t in tight), dtype=np.uint8)
+    at = np.flatnonzero(buf)  # vertex · width + byte, increasing
+    bits = np.flatnonzero(np.unpackbits(buf[at], bitorder="little"))
+    at = at[bits >> 3]
+    return at // width, at % width * 8 + (bits & 7)
 
 
 def members_of(tight: list[int]) -> dict[int, list[int]]:
@@ -66,10 +66,11 @@ def members_of(tight: list[int]) -> dict[int, list[int]]:
     vs, hs = tight_pairs(tight)
     if not len(hs):
         return {}
-    order = np.argsort(hs, kind="stable")
-    hs, vs = hs[order], vs[order]
-    cuts = np.flatnonzero(hs[1:] != hs[:-1]) + 1
-    return dict(zip(hs[np.r_[0, cuts]].tolist(), (g.tolist() for g in np.split(vs, cuts)),
+    hs, vs = np.divmod(np.sort(hs * len(tight) + vs), len(tight))  # by row, then vertex
+    flat = vs.tolist()
+    ends = [*(np.flatnonzero(hs[1:] != hs[:-1]) + 1).tolist(), len(flat)]
+    starts = [0, *ends[:-1]]
+    return dict(zip(hs[starts].tolist(), (flat[a:b] for a, b in zip(starts, ends, strict=True)),
                     strict=True))
 
 
@@ -286,30 +287,73 @@ class ExactPolytope:
         return [tuple(Fraction(yi, v[0]) for yi in v[1:]) for v in self.verts]
 
     def dim(self) -> int:
-        """Affine dimension of the vertex set (−1 if empty): k when the smallest
-        singular value of the float differences exceeds a bound on their error and the
-        SVD's (σ moves by at most the perturbation's norm, so the exact rank is full
-        too), else exactly (Bareiss)."""
+        """Affine dimension of the vertex set (−1 if empty): k when full rank is
+        certified for the vertices extreme in some coordinate (at most 2k, whose affine
+        hull lies in that of all) or else for all of them — in floats
+        (:func:`_full_rank_floats`), then for the extreme ones modulo a prime (a minor
+        nonzero modulo p is nonzero: :func:`_rank_mod`) — else exactly (Bareiss)."""
         if not self.verts:
             return -1
         if len(self.verts) > self.k:
             V = self._float_array()
-            D = V[1:] - V[0]
-            # entries off by ≤ 4ε max|V| (+ underflow); the SVD's own error ≤ a few ε ‖D‖
-            # (margin 8); an inf or NaN anywhere fails the test
-            err = np.sqrt(D.size) * (_EPS * (4.0 * np.abs(V).max() + 8.0 * np.linalg.norm(D))
-                                     + underflow_floor(self.k, float(np.abs(V).max())))
-            if np.linalg.svd(D, compute_uv=False)[-1] > 2.0 * err:
+            few = np.unique(np.r_[V.argmin(axis=0), V.argmax(axis=0)]).tolist()
+            if len(few) <= self.k:
+                few = []
+            if (few and _full_rank_floats(V[few], self.k)) or _full_rank_floats(V, self.k):
                 return self.k
-        w0, *y0 = self.verts[0]
-        rows = [[yi * w0 - y0i * v[0] for yi, y0i in zip(v[1:], y0, strict=True)]
-                for v in self.verts[1:]]
+            if few and _rank_mod(self._differences(few), PRIME) == self.k:
+                return self.k
+        rows = self._differences(range(len(self.verts)))
         return bareiss_rank(rows)[0] if rows else 0
+
+    def _differences(self, ids) -> list[list[int]]:
+        """The integer rows w_0 w_i (x_i − x_0) = y_i w_0 − y_0 w_i for the vertices
+        ``ids`` after the first (0 here being ``ids[0]``)."""
+        ids = list(ids)
+        w0, *y0 = self.verts[ids[0]]
+        return [[yi * w0 - y0i * self.verts[i][0]
+                 for yi, y0i in zip(self.verts[i][1:], y0, strict=True)] for i in ids[1:]]
 
     def incidence(self) -> dict[int, list[int]]:
         """constraint → the vertices tight on it (only constraints tight somewhere):
         :func:`members_of`."""
         return members_of(self.tight)
+
+
+#: a prime below 2^31: a product of two residues fits an int64
+PRIME = 2_147_483_647
+
+
+def _full_rank_floats(V: np.ndarray, k: int) -> bool:
+    """The exact points that the float rows V round have affine rank k: the smallest
+    singular value of the float differences exceeds a bound on their error and the
+    SVD's (σ moves by at most the perturbation's norm, so the exact rank is full too).
+    The entries are off by ≤ 4ε max|V| (+ underflow), the SVD's own error ≤ a few ε ‖D‖
+    (margin 8); an inf or NaN anywhere fails the test."""
+    D = V[1:] - V[0]
+    top = float(np.abs(V).max())
+    err = np.sqrt(D.size) * (_EPS * (4.0 * top + 8.0 * np.linalg.norm(D))
+                             + underflow_floor(k, top))
+    return bool(np.linalg.svd(D, compute_uv=False)[-1] > 2.0 * err)
+
+
+def _rank_mod(rows: list[list[int]], p: int) -> int:
+    """The rank of an integer matrix modulo the prime p < 2^31 (Gaussian elimination on
+    int64 residues: products of two stay below 2^62). It is at most the rank over the
+    integers, as every minor nonzero modulo p is nonzero."""
+    M = np.array([[v % p for v in row] for row in rows], dtype=np.int64).reshape(len(rows), -1)
+    rank = 0
+    for c in range(M.shape[1]):
+        nz = np.flatnonzero(M[rank:, c])
+        if not len(nz):
+            continue
+        M[[rank, rank + nz[0]]] = M[[rank + nz[0], rank]]
+        M[rank] = M[rank] * pow(int(M[rank, c]), p - 2, p) % p
+        M[rank + 1:] = (M[rank + 1:] - M[rank + 1:, c, None] * M[rank]) % p
+        rank += 1
+        if rank == len(M):
+            break
+    return rank
 
 
 def clip_to_fixpoint(P: ExactPolytope, H, scale: int, first: np.ndarray | None = None
