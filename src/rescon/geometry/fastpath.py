@@ -115,7 +115,11 @@ def _propose(H, sel: np.ndarray, options: str | None = None
         return None
     if not np.isfinite(hs.intersections).all():
         return None
-    return o + s * hs.intersections, [[int(rows[i]) for i in f] for f in hs.dual_facets]
+    facets = hs.dual_facets  # lists of ints, positions in rows
+    if len(rows) < len(sel):  # the local pass left rows out: positions in sel
+        kept = rows.tolist()
+        facets = [[kept[i] for i in f] for f in facets]
+    return o + s * hs.intersections, facets
 
 
 def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope | None:
