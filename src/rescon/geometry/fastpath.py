@@ -512,13 +512,10 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
         X[sure] = _meet(H, E, B[sure], at[sure], k)
     if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
         X[~sure] = cross_all(E[at[~sure]])
-    met = np.flatnonzero(X[:, 0] != 0)
-    if len(met):  # primitive, x_0 > 0: divided by ±gcd, all rows at once
-        X = X[met]
-        g = np.gcd.reduce(X, axis=1)
-        for p, row in zip(met.tolist(), (X // np.where(X[:, 0] > 0, g, -g)[:, None]).tolist(),
-                          strict=True):
-            out[p] = tuple(row)
+    for p, row in enumerate(X.tolist()):
+        if row[0] != 0:
+            g = gcd(*row) if row[0] > 0 else -gcd(*row)
+            out[p] = tuple(v // g for v in row)
     return out
 
 
@@ -558,35 +555,38 @@ def _meet(H, E: np.ndarray, R: np.ndarray, at: np.ndarray, k: int,
     points (with ``direction``: x_0 = 0 and y the null direction of the k − 1 normals).
 
     Take a group G of the rows whose hyperplanes share a set Q of k − |G| + 1 data
-    points (the largest such group; else G one row, Q its k points): the points of Q
-    are affinely independent, so flat(Q) (projective: its points at infinity too) has
-    dimension k − |G|, the dimension of ⋂_G H_h (independent rows), and flat(Q) ⊆
-    ⋂_G H_h: they are equal and hold the answer. So x = Σ_{q ∈ Q} λ_q (1, q) with
-    M λ = 0 for the other rows, M_{hq} = e_h·(1, q) (brackets of k + 1 data points; 1
-    for the row at infinity): λ is the cross product of M (:func:`.exact.cross_all`),
-    nonzero as M has full rank (the rows, the one at infinity included, are
-    independent, so x spans their null space). A larger group leaves a smaller M: two
-    rows through k − 1 common points leave a (k − 2) × (k − 1) one, three through
-    k − 2 a (k − 3) × (k − 2) one."""
+    points (two rows through k − 1 common points; else G one row, Q its k points):
+    the points of Q are affinely independent, so flat(Q) (projective: its points at
+    infinity too) has dimension k − |G|, the dimension of ⋂_G H_h (independent rows),
+    and flat(Q) ⊆ ⋂_G H_h: they are equal and hold the answer. So x = Σ_{q ∈ Q} λ_q
+    (1, q) with M λ = 0 for the other rows, M_{hq} = e_h·(1, q) (brackets of k + 1
+    data points; 1 for the row at infinity): λ is the cross product of M
+    (:func:`.exact.cross_all`), nonzero as M has full rank (the rows, the one at
+    infinity included, are independent, so x spans their null space)."""
     r = R.shape[1]
     pts = H.through[R]  # (P, r, k): the data points of each row
-    # member[p, i, j, q]: point q of row i lies on row j too
-    member = (pts[:, :, None, :, None] == pts[:, None, :, None, :]).any(axis=4)
-    groups = [G for size in range(r, 1, -1) for G in itertools.combinations(range(r), size)]
-    choice = np.full(len(R), len(groups))  # len(groups): no group, one row and its k points
-    for g, G in enumerate(groups):
-        common = member[:, G[0], list(G)].all(axis=1).sum(axis=1)
-        choice[(choice == len(groups)) & (common == k - len(G) + 1)] = g
-    groups.append((0,))
+    pairs = list(itertools.combinations(range(r), 2))
+    group = np.full(len(R), -1)
+    for g, (i, j) in enumerate(pairs):
+        common = (pts[:, i, :, None] == pts[:, j, None, :]).any(axis=2).sum(axis=1)
+        group[(group < 0) & (common == k - 1)] = g
     L = _object_rows([(1, *y) for y in H.Yi], k + 1)
     X = np.empty((len(R), k + 1), dtype=object)
     extra = np.full((len(R), int(direction)), len(E) - 1)  # the row at infinity
-    for g in np.unique(choice).tolist():
-        G, these = groups[g], np.flatnonzero(choice == g)
-        first = pts[these, G[0]]  # (P', k): Q is made of its points on every row of G
-        Q = first[member[these, G[0]][:, list(G)].all(axis=1)].reshape(len(these), -1)
-        rest = [c for c in range(r) if c not in G]
-        X[these] = _through(E, L, np.hstack([at[these][:, rest], extra[these]]), Q)
+    paired = group >= 0
+    if paired.any():
+        g = group[paired]
+        ij = np.array(pairs, dtype=np.int64)[g]
+        rest = np.array([[c for c in range(r) if c not in pair] for pair in pairs],
+                        dtype=np.int64).reshape(len(pairs), r - 2)[g]
+        first = pts[paired, ij[:, 0]]  # (P', k)
+        inside = (first[:, :, None] == pts[paired, ij[:, 1]][:, None, :]).any(axis=2)
+        Q = first[inside].reshape(-1, k - 1)
+        others = np.hstack([np.take_along_axis(at[paired], rest, axis=1), extra[paired]])
+        X[paired] = _through(E, L, others, Q)
+    if not paired.all():
+        X[~paired] = _through(E, L, np.hstack([at[~paired, 1:], extra[~paired]]),
+                              pts[~paired, 0])
     return X
 
 
