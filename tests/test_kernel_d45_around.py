@@ -114,3 +114,35 @@ def test_dim_gets_the_exact_rank_when_it_drops_only_modulo_p():
         P.verts = [(1, M, M), (1, M + step, M), (1, M - 512, M + (step != 0))]
         P.tight = [0, 0, 0]
         assert P.dim() == want
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_selection_partitions_at_the_median_with_ties(seed):
+    from rescon.geometry._candidates import _select
+
+    rng = np.random.default_rng(seed)
+    key = np.round(rng.normal(size=200) * (1 + 3 * (seed % 2)))  # many ties
+    order = rng.permutation(200)
+    lo, hi = int(rng.integers(0, 50)), int(rng.integers(150, 201))
+    mid = int(rng.integers(lo, hi))
+    before = order.copy()
+    _select(key, order, lo, hi, mid)
+    assert sorted(order[lo:hi].tolist()) == sorted(before[lo:hi].tolist())
+    assert np.array_equal(order[:lo], before[:lo]) and np.array_equal(order[hi:], before[hi:])
+    assert key[order[mid]] == np.sort(key[before[lo:hi]])[mid - lo]
+    assert key[order[lo:mid]].max(initial=-np.inf) <= key[order[mid]]
+    assert key[order[mid:hi]].min() >= key[order[mid]]
+
+
+@pytest.mark.parametrize("n,k,leaf", [(1, 4, 32), (33, 5, 32), (3000, 4, 32), (500, 5, 8)])
+def test_ball_chunks_are_small_and_cover_their_points_with_repeats(n, k, leaf):
+    from rescon.geometry._candidates import ball_chunks
+
+    V = np.round(np.random.default_rng(n).normal(size=(n, k)), 1)  # repeated coordinates
+    V[: n // 3] = V[0]  # a third of the points equal
+    order, starts, centres, radii = ball_chunks(V, leaf)
+    assert sorted(order.tolist()) == list(range(n))
+    assert np.all(np.diff(starts) >= 1) and np.all(np.diff(starts) <= leaf)
+    for c in range(len(starts) - 1):
+        P = V[order[starts[c]:starts[c + 1]]]
+        assert np.linalg.norm(P - centres[c], axis=1).max() <= radii[c] * (1 + 1e-12)

@@ -460,28 +460,79 @@ def sweep_pairs_2d(Y, W, subsets):
 def ball_chunks(V: np.ndarray, leaf: int = 32
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The rows of V grouped into chunks of ≤ ``leaf`` nearby points (a k-d split at the
-    median of the widest coordinate): (order, starts, centres, radii) — chunk c is
-    V[order[starts[c]:starts[c+1]]], within ``radii[c]`` (the float max of ‖v − centre‖,
-    a few ulps from the exact one) of ``centres[c]`` (its mean)."""
+    median of the widest coordinate, :func:`_kd_split`): (order, starts, centres,
+    radii) — chunk c is V[order[starts[c]:starts[c+1]]], within ``radii[c]`` (the
+    float max of ‖v − centre‖, a few ulps from the exact one) of ``centres[c]`` (its
+    mean)."""
     order = np.arange(len(V))
-    todo, cuts = [(0, len(V))], []
-    while todo:
-        lo, hi = todo.pop()
-        if hi - lo <= leaf:
-            cuts.append(lo)
-            continue
-        P = V[order[lo:hi]]
-        j = int(np.argmax(P.max(axis=0) - P.min(axis=0)))
-        mid = (hi - lo) // 2
-        order[lo:hi] = order[lo:hi][np.argpartition(P[:, j], mid)]
-        todo += [(lo, lo + mid), (lo + mid, hi)]
-    starts = np.array(sorted(cuts) + [len(V)], dtype=np.int64)
+    cuts = np.empty(len(V) + 1, dtype=np.int64)
+    count = _kd_split(np.ascontiguousarray(V, dtype=np.float64), leaf, order, cuts)
+    starts = np.append(np.sort(cuts[:count]), len(V))
     W = V[order]
     counts = np.diff(starts)
     centres = np.add.reduceat(W, starts[:-1], axis=0) / counts[:, None]
     gap = ((W - np.repeat(centres, counts, axis=0)) ** 2).sum(axis=1)
     radii = np.sqrt(np.maximum.reduceat(gap, starts[:-1]))
     return order, starts, centres, radii
+
+
+@njit(cache=True)
+def _kd_split(V, leaf, order, cuts):
+    """Reorder ``order`` (in place) so that runs of ≤ ``leaf`` rows of V are the leaves
+    of a k-d tree — each node's rows split in halves at the median of their widest
+    coordinate — and write the leaves' starts into ``cuts``; returns their number."""
+    n, k = V.shape
+    if n == 0:
+        return 0
+    stack = np.empty((128, 2), dtype=np.int64)  # depth-first: ≤ 2 log2(n) pending nodes
+    stack[0, 0], stack[0, 1] = 0, n
+    top, count = 1, 0
+    while top > 0:
+        top -= 1
+        lo, hi = stack[top, 0], stack[top, 1]
+        if hi - lo <= leaf:
+            cuts[count] = lo
+            count += 1
+            continue
+        widest, span = 0, -1.0
+        for j in range(k):
+            small, large = np.inf, -np.inf
+            for t in range(lo, hi):
+                v = V[order[t], j]
+                small = min(small, v)
+                large = max(large, v)
+            if large - small > span:
+                widest, span = j, large - small
+        mid = lo + (hi - lo) // 2
+        _select(V[:, widest], order, lo, hi, mid)
+        stack[top, 0], stack[top, 1] = lo, mid
+        stack[top + 1, 0], stack[top + 1, 1] = mid, hi
+        top += 2
+    return count
+
+
+@njit(cache=True, nogil=True)
+def _select(key, order, lo, hi, mid):
+    """Permute order[lo:hi] so that key[order[mid]] is the value of rank mid − lo among
+    them, none after it smaller and none before it larger (Hoare's selection)."""
+    while hi - lo > 1:
+        pivot = key[order[(lo + hi) // 2]]
+        i, j = lo, hi - 1
+        while i <= j:
+            while key[order[i]] < pivot:
+                i += 1
+            while key[order[j]] > pivot:
+                j -= 1
+            if i <= j:
+                order[i], order[j] = order[j], order[i]
+                i += 1
+                j -= 1
+        if mid <= j:
+            hi = j + 1
+        elif mid >= i:
+            lo = i
+        else:
+            return
 
 
 @njit(cache=True, nogil=True, inline="always")
