@@ -48,12 +48,24 @@ from rescon.graphs.indexed import index_graph
 from rescon.graphs.robustness import _deepening_search, _descended_upper
 from rescon.graphs.search import _kernel_inputs, min_cost_pair, whole_cost_part
 
-INSTANCES = ("40:0.8:40000:16",)
+INSTANCES = ("40:0.8:40001:16", "50:0.8:50001:21", "60:0.9:60000:28")
 
-#: the scan that chose the instances (--scan; load in the note): (n, p, seed, r, s*(r) or
-#: the bounds when stopped, search states, seconds)
-SCAN: tuple[tuple[int, float, int, int, str, int, float], ...] = ()
-SCAN_NOTE = ""
+#: the scan that chose the instances (--scan, 130 s per search; ρ from rescon.robustness):
+#: (n, p, seed, r, s*(r) or the bounds when stopped, search states, seconds)
+SCAN = (
+    (40, 0.8, 40000, 16, "s* = 10", 26_021_420, 4.11),
+    (40, 0.8, 40001, 16, "s* = 8", 104_165_086, 12.78),
+    (50, 0.8, 50000, 20, "stopped: 4 ≤ s* ≤ 8", 477_030_300, 130.0),
+    (50, 0.8, 50001, 21, "s* = 1", 259_477_843, 53.37),
+    (60, 0.8, 60000, 24, "stopped: 5 ≤ s* ≤ 15", 331_776_761, 130.0),
+    (60, 0.8, 60000, 25, "stopped: 2 ≤ s* ≤ 6", 408_936_848, 130.0),
+    (60, 0.9, 60000, 27, "stopped: 10 ≤ s* ≤ 15", 510_765_428, 130.0),
+    (60, 0.9, 60000, 28, "s* = 3", 146_114_235, 51.13),
+)
+SCAN_NOTE = ("load 3.6-5.4 from other jobs; ρ = 17, 21, 20, 25, 28 for ER(40, 0.8) seed "
+             "40001, ER(50, 0.8) seeds 50001 and 50000, ER(60, 0.8) and ER(60, 0.9) seed "
+             "60000; at n = 60, p = 0.8 no r tried finished within 130 s, so the n = 60 "
+             "instance has p = 0.9")
 
 
 def _graph(spec: str) -> tuple[str, nx.DiGraph, int]:
