@@ -160,7 +160,8 @@ class SafeKernel:
     def __getstate__(self) -> dict[str, Any]:
         """Pickled with its certificate built (the builder is a closure): a kernel
         computed on a Dask worker travels whole."""
-        self._exact.vertices  # noqa: B018 -- built now: the builders are closures
+        for name in ("vertices", "constraints", "facets"):  # built now: the builders are
+            getattr(self._exact, name)  # closures
         self.exact_vertices  # noqa: B018
         return {**self.__dict__, "_make_certificate": _Given(self.certificate)}
 
@@ -207,6 +208,8 @@ class SafeKernel:
 
 
 _Exact.vertices = _Lazy("vertices")  # type: ignore[assignment]
+_Exact.constraints = _Lazy("constraints")  # type: ignore[assignment]
+_Exact.facets = _Lazy("facets")  # type: ignore[assignment]
 SafeKernel.exact_vertices = _Lazy("exact_vertices")  # type: ignore[assignment]
 
 
@@ -327,7 +330,7 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         point = P.fraction(0)
         verts = _Deferred(lambda: (point,))
         order: list[int] = []
-        constraints: tuple = ()
+        constraints: tuple | _Deferred = ()
         V = np.array([[float(v) for v in point]])
     else:
         poly = _clip(P, hull, F)
@@ -337,10 +340,8 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         # one constraint per halfspace: the fast path keeps every row (through other
         # data points) that states the same primitive (a, b)
         first = {(tuple(poly.a[h]), poly.b[h]): h for h in sorted(incidence, reverse=True)}
-        ambient = {h: _ambient(hull, d, poly.a[h], poly.b[h], P.scale)
-                   for h in sorted(first.values())}
-        incidence = {h: incidence[h] for h in ambient}
-        constraints = tuple(ambient.values())
+        incidence = {h: incidence[h] for h in sorted(first.values())}
+        constraints = _ambient_rows(poly, hull, list(incidence), P.scale, d)
     if not len(V):
         exact = _Exact((), constraints, eqs)
         return SafeKernel(Xa, F, -1, np.zeros((0, d)), np.zeros((0, d)), np.zeros(0), None,
@@ -351,25 +352,27 @@ def safe_kernel(X: Any, F: Any) -> SafeKernel:
         dim, origin, basis, Aeq, beq, kernel_eqs = _full_affine(V[0].copy(), d)
     else:
         dim, origin, basis, Aeq, beq, kernel_eqs = _affine_of(verts.get(), d, False)
-    facets: list = []
-    A, b = _unit_rows(facets, d)
+    facets: tuple | _Deferred = ()
+    A, b = _unit_rows([], d)
     if poly is not None:
         ids, D, tops = _facet_order(poly, hull, _relative_facets(poly, incidence, sizes, dim), d)
-        facets = [ambient[h] for h in ids]
-        constraints = _needed_rows(poly, incidence, ambient, facets)
+        facets = _ambient_rows(poly, hull, ids, P.scale, d)
+        constraints = _ambient_rows(poly, hull, _needed_rows(poly, incidence, ids),
+                                    P.scale, d)
         if kernel_eqs:
-            A, b = _unit_rows(_along_hull(facets, kernel_eqs, verts.get()[0]), d)
+            A, b = _unit_rows(_along_hull(list(facets.get()), kernel_eqs, verts.get()[0]), d)
         elif ids:
             A, b = _normalised(D, [(poly.b[h], P.scale * top) for h, top in zip(ids, tops)],
                                "a facet")
-    exact = _Exact(verts, constraints, eqs, tuple(facets), kernel_eqs)
+    exact = _Exact(verts, constraints, eqs, facets, kernel_eqs)
 
     def certificate() -> dict[str, Any]:
         return {"rescon_certificate": 1, "kind": "safe_kernel", "points": Xa.tolist(),
                 "F": F, "dim": dim,
                 "vertices": [[fraction_str(v) for v in x] for x in verts.get()],
-                "equalities": halfspaces_json(eqs), "facets": halfspaces_json(constraints),
-                "adjacency": _adjacency(poly, order, verts.get(), constraints),
+                "equalities": halfspaces_json(eqs),
+                "facets": halfspaces_json(exact.constraints),
+                "adjacency": _adjacency(poly, order, verts.get(), exact.constraints),
                 "proof": {"method": "halfspaces"}}
 
     return SafeKernel(Xa, F, dim, V, A, b, origin, basis, Aeq, beq,
@@ -635,16 +638,22 @@ def _scattered(a: tuple[int, ...], coords: tuple[int, ...], d: int) -> tuple[int
     return tuple(full)
 
 
-def _needed_rows(poly: ExactPolytope, incidence: dict, ambient: dict, facets: list) -> tuple:
+def _needed_rows(poly: ExactPolytope, incidence: dict, facets: list[int]) -> list[int]:
     """The constraints that state Ψ: those tight at every vertex (they cut out aff Ψ
-    within aff X) and the relative facets. A polytope is the intersection of its
+    within aff X) and the relative ``facets``. A polytope is the intersection of its
     facets within its affine hull, and each vertex is the meet of the facets through
     it, so the rows tight only on smaller faces (the fast path's extra supporting
     planes at degenerate vertices) are redundant — the certificate leaves them out."""
     nv = len(poly.verts)
-    implicit = [ambient[h] for h, members in sorted(incidence.items())
-                if len(members) == nv]
-    return tuple(implicit + facets)
+    return [h for h, members in sorted(incidence.items()) if len(members) == nv] + facets
+
+
+def _ambient_rows(poly: ExactPolytope, hull: AffineHull, hs: list[int], scale: int, d: int
+                  ) -> _Deferred:
+    """The rows ``hs`` of ``poly`` as ambient halfspaces (Fractions, :func:`_ambient`),
+    built on first read (most callers read only the float rows A, b)."""
+    return _Deferred(lambda: tuple(_ambient(hull, d, poly.a[h], poly.b[h], scale)
+                                   for h in hs))
 
 
 def _empty_certificate(Xa, F, hull, poly, scale, d) -> dict[str, Any]:
