@@ -596,12 +596,17 @@ def _through(E: np.ndarray, L: np.ndarray, others: np.ndarray, Q: np.ndarray) ->
     Lq = L[Q]  # (P, r + 1, k + 1)
     if others.shape[1] == 0:
         return Lq[:, 0]
-    # M (P, r, r + 1): each bracket once (neighbouring vertices share most of them)
+    # M (P, r, r + 1): each bracket once (neighbouring vertices share most of them),
+    # e_h·(1, q) = e_h0 + Σ_j e_hj q_j
     pairs, where = np.unique(others[:, :, None] * len(L) + Q[:, None, :],
                              return_inverse=True)
-    brackets = (E[pairs // len(L)] * L[pairs % len(L)]).sum(axis=1)
+    Eh, Lp = E[pairs // len(L)], L[pairs % len(L)]
+    brackets = Eh[:, 0] + (Eh[:, 1:] * Lp[:, 1:]).sum(axis=1)
     lam = cross_all(brackets[where].reshape(*others.shape, Q.shape[1]))
-    return (lam[:, :, None] * Lq).sum(axis=1)
+    x = np.empty((len(Q), L.shape[1]), dtype=object)  # Σ_q λ_q (1, q)
+    x[:, 0] = lam.sum(axis=1)
+    x[:, 1:] = np.matmul(lam[:, None, :], Lq[:, :, 1:])[:, 0]
+    return x
 
 
 def _object_rows(rows: list[tuple[int, ...]], width: int) -> np.ndarray:
@@ -624,15 +629,10 @@ def _simplicial_rays(H, S_set: list[int], normals: list[tuple[int, ...]],
     S = np.asarray(S_set, dtype=np.int64)
     E = _homogeneous(H, S[used].tolist(), k)
     D = _meet(H, E, S[used][at.reshape(len(rows), k - 1)], at.reshape(len(rows), k - 1), k,
-              direction=True)[:, 1:].tolist()
-    out = []
-    for p, B in enumerate(bases):
-        rays = []
-        for j, h in enumerate(B):
-            d = D[p * k + j]
-            rays.append(tuple(-v for v in d) if _dot(normals[h], d) > 0 else tuple(d))
-        out.append(rays)
-    return out
+              direction=True)[:, 1:]
+    up = (_object_rows([normals[h] for B in bases for h in B], k) * D).sum(axis=1) > 0
+    D = list(map(tuple, np.where(up[:, None], -D, D).tolist()))
+    return [D[p:p + k] for p in range(0, len(D), k)]
 
 
 def _tangent_rays(normals: list[tuple[int, ...]], basis: list[int], T: list[int], k: int,
