@@ -146,3 +146,44 @@ def test_ball_chunks_are_small_and_cover_their_points_with_repeats(n, k, leaf):
     for c in range(len(starts) - 1):
         P = V[order[starts[c]:starts[c + 1]]]
         assert np.linalg.norm(P - centres[c], axis=1).max() <= radii[c] * (1 + 1e-12)
+
+
+def _hostile(kind: str, d: int, n: int) -> np.ndarray:
+    Z = _gaussian(d, n, 5)
+    return {
+        "tiny": lambda: Z * 1e-300,
+        "huge": lambda: Z * 1e300,
+        "mixed": lambda: Z * 10.0 ** np.random.default_rng(n).integers(-300, 300, size=(n, 1)),
+        "converged": lambda: 1.0 + 1e-15 * np.round(4 * Z),
+        "duplicated": lambda: np.vstack([Z[: n - 4], Z[:4]]),
+        "integer": lambda: np.round(3 * Z),
+        "flat": lambda: np.column_stack([np.round(3 * Z[:, :-1]), np.zeros(n)]),
+        "simplex": lambda: Z[: d + 1],
+        "cell24": lambda: _cell24(4) * 3.0 + 1.0,
+    }[kind]()
+
+
+HOSTILE = [("tiny", 4, 20, 2), ("huge", 4, 20, 2), ("mixed", 4, 18, 1), ("converged", 4, 20, 2),
+           ("duplicated", 4, 22, 2), ("integer", 4, 20, 2), ("flat", 4, 24, 2),
+           ("simplex", 4, 5, 0), ("cell24", 4, 28, 4), ("tiny", 5, 12, 1),
+           ("converged", 5, 12, 1), ("integer", 5, 13, 1)]
+
+
+@pytest.mark.parametrize("kind,d,n,F", HOSTILE, ids=[f"{h[0]}-{h[1]}" for h in HOSTILE])
+def test_kernels_identical_to_the_exact_clipping_on_hostile_data(kind, d, n, F, monkeypatch):
+    """Every output — floats bit for bit, exact vertices and rows, certificate — equals
+    the exact clipping's (fast path off) at extreme magnitudes, converged and repeated
+    points, integers, flat data, n = d + 1 and the 24-cell's non-simple vertices."""
+    import rescon
+
+    X = _hostile(kind, d, n)
+    fast = rescon.safe_kernel(X, F)
+    monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
+    slow = rescon.safe_kernel(X, F)
+    assert fast.dim == slow.dim
+    for name in ("vertices", "A", "b", "Aeq", "beq", "affine_basis"):
+        assert getattr(fast, name).tobytes() == getattr(slow, name).tobytes(), name
+    assert fast.exact_vertices == slow.exact_vertices
+    assert fast._exact.constraints == slow._exact.constraints
+    assert fast._exact.facets == slow._exact.facets
+    assert fast.certificate == slow.certificate
