@@ -164,3 +164,24 @@ def test_very_non_simple_kernels_are_bit_identical_to_exact_clipping(X, F, fast,
             and any(t.bit_count() > made[0].k for t in made[0].tight)) == fast
     monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
     assert _public(got) == _public(rescon.safe_kernel(X, F))
+
+
+def test_cross_all_is_the_signed_maximal_minors():
+    """x_j = (−1)^j det R_{−j} for m × (m + 1) integer matrices, m = 1..5, against
+    Bareiss determinants (entries of 80 bits and a dependent pair of rows: x = 0)."""
+    from rescon.geometry.exact import cross_all
+    from rescon.geometry.halfspaces import _int_det
+
+    rng = random.Random(3)
+    for m in range(1, 6):
+        mats = [[[rng.randint(-2**80, 2**80) for _ in range(m + 1)] for _ in range(m)]
+                for _ in range(30)]
+        if m >= 2:
+            mats.append([mats[0][0], [3 * v for v in mats[0][0]], *mats[0][2:]])
+        R = np.empty((len(mats), m, m + 1), dtype=object)
+        R[:] = mats
+        want = [[(-1) ** j * _int_det([row[:j] + row[j + 1:] for row in M])
+                 for j in range(m + 1)] for M in mats]
+        assert cross_all(R).tolist() == want
+        if m >= 2:
+            assert want[-1] == [0] * (m + 1)

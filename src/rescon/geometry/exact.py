@@ -276,12 +276,15 @@ def cross_all(R: np.ndarray) -> np.ndarray:
     for r in range(1, m):
         nxt = {}
         for cols in itertools.combinations(range(m + 1), r + 1):
-            acc = 0
-            for i, c in enumerate(cols):
-                term = R[:, r, c] * minors[cols[:i] + cols[i + 1:]]
-                acc = acc + term if (r + i) % 2 == 0 else acc - term
+            # Σ_i (−1)^(r+i) R[r, c_i] · minor(cols − c_i), from a term with sign +
+            terms = [R[:, r, c] * minors[cols[:i] + cols[i + 1:]] for i, c in enumerate(cols)]
+            acc = terms[r % 2]
+            for i in range(r % 2 + 1, len(terms)):
+                acc = acc + terms[i] if (r + i) % 2 == 0 else acc - terms[i]
+            if r % 2:
+                acc = acc - terms[0]
             nxt[cols] = acc
         minors = nxt
     full = tuple(range(m + 1))
-    return np.stack([minors[full[:j] + full[j + 1:]] * (-1) ** j for j in range(m + 1)],
-                    axis=1)
+    out = [minors[full[:j] + full[j + 1:]] for j in range(m + 1)]
+    return np.stack([-x if j % 2 else x for j, x in enumerate(out)], axis=1)
