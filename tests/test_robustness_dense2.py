@@ -244,3 +244,30 @@ def test_race_keeps_an_overflowed_sized_search_from_replaying(monkeypatch):
     monkeypatch.setattr(rb, "cost_tree", _no_cost_tree)
     dec = rb._replayable(ig, r, rb._race(ig, r, None, None), None)
     assert dec.holds and dec.proof["method"] == "search" and dec.proof["tree"] is None
+
+
+def test_witness_walks_get_their_budget_after_compiling(monkeypatch):
+    """A first walk that takes longer than the walks' budget (a cold process compiles
+    pair_walk: ~3 s) does not spend it: ER(50, 0.8), seed 50000, r = 21, whose witness
+    the walks find from their second draw on, is still refuted by _walked_witness."""
+    import time as _time
+
+    from rescon.graphs import robustness as rb
+
+    walk = K.pair_walk
+    calls = []
+
+    def slow_first(*args):
+        if not calls:
+            _time.sleep(1.2 * rb.WITNESS_SECONDS)
+        calls.append(1)
+        return walk(*args)
+
+    ig = index_graph(nx.gnp_random_graph(50, 0.8, directed=True, seed=50000))
+    monkeypatch.setattr(K, "pair_walk", slow_first)
+    bd.compiled_walk.cache_clear()
+    try:
+        pair = rb._walked_witness(ig, 21, None)
+    finally:
+        bd.compiled_walk.cache_clear()
+    assert pair is not None and bd.pair_cost(ig, pair, 21) == 0

@@ -35,6 +35,7 @@ __all__ = [
     "descend_pair",
     "descended_pairs",
     "tabu_pairs",
+    "compiled_walk",
     "violates",
     "upper_witness",
     "source_components_witness",
@@ -285,8 +286,7 @@ def tabu_pairs(ig: IndexedGraph, r: int, *, floor: int = 0, below: int | None = 
     pair. Every returned pair's cost bounds s*(r) from above."""
     if deadline is None and draws is None:
         raise ValueError("tabu_pairs needs a deadline or a number of draws")
-    from ._kernels import pair_walk  # numba: imported on first use
-
+    pair_walk = compiled_walk()
     rng = random.Random(seed)
     out = _out_lists(ig)
     outptr = np.cumsum([0] + [len(o) for o in out], dtype=np.int64)
@@ -306,6 +306,20 @@ def tabu_pairs(ig: IndexedGraph, r: int, *, floor: int = 0, below: int | None = 
             found.append(Pair(frozenset(np.flatnonzero(lab == 1).tolist()),
                               frozenset(np.flatnonzero(lab == 2).tolist())))
     return found
+
+
+@lru_cache(maxsize=1)
+def compiled_walk() -> Any:
+    """``_kernels.pair_walk``, compiled (or loaded from numba's cache) by one walk on a
+    2-node graph: a caller that gives the walks a time budget calls this before its clock
+    starts, so the first walk of a process does not spend the budget compiling (a cold
+    process: ~3 s, over the 1 s the ρ race's witness walks get)."""
+    from ._kernels import pair_walk  # numba: imported on first use
+
+    one = np.ones(2, dtype=np.int64)
+    pair_walk(one, np.arange(3, dtype=np.int64), np.array([1, 0], dtype=np.int64), 1,
+              np.array([1, 2], dtype=np.int8), 1, 1, 0, 0)
+    return pair_walk
 
 
 def _set(mask: int) -> frozenset[int]:
