@@ -99,15 +99,22 @@ class Halfspaces:
         p_i − p_0 (:func:`.exact.cross_all`, one numpy pass of Python ints per
         minor instead of a Bareiss elimination per row)."""
         k = len(self.Yi[0])
-        todo = [int(h) for h in dict.fromkeys(hs) if int(h) not in self._cache]
+        todo = [h for h in dict.fromkeys(np.asarray(hs, dtype=np.int64).tolist())
+                if h not in self._cache]
         if k < 2 or len(todo) < 2:
             return
         Y = np.empty((len(self.Yi), k), dtype=object)
         Y[:] = self.Yi
         sub = self.through[todo]
-        normals = cross_all(Y[sub[:, 1:]] - Y[sub[:, :1]]) * (-1) ** (k - 1)
-        for h, normal in zip(todo, normals.tolist(), strict=True):
-            self._store(h, normal)
+        # the signed normals a, b = a·p_0, and (a, b) divided by their gcd (:meth:`_store`
+        # row by row), on object arrays of Python ints
+        a = cross_all(Y[sub[:, 1:]] - Y[sub[:, :1]]) * (
+            self.sign[todo] * (-1) ** (k - 1)).astype(object)[:, None]
+        b = (a * Y[sub[:, 0]]).sum(axis=1)
+        g = np.gcd.reduce(np.column_stack([a, b]), axis=1)
+        for h, row, off in zip(todo, (a // g[:, None]).tolist(), (b // g).tolist(),
+                               strict=True):
+            self._cache[h] = tuple(row), off
 
     def _store(self, h: int, normal) -> None:
         """Cache row h from the cofactor normal of its subset (signed, primitive)."""
