@@ -242,11 +242,10 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     near_r, near_v = near_r[fresh], near_v[fresh]
     hs = rows[near_r]
     slacks = _int64_slacks(H, scale, verts, hs, near_v)
-    if slacks is None:  # in Python integers
+    if slacks is None:  # in Python integers: a·y − b·w, all pairs at once
         H.exact_all(np.unique(hs).tolist())
-        slacks = np.array([_slack(H.exact(h), verts[vi])
-                           for h, vi in zip(hs.tolist(), near_v.tolist(), strict=True)],
-                          dtype=object)
+        E = _homogeneous(H, hs.tolist(), k)[:-1]  # (−b, a)
+        slacks = (E * W[near_v]).sum(axis=1) if len(hs) else np.zeros(0, dtype=object)
     if (slacks > 0).any():
         return None
     on = slacks == 0
@@ -270,12 +269,6 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     P.edges = edges
     P._fv = Vx
     return P
-
-
-def _slack(row: tuple[tuple[int, ...], int], v: tuple[int, ...]) -> int:
-    """a·y − b·w for the row (a, b) and the homogeneous point v = (w, y)."""
-    (a, b), (w, *y) = row, v
-    return sum(map(operator.mul, a, y)) - b * w
 
 
 def _bitsets(vs: np.ndarray, hs: np.ndarray, n: int, width: int) -> list[int]:
