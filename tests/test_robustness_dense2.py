@@ -271,3 +271,41 @@ def test_witness_walks_get_their_budget_after_compiling(monkeypatch):
     finally:
         bd.compiled_walk.cache_clear()
     assert pair is not None and bd.pair_cost(ig, pair, 21) == 0
+
+
+@settings(max_examples=80, deadline=None)
+@given(random_digraphs(max_n=12), st.data())
+def test_probed_pairs_cost_what_they_claim(G, data):
+    """bounds.probed_pairs on random digraphs (all densities), every r, below a random
+    cap and above a random floor: each pair is cheaper than the one before it (the first
+    than the cap), costs at least the DP's s*(r), and the search stops at the floor."""
+    import time as _time
+
+    ig = index_graph(G)
+    n = ig.n
+    inmask = np.array(ig.in_masks(), dtype=np.uint64)
+    for r in range(1, (n + 1) // 2 + 2):
+        dp = int(K.min_pair_cost(inmask, r)[0])
+        below = data.draw(st.integers(1, n + 1))
+        floor = data.draw(st.integers(0, below - 1))
+        costs = [bd.pair_cost(ig, p, r) for p in bd.probed_pairs(
+            ig, r, floor=floor, below=below, deadline=_time.perf_counter() + 5)]
+        assert all(c is not None and c >= dp for c in costs)
+        assert costs == sorted(set(costs), reverse=True) and all(c < below for c in costs)
+        assert all(c > floor for c in costs[:-1])
+
+
+def test_near_bisection_probe_finds_the_cost_1_pair():
+    """ER(50, 0.8), seed 50001, r = 21 (ρ = 21, s* = 1): the tabu walks stop at cost 2,
+    the probes find the cost-1 pair at sizes (24, 26), and _descended_upper settles
+    s* = 1 with the proven lower bound 1."""
+    import time as _time
+
+    from rescon.graphs import robustness as rb
+
+    ig = index_graph(nx.gnp_random_graph(50, 0.8, directed=True, seed=50001))
+    found = bd.probed_pairs(ig, 21, floor=1, below=2, deadline=_time.perf_counter() + 30)
+    assert [bd.pair_cost(ig, p, 21) for p in found] == [1]
+    assert sorted((len(found[0].S1), len(found[0].S2))) == [24, 26]
+    upper, pair = rb._descended_upper(ig, 21, ig.n, None, None, lower=1)
+    assert upper == 1 and bd.pair_cost(ig, pair, 21) == 1
