@@ -187,3 +187,35 @@ def test_kernels_identical_to_the_exact_clipping_on_hostile_data(kind, d, n, F, 
     assert fast._exact.constraints == slow._exact.constraints
     assert fast._exact.facets == slow._exact.facets
     assert fast.certificate == slow.certificate
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_near_pairs_with_rows_near_many_points_equal_brute_force(seed):
+    """Rows with more near points than the counting pass keeps (NEAR_KEPT) are scanned
+    again; every pair is found, in the order of the rows (brute force: every slack)."""
+    from rescon.geometry._candidates import NEAR_KEPT, near_pairs
+
+    rng = np.random.default_rng(seed)
+    k, nv = 4, 900
+    V = rng.uniform(-1.0, 1.0, size=(nv, k))
+    V[: 3 * NEAR_KEPT, 0] = 2.0  # on the hyperplane x_0 = 2 of row 0
+    V[NEAR_KEPT // 2: NEAR_KEPT, 1] = 3.0  # a few on x_1 = 3 (row 1) too
+    A = rng.normal(size=(40, k))
+    A[0], A[1] = [1, 0, 0, 0], [0, 1, 0, 0]
+    b = (A @ V.T).max(axis=1) + rng.uniform(0.0, 2.0, 40)
+    b[:2] = [2.0, 3.0]
+    b[2::5] = (A[2::5] @ V.T).max(axis=1)  # rows touching their highest point
+    A_abs, b_abs = np.abs(A) * 1.01, np.abs(b) * 1.01
+    c_err, c = 1e-12, 32 * 2.0**-53
+    M = np.abs(V).max()
+    coarse = c_err * (A_abs.sum(axis=1) * M + b_abs) + c * (np.abs(A).sum(axis=1) * M + np.abs(b))
+    S = A @ V.T - b[:, None]
+    bound = c_err * (A_abs @ np.abs(V).T + b_abs[:, None]) + c * (
+        np.abs(A) @ np.abs(V).T + np.abs(b)[:, None])
+    assert not (S > np.minimum(bound, coarse[:, None])).any()
+    want_r, want_v = np.nonzero((np.abs(S) <= coarse[:, None]) & ~(np.abs(S) > bound))
+    got_r, got_v = near_pairs(A, b, A_abs, b_abs, V, coarse, c_err, c, 0.0)
+    assert np.bincount(want_r)[0] == 3 * NEAR_KEPT
+    assert got_r.tolist() == want_r.tolist()  # by row
+    assert sorted(zip(got_r.tolist(), got_v.tolist())) == list(zip(want_r.tolist(),
+                                                                    want_v.tolist()))

@@ -598,12 +598,16 @@ def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float) -> np.nda
 
 @njit(cache=True, nogil=True)
 def _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
-                floor, h0, h1, fill, offsets, out_r, out_v):
+                floor, h0, h1, fill, offsets, out_r, out_v, first):
     """Rows h0 ≤ h < h1 of :func:`near_pairs`: with ``fill`` False, count each row's
-    near pairs into offsets[h] (−1: a pair surely violated); with ``fill`` True, write
-    them from offsets[h] on."""
+    near pairs into offsets[h] (−1: a pair surely violated) and keep the points of its
+    first ones in first[h] (as many as fit); with ``fill`` True, write the pairs of the
+    rows with offsets[h] ≥ 0 from offsets[h] on (the others are skipped)."""
     k = A.shape[1]
+    keep = first.shape[1]
     for h in range(h0, h1):
+        if fill and offsets[h] < 0:
+            continue
         at = offsets[h] if fill else 0
         for cc in range(len(starts) - 1):
             if _chunk_top(A, b, h, centres, radii, norms[h], cc, floor) < -coarse[h]:
@@ -631,6 +635,8 @@ def _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_
                     if fill:
                         out_r[at] = h
                         out_v[at] = v
+                    elif at < keep:
+                        first[h, at] = v
                     at += 1
             if at < 0:
                 break
@@ -640,11 +646,11 @@ def _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_
 
 @njit(cache=True, parallel=True)
 def _near_parallel(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
-                   floor, fill, offsets, out_r, out_v):
+                   floor, fill, offsets, out_r, out_v, first):
     m = A.shape[0]
     for t in prange(64):
         _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
-                    floor, m * t // 64, m * (t + 1) // 64, fill, offsets, out_r, out_v)
+                    floor, m * t // 64, m * (t + 1) // 64, fill, offsets, out_r, out_v, first)
 
 
 def near_pairs(A, b, A_abs, b_abs, V, coarse, c_err: float, c: float, floor: float
@@ -662,20 +668,31 @@ def near_pairs(A, b, A_abs, b_abs, V, coarse, c_err: float, c: float, floor: flo
               c, floor)
     parallel = len(b) * (len(starts) - 1) >= 20_000
     counts = np.zeros(len(b), dtype=np.int64)
+    first = np.empty((len(b), NEAR_KEPT), dtype=np.int64)
     none = np.zeros(0, dtype=np.int64)
-    _near_run(common, parallel, False, counts, none, none)
+    _near_run(common, parallel, False, counts, none, none, first)
     if (counts < 0).any():
         return None
     offsets = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    out_r = np.empty(int(counts.sum()), dtype=np.int64)
+    out_r = np.repeat(np.arange(len(b), dtype=np.int64), counts)
     out_v = np.empty_like(out_r)
-    _near_run(common, parallel, True, offsets, out_r, out_v)
+    kept = np.arange(NEAR_KEPT)[None, :] < np.where(counts <= NEAR_KEPT, counts, 0)[:, None]
+    out_v[(offsets[:, None] + np.arange(NEAR_KEPT)[None, :])[kept]] = first[kept]
+    if (counts > NEAR_KEPT).any():  # only those rows again, writing every pair
+        _near_run(common, parallel, True, np.where(counts > NEAR_KEPT, offsets, -1), out_r,
+                  out_v, first)
     return out_r, order[out_v]
 
 
-def _near_run(common: tuple, parallel: bool, fill: bool, offsets, out_r, out_v) -> None:
+#: near_pairs keeps this many pairs per row from its counting pass; rows with more are
+#: scanned again (d = 4, n = 50: at most ~90; d = 5: up to ~500)
+NEAR_KEPT = 96
+
+
+def _near_run(common: tuple, parallel: bool, fill: bool, offsets, out_r, out_v, first
+              ) -> None:
     """One pass of :func:`near_pairs` over every row (threads for large inputs)."""
     if parallel:
-        _near_parallel(*common, fill, offsets, out_r, out_v)
+        _near_parallel(*common, fill, offsets, out_r, out_v, first)
     else:
-        _near_range(*common, 0, len(offsets), fill, offsets, out_r, out_v)
+        _near_range(*common, 0, len(offsets), fill, offsets, out_r, out_v, first)
