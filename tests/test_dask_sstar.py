@@ -49,21 +49,20 @@ def _split_run(ig, r: int, engine: str, budgets, rng: random.Random, singles: in
     finish on a cluster in any order), each below the incumbent of that moment; the
     sized tokens assembled in preorder (distributed._Tree) when ``record`` (else the
     sized search prunes non-maximal pairs too). Returns (best, pair, tree)."""
-    inputs = search._kernel_inputs(ig)
+    masks = search._kernel_inputs(ig)[1:]
     best, pair = ig.n, None
     tree = distributed._Tree(engine == "sized" and record)
     waiting = [(0, whole_cost_part(ig.n))]
     ids = iter(range(1, 10**9))
     while waiting and best > 0:
         pid, part = waiting.pop(rng.randrange(len(waiting)))
-        run = CostPartRun(inputs, engine, r, 0, part, best, tree.room() - 1 if tree.room()
-                          else 0)
-        status = run.advance(next(budgets))
-        if run.best < best:
-            best, pair = run.best, run.pair()
-        parts = split_cost_part(run.rest(), singles, ig.n) if status == K.RUNNING else []
+        res = distributed.run_cost_part(masks, engine, r, 0, part, best, tree.room(),
+                                        next(budgets))
+        if res.best < best:
+            best, pair = res.best, res.pair
+        parts = [] if res.rest is None else split_cost_part(res.rest, singles, ig.n)
         children = [next(ids) for _ in parts]
-        tree.add(pid, run.recorded(), children)
+        tree.add(pid, res.tokens, children)
         waiting += list(zip(children, parts, strict=True))
     return best, pair, tree.assemble() if best > 0 else None
 
