@@ -74,18 +74,6 @@ def members_of(tight: list[int]) -> dict[int, list[int]]:
                     strict=True))
 
 
-class _Members(dict):
-    """constraint → the vertices tight on it, computed on first use."""
-
-    def __init__(self, tight: list[int]) -> None:
-        super().__init__()
-        self.tight = tight
-
-    def __missing__(self, h: int) -> list[int]:
-        out = self[h] = [i for i, t in enumerate(self.tight) if t >> h & 1]
-        return out
-
-
 def _normalise(h: tuple[int, ...]) -> tuple[int, ...]:
     g = 0
     for v in h:
@@ -197,7 +185,7 @@ class ExactPolytope:
                 x = exact[i] = self._slack_at(a, b, i)
             return x
 
-        members = _Members(self.tight)
+        members = members_of(self.tight)
         need = self.k - 1
         new_v, new_t, new_f = [], [], []
         for v in np.flatnonzero(sign > 0).tolist():
@@ -241,7 +229,7 @@ class ExactPolytope:
         require(f"the exact vertex enumeration of the kernel in dimension {self.k}",
                 self.work, 0, "reduce d, or n")
 
-    def _edge(self, u: int, v: int, z: int, members: _Members) -> bool:
+    def _edge(self, u: int, v: int, z: int, members: dict[int, list[int]]) -> bool:
         """u, v span an edge: no other vertex is tight on all of z."""
         if not z:
             return len(self.verts) == 2
