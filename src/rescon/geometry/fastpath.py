@@ -38,7 +38,7 @@ import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
 from .exact import cross_all
-from .polytope import ExactPolytope, _bits, members_of, tight_pairs
+from .polytope import PRIME, ExactPolytope, _bits, members_of, tight_pairs
 
 __all__ = ["certified_kernel"]
 
@@ -497,8 +497,8 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     used, at = np.unique(B, return_inverse=True)
     at = at.reshape(B.shape)
     E = _homogeneous(H, used.tolist(), k)
-    A = np.array([[v % _PRIME for v in a] for a in E[:-1, 1:].tolist()], dtype=np.int64)
-    sure = _det_mod(A[at], _PRIME) != 0
+    A = np.array([[v % PRIME for v in a] for a in E[:-1, 1:].tolist()], dtype=np.int64)
+    sure = _det_mod(A[at], PRIME) != 0
     out: list[tuple[int, ...] | None] = [None] * len(Ts)
     X = np.empty((len(Ts), k + 1), dtype=object)
     if sure.any():
@@ -511,9 +511,6 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
             out[p] = tuple(v // g for v in row)
     return out
 
-
-#: a prime below 2^31: a product of two residues fits an int64
-_PRIME = 2_147_483_647
 
 
 def _det_mod(A: np.ndarray, p: int) -> np.ndarray:
