@@ -76,7 +76,7 @@ def test_vertices_through_the_data_points_equal_the_null_space(case):
 
 def test_det_mod_equals_the_exact_determinant():
     rng = random.Random(4)
-    p = fastpath._PRIME
+    p = fastpath.PRIME
     for m in (1, 2, 3, 4, 5):
         mats = [[[rng.randint(-2**70, 2**70) for _ in range(m)] for _ in range(m)]
                 for _ in range(40)]

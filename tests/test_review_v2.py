@@ -88,9 +88,9 @@ def test_the_fast_path_facets_are_the_clippings():
 
 
 def test_a_basis_whose_determinant_is_the_prime_is_solved_by_the_fallback():
-    # rows y1 = 0, y2 = 0, y3 = 0 and y1 + y2 + y3 + p y4 = 2p (p = fastpath._PRIME)
+    # rows y1 = 0, y2 = 0, y3 = 0 and y1 + y2 + y3 + p y4 = 2p (p = fastpath.PRIME)
     # through data points: det A = ±p ≡ 0 (mod p) although the rows are independent
-    p = fastpath._PRIME
+    p = fastpath.PRIME
     pts = [(0, 1, 0, 0), (0, 0, 1, 0), (0, 1, 1, 0), (0, 2, 1, 1), (1, 0, 0, 0), (1, 0, 1, 1),
            (2, 0, 1, 0), (1, 1, 0, 0), (2, 1, 0, 1), (2 * p, 0, 0, 0), (0, 2 * p, 0, 0),
            (0, 0, 2 * p, 0), (0, 0, 0, 2)]
@@ -114,7 +114,7 @@ def test_a_basis_whose_determinant_is_the_prime_is_solved_by_the_fallback():
 def test_a_tiny_prime_sends_most_bases_to_the_fallback_with_the_same_kernel(monkeypatch):
     X = np.random.default_rng(7).integers(-2, 3, size=(18, 4)).astype(float) / 4
     slow = _clipped(X, 2)
-    monkeypatch.setattr(fastpath, "_PRIME", 2)
+    monkeypatch.setattr(fastpath, "PRIME", 2)
     certified = []
     real = km.certified_kernel
     monkeypatch.setattr(km, "certified_kernel", lambda *a: certified.append(real(*a))
