@@ -262,6 +262,24 @@ def _result(fut: Any) -> PartResult:
                           f"({type(exc).__name__}: {first})") from exc
 
 
+class _Workers:
+    """Watches that the cluster still has a worker while a search waits on it: its tasks
+    would wait forever without one (a worker killed, no nanny to restart it)."""
+
+    def __init__(self, client: Any) -> None:
+        self.client, self.seen = client, time.perf_counter()
+
+    def check(self) -> None:
+        """SolverError once no worker has been seen for ``_dask.WORKER_SECONDS`` (the
+        wait rescon._dask allows a scheduler for a first worker)."""
+        now = time.perf_counter()
+        if self.client.nthreads():
+            self.seen = now
+        elif now - self.seen > _dask.WORKER_SECONDS:
+            raise SolverError(f"the Dask cluster has had no worker for "
+                              f"{_dask.WORKER_SECONDS} s: the search's tasks cannot run")
+
+
 def finish_on_cluster(
     cluster: _Cluster,
     run: PartRun,
@@ -276,6 +294,7 @@ def finish_on_cluster(
     from distributed import wait
 
     client = cluster.client()
+    workers = _Workers(client)
     K = run.K
     masks = (run.inmask, run.outmask, run.order)
     order = tuple(run.order.tolist())
@@ -300,8 +319,9 @@ def finish_on_cluster(
             try:
                 done = wait(list(running), timeout=POLL_SECONDS,
                             return_when="FIRST_COMPLETED").done
-            except TimeoutError:  # none finished: check the deadline
+            except TimeoutError:  # none finished: check the workers and the deadline
                 done = set()
+                workers.check()
             for fut in done:
                 pid = running.pop(fut)
                 res = _result(fut)
@@ -409,6 +429,7 @@ def finish_cost_on_cluster(
     from distributed import wait
 
     client = cluster.client()
+    workers = _Workers(client)
     first = runs[0]
     masks, lower = (first.inmask, first.outmask, first.order), first.lower
     order = tuple(first.order.tolist())
@@ -433,8 +454,9 @@ def finish_cost_on_cluster(
             try:
                 done = wait(list(running), timeout=POLL_SECONDS,
                             return_when="FIRST_COMPLETED").done
-            except TimeoutError:  # none finished: check the deadline
+            except TimeoutError:  # none finished: check the workers and the deadline
                 done = set()
+                workers.check()
             for fut in done:
                 eng, pid = running.pop(fut)
                 res = _result(fut)
