@@ -99,14 +99,31 @@ def test_the_last_worker_killed_mid_search_is_a_solver_error_not_a_hang(
     assert "\n" not in str(got)
 
 
-def test_a_nanny_restarted_worker_keeps_the_answer(tiny_parts):
-    """Guard (held): kept here as the control of the test above — with a worker that
-    stays, the split s*(3) is brute force's."""
-    from distributed import LocalCluster
+@pytest.mark.slow
+def test_a_worker_killed_mid_search_and_restarted_by_its_nanny_keeps_the_answer(
+        tiny_parts, monkeypatch):
+    """Guard (held): the worker process of a LocalCluster killed (SIGKILL) as the s*
+    search goes to the cluster; its nanny restarts it, the lost tasks run again, and
+    the split s*(3) is still brute force's (11)."""
+    import os
+    import signal
+
+    from distributed import Client, LocalCluster
 
     G = nx.gnp_random_graph(16, 0.8, seed=3, directed=True)
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as local:
+    original = distributed.finish_cost_on_cluster
+    killed: list[int] = []
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as local, Client(local) as client:
+        (pid,) = client.run(os.getpid).values()
+
+        def kill_then_finish(*args, **kwargs):
+            if not killed:
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+            return original(*args, **kwargs)
+
+        monkeypatch.setattr(distributed, "finish_cost_on_cluster", kill_then_finish)
         clear_cache()
         got = rescon.max_s(G, 3, method="search", scheduler=local.scheduler_address)
-    assert got == leblanc_max_s(G, 3) == 11
+    assert killed and got == leblanc_max_s(G, 3) == 11
