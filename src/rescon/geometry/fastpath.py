@@ -398,6 +398,8 @@ class _RayIndex:
         """For each key of K, a vertex registered under it other than ``own`` (which
         broadcasts against K), or −1 if there is none: the first of its run, else the
         second."""
+        if not len(self.owners):  # every vertex has > MAX_TIGHT rows: none registered
+            return np.full(np.broadcast(K, own).shape, -1, dtype=np.int64)
         lo = np.searchsorted(self.keys, K, side="left")
         hi = np.searchsorted(self.keys, K, side="right")
         last = len(self.owners) - 1
