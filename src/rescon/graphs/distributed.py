@@ -279,6 +279,18 @@ class _Workers:
             raise SolverError(f"the Dask cluster has had no worker for "
                               f"{_dask.WORKER_SECONDS} s: the search's tasks cannot run")
 
+    def finished(self, running: dict[Any, Any]) -> set[Any]:
+        """The futures of ``running`` done within ``POLL_SECONDS``; when none is, the
+        cluster must still have a worker (:meth:`check`) — the caller then checks its
+        deadline."""
+        from distributed import wait
+
+        try:
+            return wait(list(running), timeout=POLL_SECONDS, return_when="FIRST_COMPLETED").done
+        except TimeoutError:
+            self.check()
+            return set()
+
 
 def finish_on_cluster(
     cluster: _Cluster,
@@ -291,7 +303,6 @@ def finish_on_cluster(
     """Finish the decision search ``run`` (started in this process, not finished) on the
     cluster; the outcome is the serial search's, tree included (module docstring);
     after "not_robust" the witness is the first one a task found."""
-    from distributed import wait
 
     client = cluster.client()
     workers = _Workers(client)
@@ -316,12 +327,7 @@ def finish_on_cluster(
     try:
         share(0, run.tokens(), run.rest())
         while running:
-            try:
-                done = wait(list(running), timeout=POLL_SECONDS,
-                            return_when="FIRST_COMPLETED").done
-            except TimeoutError:  # none finished: check the workers and the deadline
-                done = set()
-                workers.check()
+            done = workers.finished(running)
             for fut in done:
                 pid = running.pop(fut)
                 res = _result(fut)
@@ -426,7 +432,6 @@ def finish_cost_on_cluster(
     have all finished answers, as in search.min_cost_pair; so does a pair of cost
     ``lower``. Its ``best`` is the serial search's; the sized engine's tree, assembled
     from its parts, proves it."""
-    from distributed import wait
 
     client = cluster.client()
     workers = _Workers(client)
@@ -451,12 +456,7 @@ def finish_cost_on_cluster(
                 running[client.submit(run_cost_part, masks, eng.name, first.r, lower, part,
                                       best, eng.tree.room(), COST_TASK_NODES,
                                       pure=False)] = (eng, pid)
-            try:
-                done = wait(list(running), timeout=POLL_SECONDS,
-                            return_when="FIRST_COMPLETED").done
-            except TimeoutError:  # none finished: check the workers and the deadline
-                done = set()
-                workers.check()
+            done = workers.finished(running)
             for fut in done:
                 eng, pid = running.pop(fut)
                 res = _result(fut)
