@@ -48,6 +48,8 @@ from rescon.graphs.indexed import index_graph
 from rescon.graphs.robustness import _deepening_search, _descended_upper
 from rescon.graphs.search import _kernel_inputs, min_cost_pair, whole_cost_part
 
+from .robustness_dask_bench import _cpu, _graph
+
 INSTANCES = ("40:0.8:40001:16", "50:0.9:50000:22", "60:0.9:60000:28")
 
 #: the scan that chose the instances (--scan, 130 s per search; ρ from rescon.robustness):
@@ -69,12 +71,6 @@ SCAN_NOTE = ("load 3.2-4.7 from other jobs; ρ = 17, 20, 21, 23, 28 for ER(40, 0
              "instances have p = 0.9")
 
 
-def _graph(spec: str) -> tuple[str, nx.DiGraph, int]:
-    n, p, seed, r = spec.split(":")
-    G = nx.gnp_random_graph(int(n), float(p), seed=int(seed), directed=True)
-    return f"ER({n}, {p}) seed {seed}", G, int(r)
-
-
 def _upper(ig, r: int) -> int:
     """The cheapest pair the API's bounds find (candidates, descents, tabu walks)."""
     upper, pair = ig.n, None
@@ -92,14 +88,6 @@ def _certificate(G: nx.DiGraph, r: int, out) -> dict:
         proof["tree"] = list(out.tree)
     return {"rescon_certificate": 1, "kind": "rs_robust", "graph": index_graph(G).graph_json(),
             "r": r, "s": out.best, "proof": proof}
-
-
-def _cpu(client) -> dict[str, float]:
-    """CPU seconds so far of this process ("driver") and of every worker process."""
-    used = {"driver": time.process_time()}
-    if client is not None:
-        used.update(client.run(time.process_time))
-    return used
 
 
 def _timed(ig, r: int, upper: int, cluster, client):
