@@ -182,7 +182,7 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
         if bad.any():
             sel = np.union1d(sel, np.flatnonzero(bad))
             continue
-        return _certify(H, k, scale, sel, facets, V, top)
+        return _certify(H, k, scale, sel, facets, V, top, pieces=options == "QJ")
     return None
 
 
@@ -197,22 +197,25 @@ def _row_max(H, V: np.ndarray) -> np.ndarray:
 
 
 def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
-             V: np.ndarray | None = None, top: np.ndarray | None = None
-             ) -> ExactPolytope | None:
+             V: np.ndarray | None = None, top: np.ndarray | None = None,
+             pieces: bool = False) -> ExactPolytope | None:
     """Exact vertices from the proposed defining sets (merged when equal), their full
     tight sets among the defining halfspaces S, feasibility against every valid
     halfspace, and closure: every extreme ray of every vertex's tangent cone leads to
-    another proposed vertex (see the module docstring)."""
+    another proposed vertex (see the module docstring). ``pieces``: the proposals are
+    simplicial pieces (joggled qhull), several per non-simple vertex — one per point
+    is solved (:func:`_one_per_point`)."""
     S_set = np.unique(sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
                                       count=sum(map(len, facets)))]).tolist()
     H.exact_all(S_set)
     S = np.asarray(S_set, dtype=np.int64)
     rows_of = sel.tolist()
     Ts = _bases(H, [[rows_of[i] for i in f] for f in facets], k)
-    sols = _solve_all(H, Ts, k)
+    solved = _one_per_point(H, Ts, k).tolist() if pieces else list(range(len(Ts)))
+    sols = dict(zip(solved, _solve_all(H, [Ts[p] for p in solved], k), strict=True))
     # None: k dependent rows (a zero-volume piece of a triangulated non-simple vertex),
     # the other proposals or the closure decide
-    kept = np.array([p for p, v in enumerate(sols) if v is not None], dtype=np.int64)
+    kept = np.array([p for p in solved if sols[p] is not None], dtype=np.int64)
     if not len(kept):
         return None
     index: dict[tuple[int, ...], int] = {}  # equal points, equal primitive (w, y)
@@ -494,6 +497,26 @@ def _bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
     return out
 
 
+def _one_per_point(H, Ts: list[list[int]], k: int) -> np.ndarray:
+    """The proposals to solve exactly, increasing: the first of those sharing a modular
+    key (:func:`._certify_nb.point_keys`: the joggled pieces of one non-simple vertex
+    share it) and every proposal without one. Dropping the others is sound: a point
+    lost to a key shared by chance is a vertex missed, which the closure check
+    refuses (module docstring)."""
+    from ._certify_nb import KEY_PRIME, point_keys
+
+    if not Ts:
+        return np.zeros(0, dtype=np.int64)
+    B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
+    used, at = np.unique(B, return_inverse=True)
+    E = np.array([[v % KEY_PRIME for v in e] for e in
+                  _homogeneous(H, used.tolist(), k)[:-1].tolist()], dtype=np.int64)
+    keys = np.zeros((len(Ts), k), dtype=np.int64)
+    ok = point_keys(E, at.reshape(B.shape), keys)
+    first = np.flatnonzero(ok)[np.unique(keys[ok], axis=0, return_index=True)[1]]
+    return np.sort(np.concatenate([first, np.flatnonzero(~ok)]))
+
+
 def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     """For each list T of k rows, the point where their hyperplanes meet, homogeneous
     (w, y) with w > 0 and primitive, or None if they do not meet in one point: (w, y)
@@ -520,10 +543,12 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
         X[sure] = _meet(H, E, B[sure], at[sure], k)
     if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
         X[~sure] = cross_all(E[at[~sure]])
-    for p, row in enumerate(X.tolist()):
-        if row[0] != 0:
-            g = gcd(*row) if row[0] > 0 else -gcd(*row)
-            out[p] = tuple(v // g for v in row)
+    # primitive, x_0 > 0: each row divided by ±gcd in one object-array division
+    live = np.flatnonzero(X[:, 0] != 0)
+    g = np.array([gcd(*row) if row[0] > 0 else -gcd(*row) for row in X[live].tolist()],
+                 dtype=object)
+    for p, row in zip(live.tolist(), (X[live] // g[:, None]).tolist(), strict=True):
+        out[p] = tuple(row)
     return out
 
 

@@ -1,0 +1,101 @@
+"""Compiled modular steps of the fast path's certification (:mod:`.fastpath`).
+
+A proposal of the fast path is a set T of k rows e_h = (−b_h, a_h) (integers); where
+det A_T ≠ 0 its rows meet in the single point y = A_T⁻¹ b_T. Modulo a prime p with
+det A_T ≢ 0 (mod p) the residue y mod p = A_T⁻¹ b_T (mod p) is well defined, and equal
+points have equal residues: the residues are a *key* of the point. Distinct points can
+share a key (each coordinate then agrees modulo p by chance), so a key only proposes:
+the fast path solves one proposal per key, and a vertex lost to a shared key leaves a
+tangent-cone ray without an end, which the closure check refuses (the caller then
+clips exactly).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["KEY_PRIME", "point_keys"]
+
+#: the largest prime below 2^31 − 1 (a compile-time constant: the reductions modulo it
+#: compile to multiplications); residues < 2^31, so a product of two fits an int64
+KEY_PRIME = 2_147_483_629
+
+
+@njit(cache=True, nogil=True)
+def _inverse(a):
+    """a⁻¹ modulo KEY_PRIME (a ≢ 0), by Fermat: a^(p − 2)."""
+    p = KEY_PRIME
+    out, e = 1, p - 2
+    a %= p
+    while e:
+        if e & 1:
+            out = out * a % p
+        a = a * a % p
+        e >>= 1
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _reduce(R, k):
+    """Gauss–Jordan on the k × (k + 1) residues R = [−b | A] over the columns of A,
+    without divisions (row_i ← pivot·row_i − f·row_c, mod p): on success R[i, i + 1]
+    ≠ 0, the other entries of A are 0, and y_i = −R[i, 0] / R[i, i + 1]. False if A is
+    singular modulo p."""
+    p = KEY_PRIME
+    for c in range(k):
+        piv = -1
+        for r in range(c, k):
+            if R[r, c + 1] != 0:
+                piv = r
+                break
+        if piv < 0:
+            return False
+        if piv != c:
+            for j in range(k + 1):
+                R[c, j], R[piv, j] = R[piv, j], R[c, j]
+        top = R[c, c + 1]
+        for i in range(k):
+            f = R[i, c + 1]
+            if i == c or f == 0:
+                continue
+            for j in range(k + 1):
+                R[i, j] = (top * R[i, j] - f * R[c, j]) % p
+    return True
+
+
+@njit(cache=True, nogil=True)
+def point_keys(E, at, keys):
+    """For each proposal i (its rows at[i] of the residues E (m, k + 1), entries in
+    [0, p)), the key y mod p into keys[i] (k residues) and True, or False where A_T is
+    singular modulo p (keys[i] left as is). The k divisions of each solve are one
+    inversion for all proposals (Montgomery's trick: prefix products)."""
+    P, k = at.shape
+    p = KEY_PRIME
+    ok = np.zeros(P, dtype=np.bool_)
+    num = np.empty((P, k), dtype=np.int64)
+    den = np.ones((P, k), dtype=np.int64)
+    R = np.empty((k, k + 1), dtype=np.int64)
+    for i in range(P):
+        for r in range(k):
+            for j in range(k + 1):
+                R[r, j] = E[at[i, r], j]
+        if not _reduce(R, k):
+            continue
+        ok[i] = True
+        for r in range(k):
+            num[i, r] = (p - R[r, 0]) % p
+            den[i, r] = R[r, r + 1]
+    # one inversion: prefix[t] = den_0 ⋯ den_{t−1}, then walk back
+    flat = den.ravel()
+    prefix = np.empty(len(flat) + 1, dtype=np.int64)
+    prefix[0] = 1
+    for t in range(len(flat)):
+        prefix[t + 1] = prefix[t] * flat[t] % p
+    inv = _inverse(prefix[len(flat)])
+    for t in range(len(flat) - 1, -1, -1):
+        i, r = t // k, t % k
+        if ok[i]:
+            keys[i, r] = num[i, r] * (inv * prefix[t] % p) % p
+        inv = inv * flat[t] % p
+    return ok
