@@ -543,12 +543,10 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
         X[sure] = _meet(H, E, B[sure], at[sure], k)
     if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
         X[~sure] = cross_all(E[at[~sure]])
-    # primitive, x_0 > 0: each row divided by ±gcd in one object-array division
-    live = np.flatnonzero(X[:, 0] != 0)
-    g = np.array([gcd(*row) if row[0] > 0 else -gcd(*row) for row in X[live].tolist()],
-                 dtype=object)
-    for p, row in zip(live.tolist(), (X[live] // g[:, None]).tolist(), strict=True):
-        out[p] = tuple(row)
+    for p, row in enumerate(X.tolist()):
+        if row[0] != 0:
+            g = gcd(*row) if row[0] > 0 else -gcd(*row)
+            out[p] = tuple(v // g for v in row)
     return out
 
 
