@@ -23,7 +23,10 @@ rule); the proposal is accepted only if, in exact arithmetic,
 
 Then Ψ ⊆ P_S (valid halfspaces) = conv(V) ⊆ Ψ. Anything else — a lower-dimensional
 kernel, a qhull failure, a vertex the check rejects, or one missed (e.g. its k chosen
-rows were dependent) — returns None and the caller clips exactly (:mod:`.polytope`).
+rows were dependent, or a joggled proposal was not solved because its modular key
+equalled another's: :func:`_one_per_point`) — returns None and the caller clips
+exactly (:mod:`.polytope`). Only the proposals' vertices are taken as V, so leaving a
+proposal out can lose a vertex of P_S but never add a point that is not one.
 """
 
 from __future__ import annotations
