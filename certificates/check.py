@@ -544,13 +544,15 @@ class _Side:
     holding v has at least m_v = max(1, d_v − t[v] + 2) members. Packed sets:
     ``cut[k]`` / ``keep[k]`` hold the fields with m_v > k / ≤ k; ``D`` is the deficit
     table of V (a member's field 2^(w−1) + min(t[v], n) − 1, all ones for the nodes of
-    ``gone``, those with t[v] ≤ 0, never in a closed set)."""
+    ``gone``, those with t[v] ≤ 0, never in a closed set); ``charged``: the nodes the
+    ``crowded`` leaf checks besides the earlier roots (a ``charged_tree``'s Q_k)."""
 
     t: list[int]
     cut: list[int]
     keep: list[int]
     D: int
     gone: int
+    charged: list[int]
 
     def least_in(self, Q: int, n: int) -> int:
         """min_{v∈Q} m_v for a packed Q (n + 1 when Q = ∅): a binary search on ``keep``."""
@@ -626,9 +628,10 @@ class _Replay:
         self.full = self.pack(g.full)
         self.side = self.threshold_side([r] * n)
 
-    def threshold_side(self, t: list[int]) -> _Side:
+    def threshold_side(self, t: list[int], charged: int = 0) -> _Side:
         """The :class:`_Side` of the per-node thresholds ``t`` (t[v] for node v): a member
-        v of a closed set has fewer than t[v] in-neighbours outside it."""
+        v of a closed set has fewer than t[v] in-neighbours outside it; ``charged`` (a
+        bitmask): the side's charged nodes."""
         n, w, top = self.g.n, self.w, self.top
         least = [max(1, d - tv + 2) for d, tv in zip(self.deg, t)]
         cut, acc = [0] * (n + 2), [0] * (n + 2)
@@ -645,7 +648,7 @@ class _Replay:
                 D |= self.ones << (w * self.field[v])
                 gone |= 1 << top[v]
         self.work += 3 * n * self.unit
-        return _Side(t, cut, acc, D, gone)
+        return _Side(t, cut, acc, D, gone, _bits(charged))
 
     def pack(self, mask: int) -> int:
         """The packed form of the node set ``mask`` (a bitmask)."""
@@ -687,12 +690,12 @@ class _Replay:
                 U = 0
                 steps += 1
                 break
-            D |= (todo >> (w - 1)) * ones
             steps += 1 + todo.bit_count()
-            while todo:
+            while todo:  # each removed node: its field all ones, its out-neighbours' lowered
                 low = todo & -todo
                 todo ^= low
-                D -= less[low.bit_length()]
+                b = low.bit_length()
+                D = (D | ones << (b - w)) - less[b]
             todo = U & ~D
             if todo & watch:
                 U ^= todo
@@ -782,12 +785,13 @@ class _Replay:
         return pos
 
     def crowded(self, S: int, before: list[int], side: _Side) -> int | None:
-        """A node j of ``before`` with more than d_j − t_j in-neighbours in the packed
-        set S (t: the thresholds of ``side``), or None."""
-        self.work += (S.bit_count() + len(before)) * self.unit
+        """A node j of ``before`` or of the side's charged nodes with more than d_j − t_j
+        in-neighbours in the packed set S (t: the thresholds of ``side``), or None."""
+        self.work += (S.bit_count() + len(before) + len(side.charged)) * self.unit
         S = self.unpack(S)
         inmask, deg, t = self.g.inmask, self.deg, side.t
-        return next((j for j in before if (inmask[j] & S).bit_count() > deg[j] - t[j]), None)
+        return next((j for j in before + side.charged
+                     if (inmask[j] & S).bit_count() > deg[j] - t[j]), None)
 
     @staticmethod
     def beyond(pos: int, ntok: int) -> str:
@@ -825,8 +829,8 @@ class _Replay:
         if t == -2:
             return f"{head}: S = {fmt(S)} is inside core(V \\ X) = {fmt(P)} (X = {fmt(X)})"
         if t == -4:
-            return (f"{head}: no earlier root has more than d_j - t_j in-neighbours in "
-                    f"S = {fmt(S)}")
+            return (f"{head}: no earlier root or charged node of its side has more than "
+                    f"d_j - t_j in-neighbours in S = {fmt(S)}")
         need1, need2 = self.sizes(S, Q, s1, s2)
         return (f"{head}: |S1| >= {need1} and |S2| >= {need2} fit in |P u Q| = "
                 f"{(P | Q).bit_count()} (S = {fmt(S)}, X = {fmt(X)}, B = {fmt(B)})")
@@ -1038,7 +1042,10 @@ def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] 
     has the configuration Q_k = reach_r(S_k), |Q1| + |Q2| = c, and U_k avoids
     Q1 ∪ Q2 with fewer than t_k(i) = r + |N(i) ∩ Q_k| in-neighbours outside U_k for
     each member (|N(i) \\ S_k| < r); such sets are closed under union, so the
-    ``search`` replay with these per-side thresholds and B ⊇ Q1 ∪ Q2 excludes them."""
+    ``search`` replay with these per-side thresholds and B ⊇ Q1 ∪ Q2 excludes them.
+    In a violating pair of least cost, grown maximal, each j ∈ Q_k stays r-reachable
+    (else a cheaper violating pair), so the -4 leaf also checks the charged nodes of
+    the enumerated side."""
     rp = _Replay(g, r, f"{where}.charged_tree")
 
     def configs() -> Iterator[tuple[int, _Side, _Side]]:
@@ -1046,7 +1053,7 @@ def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] 
             if not Q1:
                 yield 0, rp.side, rp.side
                 continue
-            a, b = (rp.threshold_side([r + (mk & Q).bit_count() for mk in g.inmask])
+            a, b = (rp.threshold_side([r + (mk & Q).bit_count() for mk in g.inmask], Q)
                     if Q else rp.side for Q in (Q1, Q2))
             yield Q1 | Q2, a, b
 

@@ -66,8 +66,8 @@ def charged_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = N
             return None  # each configuration costs about as much as the first: too many
         t1, t2 = (np.array([r + (m & q).bit_count() for m in masks], dtype=np.int64)
                   for q in (_mask(Q1), _mask(Q2)))
-        ntok = config_tree(inmask, outmask, order, t1, t2, not Q1, np.uint64(_mask(Q1 + Q2)),
-                           tokens, ntok)
+        ntok = config_tree(inmask, outmask, order, t1, t2, not Q1, np.uint64(_mask(Q1)),
+                           np.uint64(_mask(Q2)), tokens, ntok)
         if ntok == OVERFLOW:
             return None
         if ntok < 0:
