@@ -117,6 +117,16 @@ def test_cofactors_within_their_bound_of_the_exact_ones(k):
             assert err <= Fraction(c_err / 4) * Fraction(float(cof_abs[t, j]))
 
 
+def _full_sides(counts, F):
+    """The scan's counts with every subset surely holding more than F points on both
+    sides written as the numba scan may leave it after its octant prune
+    (``_candidates._prefix_octants``): F + 1 on each side, none uncertain."""
+    plus, minus, unc, degenerate = (np.array(c) for c in counts)
+    full = (plus > F) & (minus > F)
+    plus[full], minus[full], unc[full] = F + 1, F + 1, 0
+    return plus, minus, unc, degenerate
+
+
 @pytest.mark.parametrize("k,m,kind", [(4, 25, "normal"), (4, 22, "ties"), (5, 16, "normal"),
                                       (5, 15, "repeated"), (6, 12, "tiny")])
 def test_parallel_scan_equals_the_numpy_twin_exactly(k, m, kind):
@@ -128,10 +138,12 @@ def test_parallel_scan_equals_the_numpy_twin_exactly(k, m, kind):
     W = np.random.default_rng(m).integers(1, 4, size=m)
     subsets = _scan_np.k_subsets(m, k)
     c_err, floor = _scan_args(Y, kind == "ties")
-    threads = _candidates.classify_subsets(Y, W.astype(np.int64), subsets, c_err, 2, floor)
-    twin = _scan_np.classify(Y, W, subsets, c_err, 2, floor)
-    one = _candidates.classify(Y, W.astype(np.int64), subsets[:_candidates.PARALLEL_MIN_SUBSETS
-                                                              - 1], c_err, 2, floor)
+    threads = _full_sides(_candidates.classify_subsets(Y, W.astype(np.int64), subsets,
+                                                       c_err, 2, floor), 2)
+    twin = _full_sides(_scan_np.classify(Y, W, subsets, c_err, 2, floor), 2)
+    one = _full_sides(_candidates.classify(Y, W.astype(np.int64),
+                                           subsets[:_candidates.PARALLEL_MIN_SUBSETS - 1],
+                                           c_err, 2, floor), 2)
     for a, b, c in zip(threads, twin, one, strict=True):
         assert np.array_equal(a, b)
         assert np.array_equal(a[:len(c)], c)

@@ -4,10 +4,12 @@
 same float orientations s(q) = Σ_j (q − p_0)_j · C_j evaluated in the same order, the
 same coarse and precise rounding bounds, hence the same decisions — vectorised over
 all (subset, point) pairs instead of looped. For k ≤ 3 the numba scan stops a subset
-once both sides hold more than F points, so its counts above F are lower bounds; here every
-count is complete, which changes no comparison with F (a count above F stays above
-F). :mod:`.halfspaces` takes this path when the scan is small enough that numba's
-start-up (import, type registries, compiling on a cold cache) would dominate.
+once both sides hold more than F points, and for k ≥ 4 it may skip a subset whose both
+sides its prefix's octants show to hold more than F (reporting F + 1 each), so its
+counts above F are lower bounds; here every count is complete, which changes no
+comparison with F (a count above F stays above F). :mod:`.halfspaces` takes this path
+when the scan is small enough that numba's start-up (import, type registries,
+compiling on a cold cache) would dominate.
 """
 
 from __future__ import annotations
