@@ -269,7 +269,7 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
     i.e. (r, s)-robustness), if it is recorded within ``TREE_SECONDS`` (dense graphs:
     4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M), else, for
     s ≥ 2, the charged tree (charged.charged_tree: one decision tree per set of charged
-    nodes; ER(30, 0.5) with s = 2: 2.4–3.5M tokens, where the sized tree has > 30M),
+    nodes; ER(30, 0.5) with s = 2: 1.9–2.7M tokens, where the sized tree has > 30M),
     recorded within ``TREE_SECONDS``, resp. ``CHARGED_SECONDS``; the deciding method stays in
     ``info.decided_by``. Otherwise ``proof`` itself."""
     method = proof["method"]
@@ -721,7 +721,7 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
 
 
 TREE_SECONDS = 2.0  # budget for recording a replayable proof tree (search.cost_tree)
-CHARGED_SECONDS = 4.0  # budget for the charged tree (charged.charged_tree; ~1 s for 3.5M tokens)
+CHARGED_SECONDS = 4.0  # budget for the charged tree (charged.charged_tree; ~0.5 s for 2.7M tokens)
 
 
 DEEPEN_CHEAP_SECONDS = 0.1
