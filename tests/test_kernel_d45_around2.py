@@ -275,3 +275,18 @@ def test_d4_merged_proposal_keeps_qhull_default(monkeypatch):
     used = _recorded_options(monkeypatch)
     _same_as_clipping(_cloud("gaussian", 4, 20, 2), 2, monkeypatch)
     assert used and used[0] is None
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_lex_order_with_many_runs_of_ties_is_the_exact_order(seed):
+    """Points whose floats tie in runs (in the first and later columns, several runs
+    side by side, equal points) come in the exact lexicographic order."""
+    rng = np.random.default_rng(seed)
+    tiny = Fraction(1, 2**80)
+    base = [Fraction(int(v)) for v in rng.integers(0, 4, size=3)]
+    pts = [tuple(base[int(rng.integers(0, 3))] + int(rng.integers(0, 3)) * tiny
+                 for _ in range(3)) for _ in range(60)]
+    V = np.array([[float(v) for v in p] for p in pts])
+    got = km._lex_order(V, lambda i: pts[i])
+    assert [pts[i] for i in got] == sorted(pts)
+    assert sorted(got) == list(range(len(pts)))

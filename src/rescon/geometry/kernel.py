@@ -426,17 +426,19 @@ def _lex_order(V: np.ndarray, exact: Callable[[int], tuple[Fraction, ...]],
         rows = np.arange(len(V))
     order = rows[np.argsort(V[rows, col], kind="stable")]
     first = V[order, col]
-    cuts = [0, *(np.flatnonzero(first[1:] != first[:-1]) + 1).tolist(), len(order)]
-    out: list[int] = []
-    for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
-        if hi - lo == 1:
-            out.append(int(order[lo]))
-            continue
-        run = {int(i): exact(int(i)) for i in order[lo:hi]}
+    tie = np.flatnonzero(first[1:] == first[:-1])  # order[i] and order[i + 1] tie
+    out = order.tolist()
+    if not len(tie):
+        return out
+    # the runs of ties, [lo, hi): each is re-ordered in place, the rest stays
+    starts = tie[np.r_[True, tie[1:] != tie[:-1] + 1]]
+    ends = tie[np.r_[tie[1:] != tie[:-1] + 1, True]] + 2
+    for lo, hi in zip(starts.tolist(), ends.tolist(), strict=True):
+        run = {i: exact(i) for i in out[lo:hi]}
         if col + 1 < V.shape[1] and len({x[col] for x in run.values()}) == 1:
-            out += _lex_order(V, exact, order[lo:hi], col + 1)
+            out[lo:hi] = _lex_order(V, exact, order[lo:hi], col + 1)
         else:
-            out += sorted(run, key=lambda i: _lex_key(run[i][col:]))
+            out[lo:hi] = sorted(run, key=lambda i: _lex_key(run[i][col:]))
     return out
 
 
