@@ -1034,7 +1034,7 @@ def _configurations(n: int, c: int) -> Iterator[tuple[int, int]]:
 
 
 def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] | tuple,
-                    where: str) -> str:
+                    where: str, uniform: bool = False) -> str:
     """Replay a ``charged_tree`` (FORMAT.md): '' when every configuration's subtrees are
     justified, else why the replay stopped (work limit); raises Invalid on a fault.
 
@@ -1045,8 +1045,19 @@ def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] 
     ``search`` replay with these per-side thresholds and B ⊇ Q1 ∪ Q2 excludes them.
     In a violating pair of least cost, grown maximal, each j ∈ Q_k stays r-reachable
     (else a cheaper violating pair), so the -4 leaf also checks the charged nodes of
-    the enumerated side."""
+    the enumerated side.
+
+    ``uniform``: one part per type (c1, c2), c1 + c2 = s − 1, c1 ≥ c2 (by c2), with the
+    thresholds t_k(i) = r + min(c_k, d_i) ≥ r + |N(i) ∩ Q_k| for every configuration
+    with |Q1| ≤ c1, |Q2| ≤ c2, no charged nodes (closed sets for smaller thresholds are
+    closed for these, so its pairs are among the part's)."""
     rp = _Replay(g, r, f"{where}.charged_tree")
+
+    def uniform_types() -> Iterator[tuple[int, _Side, _Side]]:
+        sides = {c: rp.threshold_side([r + min(c, d) for d in rp.deg]) if c else rp.side
+                 for c in range(s)}
+        for c2 in range((s - 1) // 2 + 1):
+            yield 0, sides[s - 1 - c2], sides[c2]
 
     def configs() -> Iterator[tuple[int, _Side, _Side]]:
         for Q1, Q2 in _configurations(g.n, s - 1):
@@ -1057,18 +1068,20 @@ def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] 
                     if Q else rp.side for Q in (Q1, Q2))
             yield Q1 | Q2, a, b
 
-    return rp.run(order, tree, configs())
+    return rp.run(order, tree, uniform_types() if uniform else configs())
 
 
 def _proof_cost_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx) -> str:
-    _obj(p, where, ("method", "order"), ("info", "tree", "charged_tree"))
+    _obj(p, where, ("method", "order"), ("info", "tree", "charged_tree", "uniform"))
     order = _perm(p["order"], f"{where}.order", g.n)
     _info(p, where)
+    if "uniform" in p and (p["uniform"] is not True or p.get("charged_tree") is None):
+        raise Invalid(f"{where}.uniform must be true, and only with a charged_tree")
     if p.get("charged_tree") is not None:
         if p.get("tree") is not None:
             raise Invalid(f"{where}: 'tree' and 'charged_tree' are exclusive")
         tree = _tokens(p["charged_tree"], f"{where}.charged_tree", g.n, -4)
-        stopped = _charged_replay(g, r, s, order, tree, where)
+        stopped = _charged_replay(g, r, s, order, tree, where, "uniform" in p)
         if not stopped:
             return "cost_search (charged tree replayed)"
         return _enumerate_or_trust("cost_search", where, g, r, s, ctx, stopped)

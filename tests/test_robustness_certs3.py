@@ -13,7 +13,7 @@ from itertools import combinations
 import networkx as nx
 import pytest
 
-from rescon.graphs.charged import charged_tree
+from rescon.graphs.charged import charged_tree, uniform_tree, uniform_types
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import search_order
 from tests.test_checker import C, digraph, in_masks, is_robust, rand_edges, rho_and_s
@@ -56,24 +56,36 @@ def _refuted(n, inm, order, t1, t2, q1, S, X, B, before) -> bool:
             and _refuted(n, inm, order, t1, t2, q1, S, X | 1 << u, B, before))
 
 
-def _leafy_trees_exist(n: int, inm: list[int], r: int, s: int) -> bool:
-    """Whether every configuration (Q1, Q2), |Q1| + |Q2| ≤ s − 1 (both orders), has a
-    tree of the allowed leaves: independent of rescon and of the checker."""
-    order = sorted(range(n), key=lambda v: (inm[v].bit_count(), v))
+def _parts(n: int, inm: list[int], r: int, s: int, uniform: bool):
+    """(Q1, Q2, t1, t2) of every part, both orders: the configurations
+    |Q1| + |Q2| ≤ s − 1, or the uniform types with t_k(i) = r + min(c_k, d_i)."""
+    if uniform:
+        for c1, c2 in uniform_types(s):
+            for a, b in ((c1, c2), (c2, c1)):
+                yield 0, 0, [r + min(a, m.bit_count()) for m in inm], \
+                    [r + min(b, m.bit_count()) for m in inm]
+        return
     for size in range(s):
         for Q in combinations(range(n), size):
             for mask in range(1 << size):
                 q1 = sum(1 << v for j, v in enumerate(Q) if mask >> j & 1)
                 q2 = sum(1 << v for v in Q) & ~q1
-                t1, t2 = ([r + (m & q).bit_count() for m in inm] for q in (q1, q2))
-                B, before = q1 | q2, []
-                for v in order:
-                    if B >> v & 1:
-                        continue
-                    if not _refuted(n, inm, order, t1, t2, q1, 1 << v, B, B, before):
-                        return False
-                    B |= 1 << v
-                    before.append(v)
+                yield q1, q2, *([r + (m & q).bit_count() for m in inm] for q in (q1, q2))
+
+
+def _leafy_trees_exist(n: int, inm: list[int], r: int, s: int, uniform: bool = False) -> bool:
+    """Whether every part (:func:`_parts`) has a tree of the allowed leaves: independent
+    of rescon and of the checker."""
+    order = sorted(range(n), key=lambda v: (inm[v].bit_count(), v))
+    for q1, q2, t1, t2 in _parts(n, inm, r, s, uniform):
+        B, before = q1 | q2, []
+        for v in order:
+            if B >> v & 1:
+                continue
+            if not _refuted(n, inm, order, t1, t2, q1, 1 << v, B, B, before):
+                return False
+            B |= 1 << v
+            before.append(v)
     return True
 
 
@@ -103,11 +115,12 @@ def _rules_agree(seed, n, p):
         assert _leafy_trees_exist(n, inm, r, s_star)
         if s_star < n:
             assert not _leafy_trees_exist(n, inm, r, s_star + 1)
+            assert not _leafy_trees_exist(n, inm, r, s_star + 1, uniform=True)
 
 
-def _cert(ig, r, s, tree):
+def _cert(ig, r, s, charged, **extra):
     proof = {"method": "cost_search", "order": search_order(ig).tolist(),
-             "charged_tree": list(tree)}
+             "charged_tree": list(charged), **extra}
     return {"rescon_certificate": 1, "kind": "rs_robust", "graph": ig.graph_json(),
             "r": r, "s": s, "proof": proof}
 
@@ -174,3 +187,59 @@ def test_er30_p05_s_star_2_certificate_is_smaller():
     assert C.check(_cert(ig, 8, 2, tree)).verdict == "valid"
     k = next(k for k, t in enumerate(tree) if t >= 0)
     assert C.check(_cert(ig, 8, 2, tree[:k] + [-1] + tree[k + 1:])).verdict == "invalid"
+
+
+def test_uniform_trees_replay_and_exist_only_for_robust_claims():
+    """Brute force: a uniform tree is recorded only for s ≤ s*(r) and is valid (with
+    ``uniform``; a branch cut to a leaf is invalid); where none exists (a type has a
+    violating pair) the configurations' tree claimed as uniform is invalid; malformed
+    ``uniform`` keys are invalid."""
+    kinds = {"tree": 0, "none": 0}
+    for seed in range(30):
+        n, p = 7, (0.5, 0.7, 0.9)[seed % 3]
+        ig = index_graph(digraph(n, rand_edges(random.Random(seed), n, p)))
+        inm = in_masks(n, ig.edges())
+        r, s_star = rho_and_s(n, inm)
+        for s in range(2, min(s_star + 1, 5) + 1):
+            tree = uniform_tree(ig, r, s)
+            if s > s_star:
+                assert tree is None
+            elif tree is not None:
+                kinds["tree"] += 1
+                assert C.check(_cert(ig, r, s, tree, uniform=True)).verdict == "valid"
+                k = next((k for k, t in enumerate(tree) if t >= 0), None)
+                if k is not None:
+                    bad = list(tree[:k]) + [-1] + list(tree[k + 1:])
+                    assert C.check(_cert(ig, r, s, bad, uniform=True)).verdict == "invalid"
+            else:
+                kinds["none"] += 1
+                last = ig, r, s, charged_tree(ig, r, s)
+                assert C.check(_cert(*last)).verdict == "valid"
+                assert C.check(_cert(*last, uniform=True)).verdict == "invalid"
+    assert min(kinds.values()) >= 3
+    for extra in ({"uniform": False}, {"uniform": 1}, {"uniform": True, "tree": [-1]}):
+        assert C.check(_cert(*last, **extra)).verdict == "invalid"
+
+
+def test_robustness_attaches_the_smaller_charged_tree(monkeypatch):
+    """_replayed: without a sized tree, the uniform tree when it is the smaller (its
+    proof carries ``uniform``), else the configurations' tree; both valid."""
+    from rescon.graphs import robustness as rb
+
+    monkeypatch.setattr(rb, "cost_tree", lambda *a, **k: None)
+    seen = set()
+    for seed in range(40):
+        ig = index_graph(nx.gnp_random_graph(9, 0.6, directed=True, seed=seed))
+        r, s = rho_and_s(9, in_masks(9, ig.edges()))
+        if s < 2:
+            continue
+        proof = rb._replayed(ig, r, s, {"method": "milp", "solver": "highs"}, None)
+        uniform, configs = uniform_tree(ig, r, s), charged_tree(ig, r, s)
+        smaller = uniform is not None and len(uniform) < len(configs)
+        assert proof.get("uniform", False) is smaller
+        assert list(proof["charged_tree"]) == list(uniform if smaller else configs)
+        res = C.check({"rescon_certificate": 1, "kind": "rs_robust",
+                       "graph": ig.graph_json(), "r": r, "s": s, "proof": proof})
+        assert res.verdict == "valid"
+        seen.add(smaller)
+    assert seen == {True, False}

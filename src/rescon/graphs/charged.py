@@ -21,7 +21,8 @@ import numpy as np
 
 from .indexed import IndexedGraph
 
-__all__ = ["MAX_CONFIGS", "charged_tree", "configurations", "count_configurations"]
+__all__ = ["MAX_CONFIGS", "charged_tree", "configurations", "count_configurations", "uniform_tree",
+           "uniform_types"]
 
 MAX_CONFIGS = 20_000  # beyond, no charged tree is tried (each configuration costs ≥ n tokens)
 
@@ -51,28 +52,70 @@ def charged_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = N
     the first configuration's tree times the number of configurations passes twice that),
     ``MAX_CONFIGS`` configurations or ``deadline``; ValueError when a configuration has
     a violating pair (a pair cheaper than s)."""
-    from ._charged_kernels import OVERFLOW, config_tree
-    from .search import _kernel_inputs
-
     count = count_configurations(ig.n, s - 1)
     if r < 1 or count > MAX_CONFIGS:
         return None
-    _, inmask, outmask, order = _kernel_inputs(ig)
     masks = ig.in_masks()
+    parts = ((Q1, Q2, *(tuple(r + (m & _mask(Q)).bit_count() for m in masks) for Q in (Q1, Q2)))
+             for Q1, Q2 in configurations(ig.n, s - 1))
+    try:
+        return _record(ig, parts, count, deadline, max_tokens)
+    except _Violated as exc:
+        raise ValueError(f"the configuration Q1 = {exc.args[0]}, Q2 = {exc.args[1]} has a "
+                         f"pair cheaper than s = {s}") from None
+
+
+def uniform_types(s: int) -> list[tuple[int, int]]:
+    """The types (c1, c2) of a uniform charged tree: c1 + c2 = s − 1, c1 ≥ c2, by c2."""
+    return [(s - 1 - c2, c2) for c2 in range((s - 1) // 2 + 1)]
+
+
+def uniform_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = None,
+                 max_tokens: int = 4_000_000) -> tuple[int, ...] | None:
+    """The *uniform* charged tree proving (r, s)-robustness (certificates/FORMAT.md): for
+    each type (c1, c2) of :func:`uniform_types`, the decision tree for the thresholds
+    t_k(i) = r + min(c_k, d_i) and no charged node, which covers every configuration
+    with |Q1| ≤ c1, |Q2| ≤ c2 at once (r + |N(i) ∩ Q_k| ≤ t_k(i)). None for r < 1 or
+    s < 2, beyond ``max_tokens`` or ``deadline``, or when a type has a violating pair
+    (always for s ≥ 3 at r = ρ: (1, 1) asks for two (r + 1)-closed sets; ER(30, 0.5),
+    s = 2: one of three graphs, 0.33M tokens where the configurations take 2.2M)."""
+    if r < 1 or s < 2:
+        return None
+    deg = ig.in_degrees
+    parts = (((), (), *(tuple(r + min(c, d) for d in deg) for c in types))
+             for types in uniform_types(s))
+    try:
+        return _record(ig, parts, len(uniform_types(s)), deadline, max_tokens)
+    except _Violated:
+        return None
+
+
+class _Violated(Exception):
+    """A part of a charged tree has a violating pair; args: its (Q1, Q2)."""
+
+
+def _record(ig: IndexedGraph, parts: Iterator[tuple], count: int, deadline: float | None,
+            max_tokens: int) -> tuple[int, ...] | None:
+    """The concatenated trees of ``parts`` (Q1, Q2, t1, t2: the charged nodes, which the
+    -4 leaf checks, and the thresholds; one side when Q1 = ∅ and t1 = t2); None beyond
+    ``max_tokens`` (also when the first part's tree times ``count`` passes twice that)
+    or ``deadline``; raises _Violated for a part with a violating pair."""
+    from ._charged_kernels import OVERFLOW, config_tree
+    from .search import _kernel_inputs
+
+    _, inmask, outmask, order = _kernel_inputs(ig)
     tokens = np.empty(max_tokens, dtype=np.int32)
     ntok = 0
-    for index, (Q1, Q2) in enumerate(configurations(ig.n, s - 1)):
+    for index, (Q1, Q2, t1, t2) in enumerate(parts):
         if index == 1 and ntok * count > 2 * max_tokens:
-            return None  # each configuration costs about as much as the first: too many
-        t1, t2 = (np.array([r + (m & q).bit_count() for m in masks], dtype=np.int64)
-                  for q in (_mask(Q1), _mask(Q2)))
-        ntok = config_tree(inmask, outmask, order, t1, t2, not Q1, np.uint64(_mask(Q1)),
-                           np.uint64(_mask(Q2)), tokens, ntok)
+            return None  # each part costs about as much as the first: too many
+        ntok = config_tree(inmask, outmask, order, np.array(t1, dtype=np.int64),
+                           np.array(t2, dtype=np.int64), not Q1 and t1 == t2,
+                           np.uint64(_mask(Q1)), np.uint64(_mask(Q2)), tokens, ntok)
         if ntok == OVERFLOW:
             return None
         if ntok < 0:
-            raise ValueError(f"the configuration Q1 = {Q1}, Q2 = {Q2} has a pair cheaper "
-                             f"than s = {s}")
+            raise _Violated(Q1, Q2)
         if deadline is not None and time.perf_counter() > deadline:
             return None
     return tuple(tokens[:ntok].tolist())

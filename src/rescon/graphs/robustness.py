@@ -39,7 +39,7 @@ from .._progress import progress_bar
 from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
-from .charged import charged_tree
+from .charged import charged_tree, uniform_tree
 from .distributed import searches_for
 from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
@@ -269,31 +269,49 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
     i.e. (r, s)-robustness), if it is recorded within ``TREE_SECONDS`` (dense graphs:
     4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M), else, for
     s ≥ 2, the charged tree (charged.charged_tree: one decision tree per set of charged
-    nodes; ER(30, 0.5) with s = 2: 1.9–2.7M tokens, where the sized tree has > 30M),
-    recorded within ``TREE_SECONDS``, resp. ``CHARGED_SECONDS``; the deciding method stays in
-    ``info.decided_by``. Otherwise ``proof`` itself."""
+    nodes; ER(30, 0.5) with s = 2: 1.9–2.7M tokens, where the sized tree has > 30M) or,
+    when it is smaller, the uniform charged tree (charged.uniform_tree: one decision tree
+    per type of charges), recorded within ``TREE_SECONDS``, resp. ``CHARGED_SECONDS``; the
+    deciding method stays in ``info.decided_by``. Otherwise ``proof`` itself."""
     method = proof["method"]
     if (ig.n > MAX_SEARCH_NODES
             or not (method == "milp" or method == "dp" and ig.n > MAX_ENUM_N
                     or method in ("search", "cost_search") and proof.get("tree") is None
                     and proof.get("charged_tree") is None)):
         return proof
-    key, tree = "tree", _recorded(cost_tree, ig, r, s, deadline, TREE_SECONDS)
+    key, tree, extra = "tree", _recorded(cost_tree, ig, r, s, deadline, TREE_SECONDS), {}
     if tree is None and s >= 2:
-        key, tree = "charged_tree", _recorded(charged_tree, ig, r, s, deadline, CHARGED_SECONDS)
+        key, (tree, extra) = "charged_tree", _charged(ig, r, s, deadline)
     if tree is None:
         return proof
     return {"method": "cost_search", "order": search_order(ig).tolist(), key: list(tree),
-            "info": {**proof.get("info", {}), "decided_by": method}}
+            **extra, "info": {**proof.get("info", {}), "decided_by": method}}
+
+
+def _charged(ig: IndexedGraph, r: int, s: int, deadline: float | None
+             ) -> tuple[tuple[int, ...] | None, dict[str, bool]]:
+    """(the charged tree of (r, s)-robustness, the proof's extra keys): the smaller of
+    the two kinds recorded within ``CHARGED_SECONDS`` (the configurations' tree only
+    below the uniform one's size; ``{"uniform": True}`` for the uniform one), or
+    (None, {})."""
+    stop = time.perf_counter() + CHARGED_SECONDS
+    stop = stop if deadline is None else min(stop, deadline)
+    uniform = _recorded(uniform_tree, ig, r, s, stop, CHARGED_SECONDS)
+    limit = {} if uniform is None else {"max_tokens": max(1, len(uniform) - 1)}
+    tree = _recorded(charged_tree, ig, r, s, stop, CHARGED_SECONDS, **limit)
+    if tree is not None or uniform is None:
+        return tree, {}
+    return uniform, {"uniform": True}
 
 
 def _recorded(record: Callable[..., tuple[int, ...] | None], ig: IndexedGraph, r: int, s: int,
-              deadline: float | None, seconds: float) -> tuple[int, ...] | None:
-    """The tree ``record`` (search.cost_tree or charged.charged_tree) proving
-    (r, s)-robustness within ``seconds``, or None."""
+              deadline: float | None, seconds: float, **limits: int) -> tuple[int, ...] | None:
+    """The tree ``record`` (search.cost_tree, charged.charged_tree or uniform_tree)
+    proving (r, s)-robustness within ``seconds`` (``limits``: its token limit), or None."""
     stop = time.perf_counter() + seconds
     try:
-        return record(ig, r, s, deadline=stop if deadline is None else min(stop, deadline))
+        return record(ig, r, s, deadline=stop if deadline is None else min(stop, deadline),
+                      **limits)
     except ValueError as exc:
         raise RESCONError(f"internal error: ({r}, {s})-robustness was proven, "
                           f"but {exc}") from exc
