@@ -135,14 +135,16 @@ def _prefix_octants(Y, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S, T, oc
     on the prefix's directions, so of rank ≤ 2: ω = α ∧ β for two linear forms. The
     subset (prefix, p) sees q on the side sign ω(p − p_0, q − p_0) (the scan's
     orientation s(q)). Take the columns a ≠ b of the largest prefix minor |ω(e_a, e_b)|
-    and P(v) = (ω(e_a, v), ω(e_b, v)) = M (α(v), β(v)) with det M = ω(e_a, e_b), so
+    and P(v) = (ω(e_a, v), ω(e_b, v)) = L (α(v), β(v)) with det L = ω(e_a, e_b), so
     cross(P(u), P(v)) = ω(e_a, e_b) ω(u, v): the hyperplane through the prefix and p
     separates the points q as the line through 0 and P(p − p_0) separates the P(q − p_0)
-    in the plane. Each coordinate of P is an orientation whose last difference row is
-    a unit vector, computed as the scan computes s(q), so within its coarse bound
-    e = c_err · 2M · Σ_j |C|_j + floor; a point counts in an open octant only when
-    every comparison clears the bounds: |x̃| > e, |ỹ| > e, and fl(|x̃| − |ỹ|) beyond
-    ±2e (rounding is monotone, so fl(u) > 2e implies u > 2e)."""
+    in the plane (if ω(e_a, e_b) = 0, every P lies on one line through 0, so no point
+    is strictly off the line and nothing is counted on a side). Each coordinate of P
+    is an orientation whose last difference row is a unit vector, computed as the scan
+    computes s(q), so within its coarse bound e = c_err · 2M · Σ_j |C|_j + floor (M =
+    max |coordinate|; the scan's own, :func:`classify_subsets`); a point counts in an
+    open octant only when every comparison clears the bounds: |x̃| > e, |ỹ| > e, and
+    fl(|x̃| − |ỹ|) beyond ±2e (rounding is monotone, so fl(u) > 2e implies u > 2e)."""
     n = Y.shape[0]
     full = (1 << k) - 1
     a, b, top = 0, 1, -1.0
