@@ -7,7 +7,8 @@ t_k(i) = r + |N(i) ∩ Q_k| (see _charged_kernels). The configurations (Q1, Q2) 
 :func:`configurations`; each gets the decision search's tree for its thresholds, all
 concatenated: the ``charged_tree`` of a ``cost_search`` proof (certificates/FORMAT.md).
 Small when s is small and the decision trees are (sparse and medium graphs, where the
-sized search's tree is not).
+sized search's tree is not). The *uniform* charged tree (:func:`uniform_tree`) covers
+all configurations with one tree per type (|Q1| ≤ c1, |Q2| ≤ c2) when such trees exist.
 """
 
 from __future__ import annotations
@@ -77,8 +78,8 @@ def uniform_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = N
     t_k(i) = r + min(c_k, d_i) and no charged node, which covers every configuration
     with |Q1| ≤ c1, |Q2| ≤ c2 at once (r + |N(i) ∩ Q_k| ≤ t_k(i)). None for r < 1 or
     s < 2, beyond ``max_tokens`` or ``deadline``, or when a type has a violating pair
-    (always for s ≥ 3 at r = ρ: (1, 1) asks for two (r + 1)-closed sets; ER(30, 0.5),
-    s = 2: one of three graphs, 0.33M tokens where the configurations take 2.2M)."""
+    (always for s ≥ 3 at r = ρ: (1, 1) asks for two (r + 1)-closed sets). ER(30, 0.5),
+    s = 2: on one graph of three, 0.33M tokens where the configurations take 2.2M."""
     if r < 1 or s < 2:
         return None
     deg = ig.in_degrees
