@@ -221,3 +221,22 @@ def test_forcing_searches_agree_with_the_dp_on_1500_digraphs():
         ig = index_graph(nx.gnp_random_graph(n, rng.choice(DENSITIES), directed=True,
                                              seed=rng.randrange(10**6)))
         _agrees_with_the_dp(ig, rng.randint(0, n))
+
+
+# digraphs on which both ρ and s*(ρ) ≥ 2 come from the searches (not the bounds)
+SEARCHED = [(15, 0.7, 0), (16, 0.6, 19), (15, 0.7, 20), (15, 0.7, 27), (16, 0.85, 11),
+            (16, 0.85, 8)]
+
+
+@pytest.mark.parametrize("n, p, seed", SEARCHED)
+def test_searches_agree_with_the_milp_through_the_api(n, p, seed):
+    """robustness(method="search") — ρ by the decision search, s*(ρ) by the deepening
+    s* searches, whose charged-set engine forces — against the MILP; the certificate
+    checks."""
+    from rescon import check_certificate, robustness
+
+    G = nx.gnp_random_graph(n, p, directed=True, seed=seed)
+    by_search, by_milp = robustness(G, method="search"), robustness(G, method="milp")
+    assert by_search.method == "search+search" and by_search.s_max >= 2
+    assert (by_search.r_max, by_search.s_max) == (by_milp.r_max, by_milp.s_max)
+    assert check_certificate(by_search.certificate).valid
