@@ -295,13 +295,16 @@ def test_probed_pairs_cost_what_they_claim(G, data):
         assert all(c > floor for c in costs[:-1])
 
 
-def test_near_bisection_probe_finds_the_cost_1_pair():
+def test_near_bisection_probe_finds_the_cost_1_pair(monkeypatch):
     """ER(50, 0.8), seed 50001, r = 21 (ρ = 21, s* = 1): the tabu walks stop at cost 2,
     the probes find the cost-1 pair at sizes (24, 26), and _descended_upper settles
-    s* = 1 with the proven lower bound 1."""
+    s* = 1 with the proven lower bound 1. (The probes' 1 s budget is raised: the pair
+    takes 0.4–1.3 s of wall time on a loaded machine; what is tested is the wiring.)"""
     import time as _time
 
     from rescon.graphs import robustness as rb
+
+    monkeypatch.setattr(rb, "PROBE_SECONDS", 30.0)
 
     ig = index_graph(nx.gnp_random_graph(50, 0.8, directed=True, seed=50001))
     found = bd.probed_pairs(ig, 21, floor=1, below=2, deadline=_time.perf_counter() + 30)
