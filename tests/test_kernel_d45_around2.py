@@ -290,3 +290,19 @@ def test_lex_order_with_many_runs_of_ties_is_the_exact_order(seed):
     got = km._lex_order(V, lambda i: pts[i])
     assert [pts[i] for i in got] == sorted(pts)
     assert sorted(got) == list(range(len(pts)))
+
+
+def test_centre_moves_only_data_far_from_the_origin_against_its_spread():
+    """Data near the origin (against its spread) is clipped where it is; states
+    converged far from it are moved to their median (their float offsets would keep no
+    precision), unless a difference is no longer a float times the scale."""
+    near = [(3, -4), (5, 2), (-1, 7)]
+    assert km._centre(near) == [0, 0]
+    far = [(v + 2**40, w + 2**40) for v, w in near]
+    assert km._centre(far) == [3 + 2**40, 2 + 2**40]
+    assert km._centre([(v * 2**70, w * 2**70) for v, w in far]) == [
+        (3 + 2**40) * 2**70, (2 + 2**40) * 2**70]
+    wide = [(2**40 + 1, 2**40), (2**40 + 2**60 + 1, 2**40 + 1), (2**40, 2**40 + 2)]
+    assert km._centre(wide) == [0, 0]  # spread 2^60: the origin is near enough
+    odd = [(2**80, 2**80), (2**80 + 2**55 + 1, 2**80 + 1), (2**80 + 3, 2**80 + 2**55 + 1)]
+    assert km._centre(odd) == [0, 0]  # 2^55 − 2 from the median: odd part ≥ 2^53
