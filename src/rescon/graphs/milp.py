@@ -136,6 +136,7 @@ class RobustnessMilp:
                   np.array(value, dtype=np.float64))
         self.h = h
         self._thread = None
+        self._unpresolved = False  # presolve switched off after a solve error
         self._t0 = 0.0
         if on_progress is not None:
             self._span = (lower, max(upper - lower, 1), on_progress)
@@ -186,6 +187,14 @@ class RobustnessMilp:
         h = self.h
         S = self._highspy.HighsModelStatus
         status = h.getModelStatus()
+        if status == S.kSolveError and not self._unpresolved:
+            # HiGHS 1.16's presolve can reduce a model to empty with a point that breaks
+            # a row and report a solve error (5 nodes, tests/test_review_v6.py): once more
+            # without presolve
+            self._unpresolved = True
+            h.setOptionValue("presolve", "off")
+            self.start()
+            return self.outcome()
         if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
             # every variable is a bounded binary: the model cannot be unbounded
             return MilpOutcome("infeasible", None, None, seconds)
