@@ -500,6 +500,15 @@ def _bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
     return out
 
 
+def _row_table(H, Ts: list[list[int]], k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lists Ts of k rows as an int64 array B, the homogeneous rows E of the distinct
+    rows in B (:func:`_homogeneous`, the row at infinity last) and the position in E of
+    each entry of B."""
+    B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
+    used, at = np.unique(B, return_inverse=True)
+    return B, at.reshape(B.shape), _homogeneous(H, used.tolist(), k)
+
+
 def _one_per_point(H, Ts: list[list[int]], k: int) -> np.ndarray:
     """The proposals to solve exactly, increasing: the first of those sharing a modular
     key (:func:`._certify_nb.point_keys`: the joggled pieces of one non-simple vertex
@@ -510,12 +519,10 @@ def _one_per_point(H, Ts: list[list[int]], k: int) -> np.ndarray:
 
     if not Ts:
         return np.zeros(0, dtype=np.int64)
-    B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
-    used, at = np.unique(B, return_inverse=True)
-    E = np.array([[v % KEY_PRIME for v in e] for e in
-                  _homogeneous(H, used.tolist(), k)[:-1].tolist()], dtype=np.int64)
+    _, at, E = _row_table(H, Ts, k)
+    residues = np.array([[v % KEY_PRIME for v in e] for e in E[:-1].tolist()], dtype=np.int64)
     keys = np.zeros((len(Ts), k), dtype=np.int64)
-    ok = point_keys(E, at.reshape(B.shape), keys)
+    ok = point_keys(residues, at, keys)
     first = np.flatnonzero(ok)[np.unique(keys[ok], axis=0, return_index=True)[1]]
     return np.sort(np.concatenate([first, np.flatnonzero(~ok)]))
 
@@ -534,10 +541,7 @@ def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     x_0 > 0 is the answer."""
     if not Ts:
         return []
-    B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
-    used, at = np.unique(B, return_inverse=True)
-    at = at.reshape(B.shape)
-    E = _homogeneous(H, used.tolist(), k)
+    B, at, E = _row_table(H, Ts, k)
     A = np.array([[v % PRIME for v in a] for a in E[:-1, 1:].tolist()], dtype=np.int64)
     sure = _det_mod(A[at], PRIME) != 0
     out: list[tuple[int, ...] | None] = [None] * len(Ts)
