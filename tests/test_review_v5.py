@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import pickle
+import warnings
 from fractions import Fraction
 
 import numpy as np
@@ -185,3 +186,44 @@ def test_hostile_kernels_identical_to_the_exact_clipping(kind, d, n, F, monkeypa
     assert back.exact_vertices == K.exact_vertices
     assert back._exact.constraints == K._exact.constraints
     assert back.certificate == K.certificate
+
+
+@pytest.mark.parametrize("kind,d,n,F", [pytest.param("aniso", 4, 16, 2, marks=pytest.mark.slow),
+                                        ("collinear", 4, 16, 3),
+                                        ("subnormal_int", 4, 16, 1), ("cross", 5, 15, 3)])
+def test_joggled_hostile_kernels_identical_to_the_exact_clipping(kind, d, n, F,
+                                                                 monkeypatch):
+    """Joggled proposals only (one modular key per point, the rest dropped): the same
+    kernels as the exact clipping."""
+    from rescon.geometry import fastpath
+
+    monkeypatch.setattr(fastpath, "QHULL_OPTIONS", ("QJ",))
+    _same_as_clipping(_hostile(kind, d, n, 7), F, monkeypatch)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("d,N", [(4, 10), (5, 8)])
+def test_simulate_d45_identical_without_the_fast_path(d, N, monkeypatch):
+    """simulate in d = 4–5 with the kernel algorithm (safe-kernel points of the
+    converging states): trajectories and every monitor bit-identical with the fast
+    path switched off."""
+    import networkx as nx
+
+    from rescon.consensus.adversaries import RandomInBox
+    from rescon.consensus.engine import simulate
+    from rescon.consensus.scenario import Scenario
+    from rescon.geometry import kernel as km
+
+    x0 = np.random.default_rng(d).normal(size=(N, d))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sc = Scenario(nx.complete_graph(N), x0, 1, adversaries={0: RandomInBox(3.0)},
+                      steps=4 if d == 4 else 2, algorithm="kernel", seed=3, model="total",
+                      check_robustness=False)
+        fast = simulate(sc, progress=False)
+        monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
+        slow = simulate(sc, progress=False)
+    assert np.asarray(fast.states).tobytes() == np.asarray(slow.states).tobytes()
+    assert fast.metrics.keys() == slow.metrics.keys()
+    for name, values in fast.metrics.items():
+        assert np.asarray(values).tobytes() == np.asarray(slow.metrics[name]).tobytes(), name
