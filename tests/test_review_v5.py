@@ -162,7 +162,8 @@ def test_pruned_subsets_have_more_than_F_points_on_both_sides(seed, kind, k, F):
         assert not dependent and plus > F and minus > F
 
 
-KERNELS = [("aniso", 4, 16, 0), ("aniso", 4, 16, 2), ("collinear", 4, 16, 3),
+KERNELS = [("aniso", 4, 16, 0), pytest.param("aniso", 4, 16, 2, marks=pytest.mark.slow),
+           ("collinear", 4, 16, 3),
            ("ulps", 4, 16, 2), ("ulps", 5, 15, 2), ("big_offset", 4, 16, 0),
            ("subnormal_int", 4, 16, 1), ("cross", 4, 16, 2), ("cross", 5, 15, 3),
            ("cell24", 4, 26, 4), ("cell24", 4, 24, 1),
