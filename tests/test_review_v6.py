@@ -154,3 +154,67 @@ def test_no_tree_of_checker_justified_leaves_proves_a_false_claim():
 def test_no_tree_of_checker_justified_leaves_proves_a_false_claim_more():
     counts = _adversary(range(40, 240), 9)
     assert counts["true"] >= 500 and counts["false"] >= 250
+
+
+def _part_trees(ig, r: int, s: int, uniform: bool) -> list[list[int]]:
+    """The tree of each part of the charged (or uniform) tree, recorded one by one."""
+    import numpy as np
+
+    from rescon.graphs import charged as ch
+    from rescon.graphs._charged_kernels import config_tree
+    from rescon.graphs.search import _kernel_inputs
+
+    _, inmask, outmask, order = _kernel_inputs(ig)
+    masks, deg = ig.in_masks(), ig.in_degrees
+    if uniform:
+        parts = [((), (), [r + min(c1, d) for d in deg], [r + min(c2, d) for d in deg])
+                 for c1, c2 in ch.uniform_types(s)]
+    else:
+        parts = [(Q1, Q2, *([r + (m & ch._mask(Q)).bit_count() for m in masks] for Q in (Q1, Q2)))
+                 for Q1, Q2 in ch.configurations(ig.n, s - 1)]
+    out = []
+    for Q1, Q2, t1, t2 in parts:
+        buf = np.empty(1 << 16, dtype=np.int32)
+        k = config_tree(inmask, outmask, order, np.array(t1, dtype=np.int64),
+                        np.array(t2, dtype=np.int64), not Q1 and t1 == t2,
+                        np.uint64(ch._mask(Q1)), np.uint64(ch._mask(Q2)), buf, 0)
+        assert k >= 0
+        out.append(buf[:k].tolist())
+    return out
+
+
+def test_a_charged_tree_without_one_of_its_parts_is_invalid():
+    """Charged and uniform trees (s = 2, 3) of random digraphs: the parts recorded one by
+    one concatenate to the recorded tree, which is valid; without any one part (a
+    configuration or a type dropped) it is invalid."""
+    from rescon.graphs.charged import charged_tree, uniform_tree
+    from rescon.graphs.indexed import index_graph
+    from rescon.graphs.search import search_order
+    from tests.test_checker import digraph
+
+    dropped = 0
+    for seed in range(30):
+        rng = random.Random(seed)
+        n = rng.randint(3, 7)
+        ig = index_graph(digraph(n, rand_edges(rng, n, rng.choice([0.5, 0.7, 0.9, 1.0]))))
+        r, s_star = rho_and_s(n, in_masks(n, ig.edges()))
+        for s in range(2, min(s_star, 3) + 1) if r else ():
+            for uniform in (False, True):
+                if uniform and uniform_tree(ig, r, s) is None:
+                    continue
+                parts = _part_trees(ig, r, s, uniform)
+                whole = sum(parts, [])
+                assert whole == list((uniform_tree if uniform else charged_tree)(ig, r, s))
+
+                def verdict(tree, uniform=uniform, s=s, r=r, ig=ig):
+                    proof = {"method": "cost_search", "order": search_order(ig).tolist(),
+                             "charged_tree": tree, **({"uniform": True} if uniform else {})}
+                    return C.check({"rescon_certificate": 1, "kind": "rs_robust",
+                                    "graph": ig.graph_json(), "r": r, "s": s,
+                                    "proof": proof}).verdict
+
+                assert verdict(whole) == "valid"
+                for k in range(len(parts)):
+                    assert verdict(sum(parts[:k] + parts[k + 1:], [])) == "invalid", (seed, s, k)
+                    dropped += 1
+    assert dropped >= 100
