@@ -17,7 +17,8 @@ if it is small); for s*, the
 subset DP (n ≤ 22), else the two s* branch and bounds of search.min_cost_pair
 (charged-set, sized) raced against the MILP (n ≤ 64), else the MILP; an s* proof the
 checker would take on trust gets the sized search's tree below s* instead, if it is
-small, else the charged tree (one decision tree per set of charged nodes; _replayed).
+small, else the smaller charged tree (one decision tree per set of charged nodes, or
+per type of charges: the uniform one; _replayed).
 
 Before any search, every fact already proven about the same graph in this process
 (facts.py: a bounded cache keyed by node labels and edges) is used through the
@@ -739,7 +740,7 @@ def _cost_search_result(ig: IndexedGraph, r: int, out: CostOutcome, lower: int, 
 
 
 TREE_SECONDS = 2.0  # budget for recording a replayable proof tree (search.cost_tree)
-CHARGED_SECONDS = 4.0  # budget for the charged tree (charged.charged_tree; ~0.5 s for 2.7M tokens)
+CHARGED_SECONDS = 4.0  # budget for both charged trees (charged.py; ~0.5 s for 2.7M tokens)
 
 
 DEEPEN_CHEAP_SECONDS = 0.1
