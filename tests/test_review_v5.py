@@ -98,9 +98,9 @@ def _check_octants(Y: np.ndarray, idx: np.ndarray, exact: bool) -> int:
     C, Cabs, S, T = np.empty(k), np.empty(k), np.empty(m), np.empty(m)
     octant, weight = np.empty(m, dtype=np.int64), np.zeros(9, dtype=np.int64)
     _candidates._prefix_minors(Y, idx, k, R, mdet, mper)
-    _candidates._prefix_octants(Y, idx, k, R, mdet, mper, c_err, floor,
-                                float(np.abs(Y).max()), C, Cabs, S, T, octant, weight,
-                                np.ones(m, dtype=np.int64))
+    _candidates._prefix_octants(Y, np.ascontiguousarray(Y.T), idx, k, R, mdet, mper, c_err,
+                                floor, float(np.abs(Y).max()), C, Cabs, S, T, octant,
+                                weight, np.ones(m, dtype=np.int64))
     full = (1 << k) - 1
     a, b, top = 0, 1, -1.0  # the columns of the largest minor, as the filter picks them
     for i, j in itertools.combinations(range(k), 2):

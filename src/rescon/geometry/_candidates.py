@@ -125,8 +125,8 @@ def _expand_cofactors(R, k, mdet, mper, C, Cabs):
 
 
 @njit(cache=True, nogil=True)
-def _prefix_octants(Y, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S, T, octant,
-                    weight, W):
+def _prefix_octants(Y, YT, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S, T,
+                    octant, weight, W):
     """For k ≥ 4 and the prefix p_0..p_{k−2} of ``idx`` (its minors in mdet, mper:
     :func:`_prefix_minors`): each point's open octant (0..7, 8 when not sure) in the
     plane of the prefix, and the weight of each (``weight``, 9 entries).
@@ -153,10 +153,10 @@ def _prefix_octants(Y, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S, T, oc
             v = abs(mdet[full ^ (1 << i) ^ (1 << j)])
             if v > top:
                 a, b, top = i, j, v
-    e = max(_unit_row_orientations(Y, idx, k, a, R, mdet, mper, c_err, floor, M, C, Cabs,
-                                   S),
-            _unit_row_orientations(Y, idx, k, b, R, mdet, mper, c_err, floor, M, C, Cabs,
-                                   T))
+    e = max(_unit_row_orientations(Y, YT, idx, k, a, R, mdet, mper, c_err, floor, M, C,
+                                   Cabs, S),
+            _unit_row_orientations(Y, YT, idx, k, b, R, mdet, mper, c_err, floor, M, C,
+                                   Cabs, T))
     for o in range(9):
         weight[o] = 0
     for q in range(n):
@@ -166,24 +166,18 @@ def _prefix_octants(Y, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S, T, oc
 
 
 @njit(cache=True, nogil=True)
-def _unit_row_orientations(Y, idx, k, axis, R, mdet, mper, c_err, floor, M, C, Cabs, out):
+def _unit_row_orientations(Y, YT, idx, k, axis, R, mdet, mper, c_err, floor, M, C, Cabs,
+                           out):
     """ω(e_axis, q − p_0) for every point q into ``out`` (:func:`_prefix_octants`), as the
-    scan computes orientations; returns their coarse error bound."""
+    scan computes orientations (:func:`_orientations`); returns their coarse error
+    bound."""
     for j in range(k):
         R[k - 2, j] = 1.0 if j == axis else 0.0
     _expand_cofactors(R, k, mdet, mper, C, Cabs)
     perm = 0.0
     for j in range(k):
         perm += Cabs[j]
-    p0 = idx[0]
-    n = Y.shape[0]
-    x, c = Y[p0, 0], C[0]
-    for q in range(n):
-        out[q] = (Y[q, 0] - x) * c
-    for j in range(1, k):
-        x, c = Y[p0, j], C[j]
-        for q in range(n):
-            out[q] += (Y[q, j] - x) * c
+    _orientations(Y, YT, idx[0], C, out)
     return perm * c_err * 2.0 * M + floor
 
 
@@ -329,20 +323,14 @@ def _scan3(Y, W, i0, i1, i2, C, Cabs, coarse, c_err, floor, F):
 @njit(cache=True, nogil=True, inline="always")
 def _scan_all(Y, YT, W, idx, C, Cabs, coarse, c_err, floor, S):
     """The point scan of _classify_range for k ≥ 4: the orientations s(q) of every
-    point at once into S (coordinate by coordinate over the rows of YT = Yᵀ — loops
-    the compiler vectorises; each s(q) summed in the order j = 0..k−1, as the other
-    scans), their signs against the coarse bound counted without branches, the
-    subset's own points taken out again, and only the points within the coarse bound
-    (or NaN) tested against their precise one. No early stop: the counts are exact."""
+    point at once into S (:func:`_orientations`, each summed in the order j = 0..k−1,
+    as the other scans), their signs against the coarse bound counted without
+    branches, the subset's own points taken out again, and only the points within the
+    coarse bound (or NaN) tested against their precise one. No early stop: the counts
+    are exact."""
     n, k = Y.shape
     p0 = idx[0]
-    x, c, yt = Y[p0, 0], C[0], YT[0]
-    for q in range(n):
-        S[q] = (yt[q] - x) * c
-    for j in range(1, k):
-        x, c, yt = Y[p0, j], C[j], YT[j]
-        for q in range(n):
-            S[q] += (yt[q] - x) * c
+    _orientations(Y, YT, p0, C, S)
     np_, nm, near = _coarse_counts(S, W, coarse, 0, n)
     for i in range(k):  # the subset's own points
         a, b, e = _coarse_counts(S, W, coarse, idx[i], idx[i] + 1)
@@ -359,6 +347,21 @@ def _scan_all(Y, YT, W, idx, C, Cabs, coarse, c_err, floor, S):
             bound += abs(Y[q, j] - Y[p0, j]) * Cabs[j]
         np_, nm, nu = _tally(_side(s, bound * c_err + floor, c_err), W[q], np_, nm, nu)
     return np_, nm, nu
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _orientations(Y, YT, p0, C, S):
+    """s(q) = Σ_j (q − p_0)_j C_j of every point q into S, summed in the order
+    j = 0..k − 1, coordinate by coordinate over the rows of YT = Yᵀ (loops the
+    compiler vectorises)."""
+    n, k = Y.shape
+    x, c, yt = Y[p0, 0], C[0], YT[0]
+    for q in range(n):
+        S[q] = (yt[q] - x) * c
+    for j in range(1, k):
+        x, c, yt = Y[p0, j], C[j], YT[j]
+        for q in range(n):
+            S[q] += (yt[q] - x) * c
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -421,8 +424,8 @@ def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
                 # lexicographic order ends with the last point n − 1
                 pruning = counting and n - 1 - idx[k - 2] >= PRUNE_MIN_RUN
                 if pruning:
-                    _prefix_octants(Y, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S,
-                                    T, octant, weight, W)
+                    _prefix_octants(Y, YT, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs,
+                                    S, T, octant, weight, W)
             if pruning and _both_sides_full(octant, weight, idx[k - 1], F):
                 plus[t], minus[t] = F + 1, F + 1  # lower bounds: the subset is not valid
                 continue
