@@ -149,6 +149,19 @@ class SafeKernel:
     _make_certificate: Callable[[], dict[str, Any]] = field(repr=False, compare=False)
     _cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
+    def __eq__(self, other: object) -> bool:
+        """The same input (X bit for bit, F) and the same exact kernel (dimension and
+        exact vertices, in their canonical order); the wall time is not compared."""
+        if not isinstance(other, SafeKernel):
+            return NotImplemented
+        return (self.F == other.F and self.dim == other.dim
+                and self.points.shape == other.points.shape
+                and np.array_equal(self.points, other.points)
+                and self.exact_vertices == other.exact_vertices)
+
+    def __hash__(self) -> int:
+        return hash((self.F, self.dim, self.points.shape, self.exact_vertices))
+
     @property
     def certificate(self) -> dict[str, Any]:
         """The ``safe_kernel`` / ``kernel_empty`` certificate (built on first use: the
