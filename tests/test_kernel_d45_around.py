@@ -174,19 +174,10 @@ def test_kernels_identical_to_the_exact_clipping_on_hostile_data(kind, d, n, F, 
     """Every output — floats bit for bit, exact vertices and rows, certificate — equals
     the exact clipping's (fast path off) at extreme magnitudes, converged and repeated
     points, integers, flat data, n = d + 1 and the 24-cell's non-simple vertices."""
-    import rescon
 
-    X = _hostile(kind, d, n)
-    fast = rescon.safe_kernel(X, F)
-    monkeypatch.setattr(km, "certified_kernel", lambda *a: None)
-    slow = rescon.safe_kernel(X, F)
-    assert fast.dim == slow.dim
-    for name in ("vertices", "A", "b", "Aeq", "beq", "affine_basis"):
-        assert getattr(fast, name).tobytes() == getattr(slow, name).tobytes(), name
-    assert fast.exact_vertices == slow.exact_vertices
-    assert fast._exact.constraints == slow._exact.constraints
-    assert fast._exact.facets == slow._exact.facets
-    assert fast.certificate == slow.certificate
+    from tests.test_kernel_d45_around2 import _same_as_clipping
+
+    _same_as_clipping(_hostile(kind, d, n), F, monkeypatch)
 
 
 @pytest.mark.parametrize("seed", range(3))

@@ -17,6 +17,7 @@ import rescon
 from rescon._rounding import UNIT_ROUNDOFF, underflow_floor
 from rescon.geometry import _candidates, _scan_np, fastpath, halfspaces
 from rescon.geometry import kernel as km
+from tests.test_kernel_d45_scan import _integers
 
 
 def _points(kind: str, k: int, m: int, seed: int) -> np.ndarray:
@@ -41,13 +42,6 @@ def _points(kind: str, k: int, m: int, seed: int) -> np.ndarray:
     elif kind == "adversary":  # one point at 1e300 among O(1) ones
         Y[m // 2] = 1e300 * np.sign(Y[m // 2])
     return Y
-
-
-def _integers(Y: np.ndarray) -> list[tuple[int, ...]]:
-    """Y's exact binary values times one power of two: integers."""
-    fr = [[Fraction(float(v)) for v in row] for row in Y]
-    unit = max(v.denominator for row in fr for v in row)
-    return [tuple(int(v * unit) for v in row) for row in fr]
 
 
 def _exact_sides(Yi, W, subset) -> tuple[int, int, bool]:
