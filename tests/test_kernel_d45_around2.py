@@ -8,16 +8,14 @@ from __future__ import annotations
 
 import itertools
 from fractions import Fraction
-from math import factorial
 
 import numpy as np
 import pytest
 
 import rescon
-from rescon._rounding import UNIT_ROUNDOFF, underflow_floor
 from rescon.geometry import _candidates, _scan_np, fastpath, halfspaces
 from rescon.geometry import kernel as km
-from tests.test_kernel_d45_scan import _integers
+from tests.test_kernel_d45_scan import _integers, _scan_args
 
 
 def _points(kind: str, k: int, m: int, seed: int) -> np.ndarray:
@@ -60,14 +58,6 @@ def _exact_sides(Yi, W, subset) -> tuple[int, int, bool]:
         plus += int(W[q]) * (s > 0)
         minus += int(W[q]) * (s < 0)
     return plus, minus, False
-
-
-def _scan_args(Y: np.ndarray, exact: bool) -> tuple[float, float]:
-    k = Y.shape[1]
-    if exact:
-        return 0.0, 0.0
-    return (4.0 * (3 * k + factorial(k) + 4) * UNIT_ROUNDOFF,
-            underflow_floor(k, float(np.abs(Y).max())))
 
 
 KINDS = ("normal", "coplanar", "repeated", "integers", "tiny", "subnormal", "huge",
