@@ -14,8 +14,12 @@ rule); the proposal is accepted only if, in exact arithmetic,
    conv(V) ⊆ Ψ by the characterisation theorem;
 2. every extreme ray of every vertex's tangent cone {d : a_h·d ≤ 0, h tight at v}
    leads to another proposed vertex: for a simple vertex the rays keep all but one of
-   its k rows tight; for a non-simple one they come from an integer double description
-   of the cone. The rows Z tight along a ray have rank k − 1, so a vertex u ≠ v with
+   its k rows tight; for a non-simple one they are the directions u − v to the
+   proposed vertices u whose tight rows shared with v have rank k − 1, where a check
+   on the exact tight sets proves that these are all the rays (:mod:`._closure`: the
+   faces they span are closed under adjacency, level by level down the face figures),
+   else they come from an integer double description of the cone. The rows Z tight
+   along a ray have rank k − 1, so a vertex u ≠ v with
    Z ⊆ tight(u) lies on the ray's line, hence on the ray (v is a vertex) and the edge of
    P_S = ⋂ S leaving v along it is bounded and ends at a proposed vertex. So V is
    closed under adjacency; the graph of a polyhedron is connected, hence V is all of
@@ -305,18 +309,23 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     """The edges of P_S — for each vertex, its neighbours, increasing — if every extreme
     ray of every vertex's tangent cone leads to another vertex, else None. A simple
     vertex (k tight rows, its basis) has a simplicial cone whose rays keep all but one
-    row tight; a non-simple one's rays come from :func:`_tangent_rays`. The rows Z tight
-    along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff Z ⊆
-    tight[u], and then it is the other end of the edge (the line meets P_S in that
-    edge). Found through the (k − 1)-subsets of the tight sets (:class:`_RayIndex`).
-    ``start_rays``: for a list of bases, their simplicial cones' rays
-    (:func:`_simplicial_rays`), where the double descriptions start."""
+    row tight. A non-simple one is settled from the tight sets where
+    :func:`._closure.combinatorial_rays` concludes; the others' rays come from
+    :func:`_tangent_rays`. The rows Z tight along a ray have rank k − 1, so a vertex
+    u ≠ v lies on the ray's line iff Z ⊆ tight[u], and then it is the other end of the
+    edge (the line meets P_S in that edge). Found through the (k − 1)-subsets of the
+    tight sets (:class:`_RayIndex`). ``start_rays``: for a list of bases, their
+    simplicial cones' rays (:func:`_simplicial_rays`), where the double descriptions
+    start."""
+    from ._closure import combinatorial_rays
+
     index = _RayIndex(tight, basis, len(normals), k)
-    non_simple = index.non_simple
-    starts = start_rays([basis[vi] for vi in non_simple])
+    settled, settled_ends = combinatorial_rays(tight, normals, k, index.non_simple)
+    rest = [vi for vi, ok in zip(index.non_simple, settled.tolist(), strict=True) if not ok]
+    starts = start_rays([basis[vi] for vi in rest])
     ray_v: list[int] = []
     ray_z: list[int] = []
-    for vi, start in zip(non_simple, starts, strict=True):
+    for vi, start in zip(rest, starts, strict=True):
         for Z in _tangent_rays(normals, basis[vi], list(_bits(tight[vi])), k, start):
             ray_v.append(vi)
             ray_z.append(Z)
@@ -328,6 +337,8 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     for vi, u in zip(ray_v, ends, strict=True):
         edges[vi].add(u)
     for vi, us in zip(index.simple.tolist(), simple_ends, strict=True):
+        edges[vi].update(us)
+    for vi, us in zip(index.non_simple, settled_ends, strict=True):
         edges[vi].update(us)
     return [sorted(e) for e in edges]
 

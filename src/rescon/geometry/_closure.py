@@ -1,0 +1,245 @@
+"""Combinatorial closure of a non-simple vertex's tangent cone (:mod:`.fastpath`).
+
+The fast path must show that every extreme ray of the tangent cone
+C_v = {d : a_h·d ≤ 0, h ∈ T(v)} of every proposed vertex v (T(v): the rows of S tight at
+v, computed exactly) leads to another proposed vertex. This module does it for a
+non-simple v from the exact tight sets alone; where it cannot conclude, the caller runs
+the double description of C_v.
+
+**Faces and zero sets.** C_v is pointed (v is a vertex: T(v) has rank k). A face F of
+C_v is C_v ∩ {a_h·d = 0, h ∈ Z_F} with Z_F ⊆ T(v) the rows tight on all of F (its zero
+set), and dim F = k − rank Z_F (the zero set's equations cut out F's linear span).
+Distinct faces have distinct zero sets.
+
+**Found rays.** For a proposed vertex u ≠ v, d = u − v lies in C_v (u ∈ P_S) and the
+rows of T(v) tight along d are Z_u = T(v) ∩ T(u). The face of C_v with zero set Z_u holds
+d and has rank Z_u ≤ k − 1 (u ≠ v both satisfy Z_u's equations). Where the rank of Z_u's
+normals modulo a prime p is k − 1 — a lower bound of the rank over ℚ — it is k − 1, so
+d spans an extreme ray of C_v; the face of P_S cut out by Z_u is then an edge on d's line
+with the vertex v as one end, and the vertex u of P_S on it is its other end. Distinct
+u are distinct rays. A modular rank that falls short by chance only leaves u out.
+
+**Joins.** Let G ≠ G' be two found faces of dimension j, both containing a face A of
+dimension j − 1 (for j = 1, A = {0}), rank Z_G = r = k − j. The face H with zero set
+Z_G ∩ Z_G' contains both, so dim H ≥ j + 1 and rank(Z_G ∩ Z_G') ≤ r − 1; a modular rank
+≥ r − 1 proves equality: H is the (j + 1)-face G ∨ G'. Distinct G' give distinct H (a
+(j + 1)-face over A holds exactly two j-faces over A, see below).
+
+**Lemma.** The faces of C_v that contain a face A form the face lattice of a pointed
+cone C/A of dimension m = k − dim A (the face figure), whose extreme rays are the faces
+of dimension dim A + 1 over A and whose 2-faces those of dimension dim A + 2. A set R of
+extreme rays of a pointed cone of dimension m ≥ 2 is all of them if R is non-empty and
+every 2-face containing a ray of R contains a second one: the rays and 2-faces are the
+vertices and edges of a (m − 1)-polytope (a cross-section), whose graph is connected.
+For m = 2 the cone has exactly two extreme rays.
+
+**The check.** Found faces R of dimension j over A (rank r = k − j, m = r + 1) are all
+such faces if R ≠ ∅ and: r = 1 and |R| ≥ 2; or r ≥ 2 and for each G ∈ R the joins
+{G ∨ G' : G' ∈ R} are all the (j + 1)-faces containing G — the extreme rays of C/G
+(dimension r), each a 2-face of C/A at G holding a second member G' of R. That is the
+same check one level down (faces of dimension j + 1 over G), except where Z_G is
+independent (|Z_G| = r): near G, C_v is the cone of Z_G's r rows, so C/G is simplicial
+and its extreme rays are the r faces with zero sets Z_G − {g}: all r must be joins.
+Started from the found rays (j = 1, A = {0}), a pass proves they are all the extreme
+rays of C_v, each ending at a proposed vertex; the proposed vertices u found are then
+exactly v's neighbours on P_S. A check that exceeds its work bound, a vertex of more than
+MAX_ROWS tight rows, or a missing face fails: the caller falls back to the double
+description of C_v (never to a weaker answer).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .polytope import PRIME, tight_pairs
+
+__all__ = ["combinatorial_rays"]
+
+#: vertices with more tight rows are left to the double description (the zero sets are
+#: int64 bitmasks over a vertex's rows)
+MAX_ROWS = 62
+#: join computations per vertex before the check gives up (the double description
+#: decides then)
+WORK = 200_000
+
+
+def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
+                       vs: list[int]) -> tuple[np.ndarray, list[list[int]]]:
+    """For each vertex of ``vs`` (non-simple: more than k rows tight), whether the
+    combinatorial check (module docstring) proves that the proposed vertices u with
+    rank(T(v) ∩ T(u)) = k − 1 end all the extreme rays of its tangent cone, and those u
+    (increasing; empty where it does not)."""
+    if not vs:
+        return np.zeros(0, dtype=np.bool_), []
+    v_of, h_of = tight_pairs(tight)  # by vertex, then row
+    v_ptr = np.searchsorted(v_of, np.arange(len(tight) + 1)).astype(np.int64)
+    by_row = np.argsort(h_of, kind="stable")  # by row, then vertex
+    h_ptr = np.searchsorted(h_of[by_row], np.arange(len(normals) + 1)).astype(np.int64)
+    residues = np.array([[x % PRIME for x in a] for a in normals], dtype=np.int64)
+    ok = np.zeros(len(vs), dtype=np.bool_)
+    ptr, ends = _closures(v_ptr, h_of.astype(np.int64), h_ptr,
+                          v_of[by_row].astype(np.int64), residues,
+                          np.asarray(vs, dtype=np.int64), k, ok)
+    ends = ends.tolist()
+    return ok, [ends[a:b] for a, b in zip(ptr[:-1].tolist(), ptr[1:].tolist(), strict=True)]
+
+
+@njit(cache=True, nogil=True)
+def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, vs, k, ok):
+    """:func:`combinatorial_rays` on the incidences in CSR form (v_rows[v_ptr[v]:
+    v_ptr[v + 1]]: the rows of vertex v, increasing; h_verts likewise the vertices of
+    each row): ok[i] for vs[i], and the ends of the passing ones (ends[ptr[i]:ptr[i +
+    1]])."""
+    n = len(v_ptr) - 1
+    count = np.zeros(n, dtype=np.int64)
+    mask = np.zeros(n, dtype=np.int64)
+    touched = np.empty(n, dtype=np.int64)
+    ptr = np.zeros(len(vs) + 1, dtype=np.int64)
+    ends = np.empty(16, dtype=np.int64)
+    found_u = np.empty(n, dtype=np.int64)
+    found_z = np.empty(n, dtype=np.int64)
+    R = np.empty((MAX_ROWS, k), dtype=np.int64)
+    work = np.empty((MAX_ROWS, k), dtype=np.int64)
+    for i in range(len(vs)):
+        v = vs[i]
+        ptr[i + 1] = ptr[i]
+        t = v_ptr[v + 1] - v_ptr[v]
+        if t > MAX_ROWS:
+            continue
+        # the vertices sharing rows with v: how many, and which (bits over v's rows)
+        m = 0
+        for j in range(t):
+            h = v_rows[v_ptr[v] + j]
+            R[j] = residues[h]
+            for e in range(h_ptr[h], h_ptr[h + 1]):
+                u = h_verts[e]
+                if u == v:
+                    continue
+                if count[u] == 0:
+                    touched[m] = u
+                    m += 1
+                count[u] += 1
+                mask[u] |= np.int64(1) << j
+        f = 0
+        for e in range(m):
+            u = touched[e]
+            if count[u] >= k - 1 and _rank_at_least(R, mask[u], k - 1, work):
+                found_u[f] = u
+                found_z[f] = mask[u]
+                f += 1
+            count[u] = 0
+            mask[u] = 0
+        if not _faces_closed(found_z[:f].copy(), k - 1, R, work):
+            continue
+        ok[i] = True
+        if ptr[i] + f > len(ends):
+            grown = np.empty(2 * (ptr[i] + f), dtype=np.int64)
+            grown[:ptr[i]] = ends[:ptr[i]]
+            ends = grown
+        ends[ptr[i]:ptr[i] + f] = np.sort(found_u[:f])
+        ptr[i + 1] = ptr[i] + f
+    return ptr, ends[:ptr[-1]]
+
+
+@njit(cache=True, nogil=True)
+def _faces_closed(faces, r, R, work):
+    """The check of the module docstring, a task per face set: ``faces`` (distinct zero
+    sets over a common face, rank r each) are all the faces of their dimension over it.
+    Tasks are kept in a queue (start, count, rank) over a growing array of zero sets;
+    False as soon as one fails or the work exceeds WORK joins."""
+    store = faces
+    top = len(faces)
+    tasks = [(0, len(faces), r)]
+    spent = 0
+    while tasks:
+        start, n, r = tasks.pop()
+        if n == 0 or (r == 1 and n < 2):
+            return False
+        if r == 1:
+            continue
+        for a in range(start, start + n):
+            G = store[a]
+            simplicial = _popcount(G) == r
+            first = top
+            for b in range(start, start + n):
+                if b == a:
+                    continue
+                spent += 1
+                if spent > WORK:
+                    return False
+                J = G & store[b]
+                size = _popcount(J)
+                if size < r - 1 or (simplicial and size != r - 1):
+                    continue
+                seen = False
+                for c in range(first, top):
+                    if store[c] == J:
+                        seen = True
+                        break
+                if seen or not (simplicial or _rank_at_least(R, J, r - 1, work)):
+                    continue
+                if top == len(store):
+                    grown = np.empty(2 * len(store) + 16, dtype=np.int64)
+                    grown[:top] = store[:top]
+                    store = grown
+                store[top] = J
+                top += 1
+            if simplicial:
+                if top - first != r:
+                    return False
+                top = first  # the joins are not looked at again
+            else:
+                tasks.append((first, top - first, r - 1))
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _rank_at_least(R, bits, r, work):
+    """The rows of R (residues modulo PRIME) whose bits are set span rank ≥ r modulo
+    PRIME (then over ℚ too): elimination without divisions, row_i ← p_c·row_i −
+    f·row_c."""
+    p = PRIME
+    k = R.shape[1]
+    m = 0
+    b = bits
+    j = 0
+    while b:
+        if b & 1:
+            work[m] = R[j]
+            m += 1
+        b >>= 1
+        j += 1
+    if m < r:
+        return False
+    rank = 0
+    for c in range(k):
+        piv = -1
+        for i in range(rank, m):
+            if work[i, c] != 0:
+                piv = i
+                break
+        if piv < 0:
+            continue
+        if piv != rank:
+            for x in range(k):
+                work[rank, x], work[piv, x] = work[piv, x], work[rank, x]
+        top = work[rank, c]
+        for i in range(rank + 1, m):
+            g = work[i, c]
+            if g != 0:
+                for x in range(k):
+                    work[i, x] = (top * work[i, x] - g * work[rank, x]) % p
+        rank += 1
+        if rank >= r:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def _popcount(x):
+    n = 0
+    while x:
+        x &= x - 1
+        n += 1
+    return n
