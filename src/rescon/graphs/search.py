@@ -108,7 +108,8 @@ def _out_mask_array(ig: IndexedGraph) -> np.ndarray:
 
 def _grown(buffer: np.ndarray, room: int) -> np.ndarray | None:
     """A full token buffer doubled (capped at ``room``, its old tokens kept), or None
-    when it already holds ``room`` tokens: the caller then drops the tree."""
+    when it already holds ``room`` tokens: the caller then drops the tree, or stops (a
+    part on a cluster that keeps its tree: graphs/distributed.py, the tree's room)."""
     size = buffer.shape[0]
     if size >= room:
         return None
@@ -173,11 +174,14 @@ def _frame_pieces(k: int, singles: int) -> list[tuple[int, int]]:
 class PartRun:
     """A resumable run of ``_kernels.decide_step`` over one :class:`SearchPart`: the
     stack, state, witness and token arrays it advances, slice by slice. The tree is
-    recorded while it has fewer than ``room`` tokens (0: not recorded)."""
+    recorded while it has fewer than ``room`` tokens (0: not recorded); with ``keep``,
+    a run whose ``room`` tokens are written stops there (status NEED_ROOM, its
+    :meth:`rest` still to search) instead of dropping its tree."""
 
-    def __init__(self, inputs: tuple, r: int, part: SearchPart, room: int) -> None:
+    def __init__(self, inputs: tuple, r: int, part: SearchPart, room: int,
+                 keep: bool = False) -> None:
         self.K, self.inmask, self.outmask, self.order = inputs
-        self.r, self.room, self.record = r, room, room > 0
+        self.r, self.room, self.record, self.keep = r, room, room > 0, keep
         K, n = self.K, self.inmask.shape[0]
         k = part.frames.shape[0]
         self.stack = np.zeros((2 * n + 2 + k, K.STACK_WIDTH), dtype=np.uint64)
@@ -193,7 +197,8 @@ class PartRun:
     def advance(self, max_nodes: int) -> int:
         """Expand up to ``max_nodes`` more states; the kernel's status (RUNNING: not
         finished). A full token buffer doubles, up to ``room``; a full buffer of that
-        size drops the tree (``record`` becomes False)."""
+        size drops the tree (``record`` becomes False), or with ``keep`` stops the run
+        (NEED_ROOM)."""
         K = self.K
         while True:
             self.state[K.ST_STATUS] = K.RUNNING
@@ -203,6 +208,8 @@ class PartRun:
             if self.state[K.ST_STATUS] != K.NEED_ROOM:
                 return int(self.state[K.ST_STATUS])
             grown = _grown(self.buffer, self.room)
+            if grown is None and self.keep:
+                return K.NEED_ROOM
             if grown is None:
                 self.record, grown = False, np.empty(1, dtype=np.int32)
             self.buffer = grown
@@ -373,11 +380,12 @@ class CostPartRun:
     """A resumable run of one s* engine over a :class:`CostPart`: ``engine`` "sized"
     (``_kernels.min_cost_sized_step``) or "charged" (``_kernels.min_cost_step``), below
     the incumbent ``best`` (a pair's cost, or a cap), ending at the first pair of cost
-    ≤ ``lower``. The sized search's tree is recorded while it has at most ``max_tokens``
-    tokens (``recording`` turns False beyond, the search goes on; 0: not recorded)."""
+    ≤ ``lower``. The sized search's tree is recorded while it has fewer than
+    ``max_tokens`` tokens (``recording`` turns False beyond, the search goes on; 0: not
+    recorded), or with ``keep`` the run stops there (NEED_ROOM), as :class:`PartRun`."""
 
     def __init__(self, inputs: tuple, engine: str, r: int, lower: int, part: CostPart,
-                 best: int, max_tokens: int = 0) -> None:
+                 best: int, max_tokens: int = 0, keep: bool = False) -> None:
         if engine not in COST_ENGINES:
             raise ValueError(f"engine must be one of {COST_ENGINES}; got {engine!r}")
         self.K, self.inmask, self.outmask, self.order = inputs
@@ -394,7 +402,7 @@ class CostPartRun:
         if part.root > 0:  # the started root's B (a root not yet started sets its own)
             run.ubuf[K.CB_B] = K.prefix_mask(self.order, part.root - 1)
         self.max_tokens = max_tokens if engine == "sized" else 0
-        self.recording = self.max_tokens > 0
+        self.recording, self.keep = self.max_tokens > 0, keep
         self.tokens = np.empty(min(1 << 12, self.max_tokens) if self.recording else 1,
                                dtype=np.int32)
         self.seconds = 0.0  # wall time in advance(), for turns between engines
@@ -402,7 +410,7 @@ class CostPartRun:
     def advance(self, max_nodes: int) -> int:
         """Expand up to ``max_nodes`` more states; the kernel's status (RUNNING: not
         finished). A full token buffer doubles, up to ``max_tokens``; beyond, the tree
-        is dropped."""
+        is dropped, or with ``keep`` the run stops (NEED_ROOM)."""
         K, run = self.K, self.run
         t0 = time.perf_counter()
         try:
@@ -419,6 +427,8 @@ class CostPartRun:
                 if status != K.NEED_ROOM:
                     return status
                 grown = _grown(self.tokens, self.max_tokens)
+                if grown is None and self.keep:
+                    return status
                 if grown is None:
                     self.recording, grown = False, np.empty(1, dtype=np.int32)
                 self.tokens = grown
@@ -433,7 +443,7 @@ class CostPartRun:
 
     @property
     def finished(self) -> bool:
-        return int(self.run.state[self.K.CS_STATUS]) != self.K.RUNNING
+        return int(self.run.state[self.K.CS_STATUS]) not in (self.K.RUNNING, self.K.NEED_ROOM)
 
     @property
     def best(self) -> int:
