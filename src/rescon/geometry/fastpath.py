@@ -77,7 +77,8 @@ def _chebyshev(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 
 
 #: the merged proposal (``options`` None) in dimension k ≥ 5 tries these qhull options
-#: in turn: zero-centrum pre-merges with pinched-vertex merging first, which completed
+#: in turn, each until its proposal is certified or fails (:func:`_chain`):
+#: zero-centrum pre-merges with pinched-vertex merging first, which completed
 #: on all 6 d = 5, n = 30 and 8 of 9 n = 20 bench clouds, 1.2–2.4× faster than qhull's
 #: default "Qx" where both completed — "Qx" failed with a duplicate ridge (QH6271) or
 #: a precision error on 3 of the 6 n = 30 clouds, whose proposals then came joggled
@@ -91,8 +92,8 @@ def _propose(H, sel: np.ndarray, options: str | None = None
     qhull around a Chebyshev centre. A kernel small against its coordinates (states
     that have nearly converged) is re-centred and rescaled first: x = o + s y with o
     the first centre, s the distance from o to its (k+1)-th nearest halfspace, so the
-    LP and qhull see it at unit size. ``options`` None (merged facets) in k ≥ 5 tries
-    MERGED_OPTIONS_5D in turn. None for a flat or empty kernel or a qhull failure."""
+    LP and qhull see it at unit size. ``options``: qhull's option string (None: its
+    default). None for a flat or empty kernel or a qhull failure."""
     from scipy.spatial import HalfspaceIntersection, QhullError
 
     norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
@@ -124,16 +125,13 @@ def _propose(H, sel: np.ndarray, options: str | None = None
         x0, r = found
     if r <= 1e-9 * (1.0 + np.abs(x0).max()):
         return None
-    hs = None
-    for opts in MERGED_OPTIONS_5D if options is None and k >= 5 else (options,):
-        try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
-            with np.errstate(divide="ignore", invalid="ignore"):
-                hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0,
-                                           qhull_options=opts)
-            break
-        except (QhullError, ValueError):
-            continue
-    if hs is None or not np.isfinite(hs.intersections).all():
+    try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
+        with np.errstate(divide="ignore", invalid="ignore"):
+            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0,
+                                       qhull_options=options)
+    except (QhullError, ValueError):
+        return None
+    if not np.isfinite(hs.intersections).all():
         return None
     facets = hs.dual_facets  # lists of ints, positions in rows
     if len(rows) < len(sel):  # the local pass left rows out: positions in sel
@@ -151,10 +149,19 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
     sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
     with _collection_deferred():
         for options in QHULL_OPTIONS:
-            P = _attempt(H, k, scale, sel, options)
-            if P is not None:
-                return P
+            for opts in _chain(options, k):
+                P = _attempt(H, k, scale, sel, opts)
+                if P is not None:
+                    return P
     return None
+
+
+def _chain(options: str | None, k: int) -> tuple[str | None, ...]:
+    """The qhull options tried in turn for an entry of QHULL_OPTIONS: the merged proposal
+    (None) in k ≥ 5 is MERGED_OPTIONS_5D, each option in an attempt of its own — so
+    qhull's default still runs when the first option's proposal fails the
+    certification, not only when qhull fails."""
+    return MERGED_OPTIONS_5D if options is None and k >= 5 else (options,)
 
 
 @contextlib.contextmanager
