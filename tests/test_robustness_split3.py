@@ -11,6 +11,7 @@ on a cluster), and on a LocalCluster of 2 worker processes on loopback."""
 
 from __future__ import annotations
 
+import itertools
 import random
 
 import networkx as nx
@@ -19,7 +20,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from benchmarks.baselines import leblanc_rho
+from rescon.graphs import bounds as bd
 from rescon.graphs import distributed, search
+from rescon.graphs import robustness as rob
+from rescon.graphs.charged import charged_tree, uniform_excluded, uniform_tree
+from rescon.graphs.facts import clear_cache, facts_for
 from rescon.graphs.indexed import index_graph
 from rescon.graphs.search import CostPartRun, cost_tree, decide_r_robust, whole_cost_part
 from tests.test_robustness_exact import digraphs
@@ -272,3 +278,61 @@ def test_split_sized_search_on_the_cluster_keeps_a_tree_one_below_the_cap(cluste
         with distributed.searches_on(scheduler=cluster):
             split, _ = _split_sized(ig, r, s, distributed.active())
         assert split == (full if cap > len(full) else None)
+
+
+# ---------------------------------------------------------------- the uniform attempt
+
+
+def _all_pairs(n: int):
+    """Every pair of disjoint nonempty node sets of range(n), each unordered pair once
+    per order."""
+    for labels in itertools.product(range(3), repeat=n):
+        S1 = frozenset(i for i in range(n) if labels[i] == 1)
+        S2 = frozenset(i for i in range(n) if labels[i] == 2)
+        if S1 and S2:
+            yield bd.Pair(S1, S2)
+
+
+@settings(max_examples=40, deadline=None)
+@given(digraphs(max_n=6), st.integers(1, 4), st.integers(2, 6))
+def test_a_pair_excluding_the_uniform_tree_means_it_has_none(G, r, s):
+    """charged.uniform_excluded against the uniform tree itself, pair by pair (every
+    pair of disjoint sets of a small digraph): a pair that excludes it means no tree."""
+    ig = index_graph(G)
+    excluding = [p for p in _all_pairs(ig.n) if uniform_excluded(ig, r, s, [p])]
+    assert not excluding or uniform_tree(ig, r, s) is None
+
+
+@settings(max_examples=40, deadline=None)
+@given(digraphs(max_n=9))
+def test_at_rho_the_refuting_pair_excludes_the_uniform_tree_of_every_s_from_3(G):
+    ig = index_graph(G)
+    rho = leblanc_rho(G)
+    if rho < 1:
+        return
+    refuted = decide_r_robust(ig, rho + 1)
+    assert refuted.status == "not_robust"
+    pair = bd.Pair(*refuted.witness)
+    for s in range(2, 7):
+        assert uniform_excluded(ig, rho, s, [pair]) == (s >= 3)
+        assert s == 2 or uniform_tree(ig, rho, s) is None
+
+
+def test_the_charged_proof_skips_an_excluded_uniform_tree(monkeypatch):
+    """robustness._charged with the pair that refuted (ρ + 1)-robustness among the facts
+    records the configurations' tree without trying the uniform one (it was tried first,
+    always, though it cannot exist)."""
+    G = nx.gnp_random_graph(14, 0.5, seed=3, directed=True)
+    ig = index_graph(G)
+    clear_cache()
+    rho = leblanc_rho(G)
+    s = search.min_cost_pair(ig, rho, ig.n).best
+    assert s >= 3
+    facts_for(ig).add_pair(bd.Pair(*decide_r_robust(ig, rho + 1).witness))
+    tried = []
+    monkeypatch.setattr(rob, "uniform_tree", lambda *a, **k: tried.append(a))
+    try:
+        assert rob._charged(ig, rho, s, None) == (charged_tree(ig, rho, s), {})
+    finally:
+        clear_cache()
+    assert tried == [] and charged_tree(ig, rho, s) is not None

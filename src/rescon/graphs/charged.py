@@ -14,16 +14,20 @@ all configurations with one tree per type (|Q1| ≤ c1, |Q2| ≤ c2) when such t
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from itertools import combinations
 from math import comb
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .indexed import IndexedGraph
 
-__all__ = ["MAX_CONFIGS", "charged_tree", "configurations", "count_configurations", "uniform_tree",
-           "uniform_types"]
+if TYPE_CHECKING:
+    from .bounds import Pair
+
+__all__ = ["MAX_CONFIGS", "charged_tree", "configurations", "count_configurations",
+           "uniform_excluded", "uniform_tree", "uniform_types"]
 
 MAX_CONFIGS = 20_000  # beyond, no charged tree is tried (each configuration costs ≥ n tokens)
 
@@ -89,6 +93,24 @@ def uniform_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = N
         return _record(ig, parts, len(uniform_types(s)), deadline, max_tokens)
     except _Violated:
         return None
+
+
+def uniform_excluded(ig: IndexedGraph, r: int, s: int, pairs: Iterable[Pair]) -> bool:
+    """True when one of ``pairs`` (e.g. the violating pairs met so far) proves that
+    :func:`uniform_tree` has no tree for (r, s), so that it need not be tried: its sets,
+    disjoint and nonempty, are both closed for the thresholds t(i) = r + min(c, d_i) of
+    the last type (s − 1 − c, c), c = ⌊(s − 1)/2⌋, of :func:`uniform_types`.
+
+    Proof: that type's thresholds are t2 = t and t1 ≥ t (s − 1 − c ≥ c), and a set
+    closed for t is closed for any larger thresholds; so the pair is a violating pair of
+    that type's decision search, which meets one if there is any (uniform_tree: None).
+    For s ≥ 3 (c ≥ 1) every pair violating (r + 1)-robustness is one, since its members
+    have |N(i) \\ S| ≤ min(r, d_i) < r + min(c, d_i) outside in-neighbours: at r = ρ the
+    pair that refuted (ρ + 1)-robustness excludes the uniform tree of every s ≥ 3."""
+    t = [r + min((s - 1) // 2, d) for d in ig.in_degrees]
+    return any(pair.S1 and pair.S2 and not pair.S1 & pair.S2
+               and all(len(ig.in_nbrs[i] - S) < t[i] for S in (pair.S1, pair.S2) for i in S)
+               for pair in pairs)
 
 
 class _Violated(Exception):

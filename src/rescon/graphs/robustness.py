@@ -40,7 +40,7 @@ from .._progress import progress_bar
 from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
-from .charged import charged_tree, uniform_tree
+from .charged import charged_tree, uniform_excluded, uniform_tree
 from .distributed import searches_for
 from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
@@ -294,10 +294,12 @@ def _charged(ig: IndexedGraph, r: int, s: int, deadline: float | None
     """(the charged tree of (r, s)-robustness, the proof's extra keys): the smaller of
     the two kinds recorded within ``CHARGED_SECONDS`` (the configurations' tree only
     below the uniform one's size; ``{"uniform": True}`` for the uniform one), or
-    (None, {})."""
+    (None, {}). The uniform tree is not tried where a violating pair met so far shows
+    that it does not exist (charged.uniform_excluded: at r = ρ for every s ≥ 3)."""
     stop = time.perf_counter() + CHARGED_SECONDS
     stop = stop if deadline is None else min(stop, deadline)
-    uniform = _recorded(uniform_tree, ig, r, s, stop, CHARGED_SECONDS)
+    uniform = None if uniform_excluded(ig, r, s, facts_for(ig).pairs) else _recorded(
+        uniform_tree, ig, r, s, stop, CHARGED_SECONDS)
     limit = {} if uniform is None else {"max_tokens": max(1, len(uniform) - 1)}
     tree = _recorded(charged_tree, ig, r, s, stop, CHARGED_SECONDS, **limit)
     if tree is not None or uniform is None:
