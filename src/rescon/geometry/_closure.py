@@ -43,8 +43,9 @@ and its extreme rays are the r faces with zero sets Z_G − {g}: all r must be j
 Started from the found rays (j = 1, A = {0}), a pass proves they are all the extreme
 rays of C_v, each ending at a proposed vertex; the proposed vertices u found are then
 exactly v's neighbours on P_S. A check that exceeds its work bound, a vertex of more than
-MAX_ROWS tight rows, or a missing face fails: the caller falls back to the double
-description of C_v (never to a weaker answer).
+MAX_ROWS tight rows, a missing face, or two found faces of one dimension whose zero sets
+contain one another (impossible for distinct faces: the tight sets are not exact) fails:
+the caller falls back to the double description of C_v (never to a weaker answer).
 """
 
 from __future__ import annotations
@@ -169,6 +170,8 @@ def _faces_closed(faces, r, R, work):
                 if spent > WORK:
                     return False
                 J = G & store[b]
+                if J == G:  # G' ⊇ G: not two distinct faces of one dimension
+                    return False
                 size = _popcount(J)
                 if size < r - 1 or (simplicial and size != r - 1):
                     continue

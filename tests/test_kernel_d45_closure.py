@@ -1,0 +1,203 @@
+"""The combinatorial closure of non-simple vertices (:mod:`rescon.geometry._closure`)
+against the integer double description on every non-simple vertex of many kernels,
+tampered tight sets, modular ranks that fall short, and whole kernels against the exact
+clipping."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rescon
+from rescon.geometry import _closure, fastpath
+from rescon.geometry.polytope import PRIME, _bits
+from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
+
+
+def _recorded(monkeypatch) -> list:
+    """Records the arguments of every closure of the fast path, with the start rays of
+    the double description of every non-simple vertex."""
+    seen = []
+    real = fastpath._closed
+
+    def closed(tight, basis, normals, k, start_rays):
+        non_simple = [v for v, t in enumerate(tight) if t.bit_count() > k]
+        starts = start_rays([basis[v] for v in non_simple])
+        seen.append((tight, basis, normals, k, dict(zip(non_simple, starts, strict=True))))
+        return real(tight, basis, normals, k, start_rays)
+
+    monkeypatch.setattr(fastpath, "_closed", closed)
+    return seen
+
+
+def _dd_ends(tight, basis, normals, k, v, start) -> list[int] | None:
+    """The other ends of v's rays from the double description, each the one vertex u ≠ v
+    holding the ray's tight rows (brute force), or None if a ray has none."""
+    out = set()
+    for Z in fastpath._tangent_rays(normals, basis[v], list(_bits(tight[v])), k, start):
+        holders = [u for u, t in enumerate(tight) if u != v and t & Z == Z]
+        if len(holders) != 1:
+            return None
+        out.add(holders[0])
+    return sorted(out)
+
+
+def _agrees_with_the_double_description(tight, basis, normals, k, starts) -> int:
+    """Where the check concludes, its ends are the double description's; returns how
+    many vertices it settled."""
+    vs = sorted(starts)
+    ok, ends = _closure.combinatorial_rays(tight, normals, k, vs)
+    for v, passed, us in zip(vs, ok.tolist(), ends, strict=True):
+        want = _dd_ends(tight, basis, normals, k, v, starts[v])
+        if passed:
+            assert us == want, v
+        else:
+            assert us == []
+    return int(ok.sum())
+
+
+CLOUDS = [("gaussian", 3, 30, 3), ("cube", 3, 30, 2), ("sphere", 3, 30, 1),
+          ("integer", 3, 24, 2), ("lattice", 3, 27, 3),
+          ("gaussian", 4, 22, 2), ("cube", 4, 20, 3), ("sphere", 4, 20, 1),
+          ("attack", 4, 20, 2), ("converged", 5, 16, 1), ("grid", 4, 20, 2),
+          ("tiny", 4, 20, 2), ("huge", 4, 20, 2), ("nearsame", 4, 20, 2),
+          ("integer", 4, 20, 3), ("cell24", 4, 28, 4), ("lattice", 4, 27, 4),
+          ("gaussian", 5, 14, 1), ("sphere", 5, 14, 1), ("cube", 5, 14, 1),
+          ("integer", 5, 14, 1), ("nearsame", 5, 13, 1), ("lattice", 5, 40, 3)]
+
+
+@pytest.mark.parametrize("kind,d,n,F", CLOUDS)
+def test_settled_vertices_have_the_double_descriptions_edges(kind, d, n, F, monkeypatch):
+    """On every non-simple vertex of the kernel the check either defers or gives the
+    neighbours the double description gives: benchmark families in d = 3–5, integer
+    data, converged and nearly identical points, magnitudes 1e-300 and 1e300, the
+    24-cell and lattices (very non-simple vertices)."""
+    seen = _recorded(monkeypatch)
+    rescon.safe_kernel(_cloud(kind, d, n, F), F)
+    assert seen
+    for tight, basis, normals, k, starts in seen:
+        _agrees_with_the_double_description(tight, basis, normals, k, starts)
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("sphere", 4, 30, 1), ("cube", 5, 16, 1),
+                                        ("lattice", 4, 27, 4), ("cell24", 4, 28, 4)])
+def test_the_check_settles_non_simple_vertices(kind, d, n, F, monkeypatch):
+    """The check concludes where the double description was needed (every non-simple
+    vertex of these kernels), and the kernel is certified."""
+    seen = _recorded(monkeypatch)
+    rescon.safe_kernel(_cloud(kind, d, n, F), F)
+    tight, basis, normals, k, starts = seen[-1]
+    assert starts
+    assert _agrees_with_the_double_description(tight, basis, normals, k, starts) == len(starts)
+
+
+def _pyramid(scale: int = 1):
+    """The square pyramid over [−1, 1]² × {0} with apex (0, 0, 1): rows x + z ≤ 1 (its
+    normal times ``scale``), −x + z ≤ 1, y + z ≤ 1, −y + z ≤ 1, −z ≤ 0. Vertices: the
+    apex (4 rows, non-simple) and the corners (3 rows)."""
+    normals = [(scale, 0, scale), (-1, 0, 1), (0, 1, 1), (0, -1, 1), (0, 0, -1)]
+    apex = 0b01111
+    corners = [0b10101, 0b10110, 0b11010, 0b11001]  # (1,1), (−1,1), (−1,−1), (1,−1)
+    return [apex, *corners], normals
+
+
+def test_pyramid_apex_is_settled_with_its_four_corners():
+    tight, normals = _pyramid()
+    ok, ends = _closure.combinatorial_rays(tight, normals, 3, [0])
+    assert ok.tolist() == [True] and ends == [[1, 2, 3, 4]]
+
+
+def test_a_modular_rank_that_falls_short_is_not_counted():
+    """Row x + z ≤ 1 scaled by the prime: its normal is 0 modulo the prime, so the
+    shared rows with the corners on it have modular rank 1 < 2 — those corners are not
+    found, and the check defers instead of settling the apex."""
+    tight, normals = _pyramid(PRIME)
+    ok, ends = _closure.combinatorial_rays(tight, normals, 3, [0])
+    assert ok.tolist() == [False] and ends == [[]]
+    R = np.array([[x % PRIME for x in a] for a in normals], dtype=np.int64)
+    work = np.empty_like(R)
+    assert not _closure._rank_at_least(R, 0b00101, 2, work)  # x + z and y + z
+    assert _closure._rank_at_least(R, 0b00110, 2, work)
+
+
+@pytest.mark.parametrize("corner", range(1, 5))
+def test_a_missing_corner_is_refused(corner):
+    tight, normals = _pyramid()
+    tight = tight[:corner] + tight[corner + 1:]
+    ok, _ = _closure.combinatorial_rays(tight, normals, 3, [0])
+    assert ok.tolist() == [False]
+
+
+def test_a_fake_neighbour_on_an_edge_is_refused():
+    """A point inside the edge from the apex to a corner, tight on the edge's rows: the
+    ray's zero set appears twice, which distinct faces never do."""
+    tight, normals = _pyramid()
+    ok, _ = _closure.combinatorial_rays([*tight, 0b00101], normals, 3, [0])
+    assert ok.tolist() == [False]
+
+
+def _kernel_closure(kind, d, n, F, monkeypatch):
+    seen = _recorded(monkeypatch)
+    rescon.safe_kernel(_cloud(kind, d, n, F), F)
+    monkeypatch.undo()
+    return seen[-1]
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("sphere", 4, 30, 1), ("lattice", 4, 27, 4),
+                                        ("cube", 5, 16, 1)])
+def test_tampered_tight_sets_are_refused(kind, d, n, F, monkeypatch):
+    """Removing a proposed vertex (a neighbour of every tenth non-simple one), or a
+    tight row of that neighbour that the rank of their shared rows needs, makes the
+    closure refuse; with a copy of the neighbour the non-simple vertex's check defers."""
+    tight, basis, normals, k, starts = _kernel_closure(kind, d, n, F, monkeypatch)
+
+    by_basis = {tuple(basis[v]): start for v, start in starts.items()}
+
+    def closed(tight, basis):  # the double description starts from the recorded rays
+        return fastpath._closed(tight, basis, normals, k,
+                                lambda bs: [by_basis[tuple(b)] for b in bs])
+
+    edges = closed(tight, basis)
+    assert edges is not None
+    vs = sorted(starts)[::10]
+    for v in vs:
+        u = edges[v][0]
+        dropped = [t for w, t in enumerate(tight) if w != u]
+        kept = [b for w, b in enumerate(basis) if w != u]
+        assert closed(dropped, kept) is None
+        for h in _bits(tight[v] & tight[u]):
+            shared = [normals[g] for g in _bits(tight[v] & tight[u] & ~(1 << h))]
+            if _rank(shared) < k - 1:  # h is needed: without it u is off v's ray
+                bad = list(tight)
+                bad[u] &= ~(1 << h)
+                assert closed(bad, basis) is None
+                break
+        # a copy of u: v's check defers (the double description takes either copy)
+        ok, _ = _closure.combinatorial_rays([*tight, tight[u]], normals, k, [v])
+        assert ok.tolist() == [False]
+
+
+def _rank(rows) -> int:
+    from fractions import Fraction
+
+    M = [[Fraction(x) for x in r] for r in rows]
+    rank = 0
+    for c in range(len(M[0]) if M else 0):
+        piv = next((i for i in range(rank, len(M)) if M[i][c]), None)
+        if piv is None:
+            continue
+        M[rank], M[piv] = M[piv], M[rank]
+        for i in range(len(M)):
+            if i != rank and M[i][c]:
+                f = M[i][c] / M[rank][c]
+                M[i] = [a - f * b for a, b in zip(M[i], M[rank], strict=True)]
+        rank += 1
+    return rank
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("sphere", 4, 30, 1), ("cube", 4, 30, 3),
+                                        ("lattice", 4, 27, 4), ("cell24", 4, 28, 4),
+                                        ("gaussian", 5, 16, 1), ("integer", 5, 14, 1),
+                                        ("tiny", 4, 20, 2), ("huge", 4, 20, 2)])
+def test_kernels_bit_identical_to_the_exact_clipping(kind, d, n, F, monkeypatch):
+    _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
