@@ -115,11 +115,11 @@ def test_other_ends_are_the_vertices_on_each_ray(X, F):
     assert P is not None
     basis = [sorted(_bits(t))[:k] for t in P.tight]  # unused for simple vertices' keys
     index = fastpath._RayIndex(P.tight, basis, len(P.a), k)
-    simple = index.simple.tolist()
-    ends = index.simple_ends()
-    for vi, us in zip(simple, ends, strict=True):
-        for j, u in zip(sorted(_bits(P.tight[vi])), us, strict=True):
-            assert _brute_end(P.tight, vi, P.tight[vi] ^ (1 << j)) == {u}
+    rays = [(vi, P.tight[vi] ^ (1 << j)) for vi in index.simple.tolist()
+            for j in _bits(P.tight[vi])]
+    ends = index.other_ends([vi for vi, _ in rays], [Z for _, Z in rays])
+    for (vi, Z), u in zip(rays, ends, strict=True):
+        assert _brute_end(P.tight, vi, Z) == {u}
     ray_v, ray_z = [], []
     for vi in index.non_simple:
         for u in P.edges[vi]:

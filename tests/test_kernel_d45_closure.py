@@ -43,17 +43,23 @@ def _dd_ends(tight, basis, normals, k, v, start) -> list[int] | None:
 
 
 def _agrees_with_the_double_description(tight, basis, normals, k, starts) -> int:
-    """Where the check concludes, its ends are the double description's; returns how
-    many vertices it settled."""
-    vs = sorted(starts)
-    ok, ends = _closure.combinatorial_rays(tight, normals, k, vs)
-    for v, passed, us in zip(vs, ok.tolist(), ends, strict=True):
-        want = _dd_ends(tight, basis, normals, k, v, starts[v])
+    """Where the check concludes, its ends are the double description's at a non-simple
+    vertex; a simple one is settled iff one vertex holds each k − 1 of its rows (brute
+    force), and its ends are those. Returns how many non-simple vertices it settled."""
+    ok, ends = _closure.combinatorial_rays(tight, normals, k)
+    for v, (passed, us) in enumerate(zip(ok.tolist(), ends, strict=True)):
+        if v in starts:
+            want = _dd_ends(tight, basis, normals, k, v, starts[v])
+        else:
+            holders = [[u for u, t in enumerate(tight) if u != v and t & Z == Z]
+                       for Z in (tight[v] & ~(1 << h) for h in _bits(tight[v]))]
+            want = sorted(u for us in holders for u in us)
+            assert passed == all(len(us) == 1 for us in holders)
         if passed:
             assert us == want, v
         else:
             assert us == []
-    return int(ok.sum())
+    return int(ok[sorted(starts)].sum())
 
 
 CLOUDS = [("gaussian", 3, 30, 3), ("cube", 3, 30, 2), ("sphere", 3, 30, 1),
@@ -103,8 +109,8 @@ def _pyramid(scale: int = 1):
 
 def test_pyramid_apex_is_settled_with_its_four_corners():
     tight, normals = _pyramid()
-    ok, ends = _closure.combinatorial_rays(tight, normals, 3, [0])
-    assert ok.tolist() == [True] and ends == [[1, 2, 3, 4]]
+    ok, ends = _closure.combinatorial_rays(tight, normals, 3)
+    assert ok.all() and ends[0] == [1, 2, 3, 4] and ends[1] == [0, 2, 4]
 
 
 def test_a_modular_rank_that_falls_short_is_not_counted():
@@ -112,8 +118,8 @@ def test_a_modular_rank_that_falls_short_is_not_counted():
     shared rows with the corners on it have modular rank 1 < 2 — those corners are not
     found, and the check defers instead of settling the apex."""
     tight, normals = _pyramid(PRIME)
-    ok, ends = _closure.combinatorial_rays(tight, normals, 3, [0])
-    assert ok.tolist() == [False] and ends == [[]]
+    ok, ends = _closure.combinatorial_rays(tight, normals, 3)
+    assert not ok[0] and ends[0] == []
     R = np.array([[x % PRIME for x in a] for a in normals], dtype=np.int64)
     work = np.empty_like(R)
     assert not _closure._rank_at_least(R, 0b00101, 2, work)  # x + z and y + z
@@ -124,16 +130,16 @@ def test_a_modular_rank_that_falls_short_is_not_counted():
 def test_a_missing_corner_is_refused(corner):
     tight, normals = _pyramid()
     tight = tight[:corner] + tight[corner + 1:]
-    ok, _ = _closure.combinatorial_rays(tight, normals, 3, [0])
-    assert ok.tolist() == [False]
+    ok, _ = _closure.combinatorial_rays(tight, normals, 3)
+    assert not ok[0] and not ok.all()
 
 
 def test_a_fake_neighbour_on_an_edge_is_refused():
     """A point inside the edge from the apex to a corner, tight on the edge's rows: the
     ray's zero set appears twice, which distinct faces never do."""
     tight, normals = _pyramid()
-    ok, _ = _closure.combinatorial_rays([*tight, 0b00101], normals, 3, [0])
-    assert ok.tolist() == [False]
+    ok, _ = _closure.combinatorial_rays([*tight, 0b00101], normals, 3)
+    assert ok.tolist() == [False, False, True, True, True, False]  # (1, 1) too
 
 
 def _kernel_closure(kind, d, n, F, monkeypatch):
@@ -173,8 +179,8 @@ def test_tampered_tight_sets_are_refused(kind, d, n, F, monkeypatch):
                 assert closed(bad, basis) is None
                 break
         # a copy of u: v's check defers (the double description takes either copy)
-        ok, _ = _closure.combinatorial_rays([*tight, tight[u]], normals, k, [v])
-        assert ok.tolist() == [False]
+        ok, _ = _closure.combinatorial_rays([*tight, tight[u]], normals, k)
+        assert not ok[v]
 
 
 def _rank(rows) -> int:

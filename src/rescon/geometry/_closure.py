@@ -1,10 +1,10 @@
-"""Combinatorial closure of a non-simple vertex's tangent cone (:mod:`.fastpath`).
+"""Combinatorial closure of the vertices' tangent cones (:mod:`.fastpath`).
 
 The fast path must show that every extreme ray of the tangent cone
 C_v = {d : a_h·d ≤ 0, h ∈ T(v)} of every proposed vertex v (T(v): the rows of S tight at
-v, computed exactly) leads to another proposed vertex. This module does it for a
-non-simple v from the exact tight sets alone; where it cannot conclude, the caller runs
-the double description of C_v.
+v, computed exactly, of rank k) leads to another proposed vertex. This module does it
+from the exact tight sets alone, simple and non-simple vertices alike; where it cannot
+conclude at a non-simple v, the caller runs the double description of C_v.
 
 **Faces and zero sets.** C_v is pointed (v is a vertex: T(v) has rank k). A face F of
 C_v is C_v ∩ {a_h·d = 0, h ∈ Z_F} with Z_F ⊆ T(v) the rows tight on all of F (its zero
@@ -43,9 +43,11 @@ and its extreme rays are the r faces with zero sets Z_G − {g}: all r must be j
 Started from the found rays (j = 1, A = {0}), a pass proves they are all the extreme
 rays of C_v, each ending at a proposed vertex; the proposed vertices u found are then
 exactly v's neighbours on P_S. A check that exceeds its work bound, a vertex of more than
-MAX_ROWS tight rows, a missing face, or two found faces of one dimension whose zero sets
-contain one another (impossible for distinct faces: the tight sets are not exact) fails:
-the caller falls back to the double description of C_v (never to a weaker answer).
+MAX_ROWS (or fewer than k) tight rows, a missing face, or two found faces of one
+dimension whose zero sets contain one another (impossible for distinct faces: the tight
+sets are not exact) fails. The caller then runs the double description of a non-simple
+C_v; a simple v has a ray without an end (every vertex holding k − 1 of its k rows was
+looked at), and the caller refuses.
 """
 
 from __future__ import annotations
@@ -65,48 +67,45 @@ MAX_ROWS = 62
 WORK = 200_000
 
 
-def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
-                       vs: list[int]) -> tuple[np.ndarray, list[list[int]]]:
-    """For each vertex of ``vs`` (non-simple: more than k rows tight), whether the
-    combinatorial check (module docstring) proves that the proposed vertices u with
-    rank(T(v) ∩ T(u)) = k − 1 end all the extreme rays of its tangent cone, and those u
-    (increasing; empty where it does not)."""
-    if not vs:
-        return np.zeros(0, dtype=np.bool_), []
+def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int
+                       ) -> tuple[np.ndarray, list[list[int]]]:
+    """For every vertex v (``tight``: its rows, of rank k), whether the check (module
+    docstring) proves that the proposed vertices u with rank(T(v) ∩ T(u)) = k − 1 end
+    all the extreme rays of its tangent cone, and those u, increasing (empty where it
+    does not). At a simple vertex (k rows, independent) every k − 1 of them have rank
+    k − 1: no modular rank is needed, and the check passes iff each of its k rays has
+    an end."""
     v_of, h_of = tight_pairs(tight)  # by vertex, then row
     v_ptr = np.searchsorted(v_of, np.arange(len(tight) + 1)).astype(np.int64)
     by_row = np.argsort(h_of, kind="stable")  # by row, then vertex
     h_ptr = np.searchsorted(h_of[by_row], np.arange(len(normals) + 1)).astype(np.int64)
     residues = np.array([[x % PRIME for x in a] for a in normals], dtype=np.int64)
-    ok = np.zeros(len(vs), dtype=np.bool_)
+    ok = np.zeros(len(tight), dtype=np.bool_)
     ptr, ends = _closures(v_ptr, h_of.astype(np.int64), h_ptr,
-                          v_of[by_row].astype(np.int64), residues,
-                          np.asarray(vs, dtype=np.int64), k, ok)
+                          v_of[by_row].astype(np.int64), residues.reshape(-1, k), k, ok)
     ends = ends.tolist()
     return ok, [ends[a:b] for a, b in zip(ptr[:-1].tolist(), ptr[1:].tolist(), strict=True)]
 
 
 @njit(cache=True, nogil=True)
-def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, vs, k, ok):
+def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok):
     """:func:`combinatorial_rays` on the incidences in CSR form (v_rows[v_ptr[v]:
     v_ptr[v + 1]]: the rows of vertex v, increasing; h_verts likewise the vertices of
-    each row): ok[i] for vs[i], and the ends of the passing ones (ends[ptr[i]:ptr[i +
-    1]])."""
+    each row): ok[v], and the ends of the passing vertices (ends[ptr[v]:ptr[v + 1]])."""
     n = len(v_ptr) - 1
     count = np.zeros(n, dtype=np.int64)
     mask = np.zeros(n, dtype=np.int64)
     touched = np.empty(n, dtype=np.int64)
-    ptr = np.zeros(len(vs) + 1, dtype=np.int64)
-    ends = np.empty(16, dtype=np.int64)
+    ptr = np.zeros(n + 1, dtype=np.int64)
+    ends = np.empty(16 * n + 16, dtype=np.int64)
     found_u = np.empty(n, dtype=np.int64)
     found_z = np.empty(n, dtype=np.int64)
     R = np.empty((MAX_ROWS, k), dtype=np.int64)
     work = np.empty((MAX_ROWS, k), dtype=np.int64)
-    for i in range(len(vs)):
-        v = vs[i]
-        ptr[i + 1] = ptr[i]
+    for v in range(n):
+        ptr[v + 1] = ptr[v]
         t = v_ptr[v + 1] - v_ptr[v]
-        if t > MAX_ROWS:
+        if t < k or t > MAX_ROWS:
             continue
         # the vertices sharing rows with v: how many, and which (bits over v's rows)
         m = 0
@@ -125,7 +124,7 @@ def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, vs, k, ok):
         f = 0
         for e in range(m):
             u = touched[e]
-            if count[u] >= k - 1 and _rank_at_least(R, mask[u], k - 1, work):
+            if count[u] >= k - 1 and (t == k or _rank_at_least(R, mask[u], k - 1, work)):
                 found_u[f] = u
                 found_z[f] = mask[u]
                 f += 1
@@ -133,13 +132,13 @@ def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, vs, k, ok):
             mask[u] = 0
         if not _faces_closed(found_z[:f].copy(), k - 1, R, work):
             continue
-        ok[i] = True
-        if ptr[i] + f > len(ends):
-            grown = np.empty(2 * (ptr[i] + f), dtype=np.int64)
-            grown[:ptr[i]] = ends[:ptr[i]]
+        ok[v] = True
+        if ptr[v] + f > len(ends):
+            grown = np.empty(2 * (ptr[v] + f), dtype=np.int64)
+            grown[:ptr[v]] = ends[:ptr[v]]
             ends = grown
-        ends[ptr[i]:ptr[i] + f] = np.sort(found_u[:f])
-        ptr[i + 1] = ptr[i] + f
+        ends[ptr[v]:ptr[v] + f] = np.sort(found_u[:f])
+        ptr[v + 1] = ptr[v] + f
     return ptr, ends[:ptr[-1]]
 
 

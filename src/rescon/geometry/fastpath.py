@@ -314,21 +314,24 @@ def _bitsets(vs: np.ndarray, hs: np.ndarray, n: int, width: int) -> list[int]:
 def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
             k: int, start_rays) -> list[list[int]] | None:
     """The edges of P_S — for each vertex, its neighbours, increasing — if every extreme
-    ray of every vertex's tangent cone leads to another vertex, else None. A simple
-    vertex (k tight rows, its basis) has a simplicial cone whose rays keep all but one
-    row tight. A non-simple one is settled from the tight sets where
-    :func:`._closure.combinatorial_rays` concludes; the others' rays come from
-    :func:`_tangent_rays`. The rows Z tight along a ray have rank k − 1, so a vertex
-    u ≠ v lies on the ray's line iff Z ⊆ tight[u], and then it is the other end of the
-    edge (the line meets P_S in that edge). Found through the (k − 1)-subsets of the
-    tight sets (:class:`_RayIndex`). ``start_rays``: for a list of bases, their
-    simplicial cones' rays (:func:`_simplicial_rays`), where the double descriptions
-    start."""
+    ray of every vertex's tangent cone leads to another vertex, else None. The rows Z
+    tight along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff
+    Z ⊆ tight[u], and then it is the other end of the edge (the line meets P_S in that
+    edge). Every vertex is settled from the tight sets where
+    :func:`._closure.combinatorial_rays` concludes. It looks at every vertex holding
+    k − 1 of a simple vertex's k (independent) rows, so a simple vertex it does not
+    settle has a ray that leads nowhere. A non-simple one's rays then come from
+    :func:`_tangent_rays`, their ends through the (k − 1)-subsets of the tight sets
+    (:class:`_RayIndex`). ``start_rays``: for a list of bases, their simplicial cones'
+    rays (:func:`_simplicial_rays`), where the double descriptions start."""
     from ._closure import combinatorial_rays
 
-    index = _RayIndex(tight, basis, len(normals), k)
-    settled, settled_ends = combinatorial_rays(tight, normals, k, index.non_simple)
-    rest = [vi for vi, ok in zip(index.non_simple, settled.tolist(), strict=True) if not ok]
+    settled, edges = combinatorial_rays(tight, normals, k)
+    rest = np.flatnonzero(~settled).tolist()
+    if not rest:
+        return edges
+    if any(tight[vi].bit_count() <= k for vi in rest):
+        return None
     starts = start_rays([basis[vi] for vi in rest])
     ray_v: list[int] = []
     ray_z: list[int] = []
@@ -336,18 +339,15 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
         for Z in _tangent_rays(normals, basis[vi], list(_bits(tight[vi])), k, start):
             ray_v.append(vi)
             ray_z.append(Z)
-    ends = index.other_ends(ray_v, ray_z)
-    simple_ends = index.simple_ends()
-    if ends is None or simple_ends is None:
+    ends = _RayIndex(tight, basis, len(normals), k).other_ends(ray_v, ray_z)
+    if ends is None:
         return None
-    edges: list[set[int]] = [set() for _ in tight]
+    found: dict[int, set[int]] = {vi: set() for vi in rest}
     for vi, u in zip(ray_v, ends, strict=True):
-        edges[vi].add(u)
-    for vi, us in zip(index.simple.tolist(), simple_ends, strict=True):
-        edges[vi].update(us)
-    for vi, us in zip(index.non_simple, settled_ends, strict=True):
-        edges[vi].update(us)
-    return [sorted(e) for e in edges]
+        found[vi].add(u)
+    for vi, us in found.items():
+        edges[vi] = sorted(us)
+    return edges
 
 
 class _RayIndex:
@@ -385,25 +385,6 @@ class _RayIndex:
         K = np.concatenate(keys)
         order = np.argsort(K, kind="stable")
         self.keys, self.owners = K[order], np.concatenate(owners)[order]
-
-    def simple_ends(self) -> list[list[int]] | None:
-        """For each simple vertex, the other ends of its k rays (all at once: the ray
-        leaving row j keeps the others, a key, and every vertex registered under it
-        lies on the ray's line), or None if one leads nowhere."""
-        if not len(self.simple):
-            return []
-        k, B = self.k, self.simple_rows
-        K = np.stack([np.delete(B, j, axis=1) @ self.W for j in range(k)], axis=1)
-        other = self._other_owner(K, self.simple[:, None])
-        out = other.tolist()
-        for s in np.flatnonzero((other < 0).any(axis=1)).tolist():  # none registered: scan
-            vi = int(self.simple[s])
-            for j in np.flatnonzero(other[s] < 0).tolist():
-                u = self._scan(vi, self.tight[vi] ^ (1 << int(B[s, j])))
-                if u is None:
-                    return None
-                out[s][j] = u
-        return out
 
     def other_ends(self, ray_v: list[int], ray_z: list[int]) -> list[int] | None:
         """For each ray (vertex v, tight rows Z), a vertex u ≠ v with Z ⊆ tight[u]: among
