@@ -119,3 +119,28 @@ def test_d5_default_runs_when_the_first_options_proposal_does_not_certify(monkey
     ("simplex", 4, 5, 0), ("nearsame", 5, 12, 1), ("gaussian", 5, 12, 1)])
 def test_kernels_identical_to_the_exact_clipping(kind, d, n, F, monkeypatch):
     _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_rows_violated_by_a_proposal_join_the_next_round(seed, monkeypatch):
+    """A third of the defining rows given to qhull: its first proposal cuts off too
+    little, the certification (which runs while the row maxima are computed on a
+    second thread) fails, the violated rows join, and the next round's kernel is the
+    exact clipping's."""
+    from tests.test_kernel_d45 import _both_paths
+
+    X = np.random.default_rng(seed).normal(size=(22, 4))
+    _, slow, H, unit, first = _both_paths(X, 2)
+    few = np.sort(np.random.default_rng(seed).choice(first, size=len(first) // 3,
+                                                     replace=False))
+    rounds = []
+    propose = fastpath._propose
+
+    def spy(H_, sel, options=None):
+        rounds.append(len(sel))
+        return propose(H_, sel, options)
+
+    monkeypatch.setattr(fastpath, "_propose", spy)
+    P = fastpath.certified_kernel(H, 4, unit, few)
+    assert len(rounds) == 2 and rounds[1] > rounds[0]
+    assert P is not None and set(P.fraction_vertices()) == set(slow.fraction_vertices())

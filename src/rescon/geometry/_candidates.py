@@ -701,19 +701,21 @@ def _chunked_max_parallel(A, b, W, starts, centres, radii, norms, floor, out):
                            m * (c + 1) // 64, out)
 
 
-def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float) -> np.ndarray:
+def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float,
+            parallel: bool = True) -> np.ndarray:
     """Per row h an upper bound on max_v a_h·v − b_h over the float points V, which is
     the maximum itself (evaluated in floats) wherever that may be ≥ 0: chunks of V
     (:func:`ball_chunks`) whose ball lies surely below the hyperplane contribute
     their ball's bound, the others their points' values. ``floor``: the underflow
-    term of these products."""
+    term of these products. ``parallel`` False: on the calling thread only, without
+    the GIL (for a caller that works meanwhile)."""
     order, starts, centres, radii = ball_chunks(V)
     W = np.ascontiguousarray(V[order])
     A = np.ascontiguousarray(A)
     b = np.ascontiguousarray(b)
     norms = np.sqrt((A**2).sum(axis=1))
     out = np.empty(A.shape[0])
-    if A.shape[0] * (len(starts) - 1) >= 20_000:
+    if parallel and A.shape[0] * (len(starts) - 1) >= 20_000:
         _chunked_max_parallel(A, b, W, starts, centres, radii, norms, floor, out)
     else:
         _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, 0, A.shape[0],

@@ -39,6 +39,7 @@ import contextlib
 import gc
 import itertools
 import operator
+from concurrent.futures import Future, ThreadPoolExecutor
 from math import gcd
 
 import numpy as np
@@ -181,8 +182,11 @@ def _collection_deferred():
 
 def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
              ) -> ExactPolytope | None:
-    """Proposals from qhull with ``options`` (halfspaces violated by a proposed vertex
-    join ``sel`` for the next round), certified by :func:`_certify`; None on failure."""
+    """Proposals from qhull with ``options``, certified by :func:`_certify`; None on
+    failure. The rows' float maxima over the proposed vertices (:func:`_row_max`,
+    compiled code without the GIL) run on a second thread while this one solves the
+    vertices exactly; if the certification fails, the halfspaces clearly violated by a
+    proposed vertex join ``sel`` for the next round."""
     for _ in range(MAX_ROUNDS):
         prop = _propose(H, sel, options)
         if prop is None:
@@ -190,35 +194,38 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
         V, facets = prop
         if any(len(f) < k for f in facets):
             return None
-        # floats first: halfspaces clearly violated by a proposed vertex join sel
-        top = _row_max(H, V)
-        bad = top > 1e-9 * (1.0 + np.abs(H.bf))
-        if bad.any():
-            sel = np.union1d(sel, np.flatnonzero(bad))
-            continue
-        return _certify(H, k, scale, sel, facets, V, top, pieces=options == "QJ")
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            top = pool.submit(_row_max, H, V, False)
+            P = _certify(H, k, scale, sel, facets, V, top, pieces=options == "QJ")
+            bad = top.result() > 1e-9 * (1.0 + np.abs(H.bf))
+        if P is not None or not bad.any():
+            return P
+        sel = np.union1d(sel, np.flatnonzero(bad))
     return None
 
 
-def _row_max(H, V: np.ndarray) -> np.ndarray:
+def _row_max(H, V: np.ndarray, parallel: bool = True) -> np.ndarray:
     """Per row h, an upper bound on max_v a_h·v − b_h over the float vertices V (the
     value itself where it may be ≥ 0): :func:`._candidates.row_top` — balls around
     chunks of nearby vertices bound the rows that pass far from them, only the
-    chunks a row may reach are evaluated vertex by vertex."""
+    chunks a row may reach are evaluated vertex by vertex (on one thread, without
+    the GIL, unless ``parallel``)."""
     from ._candidates import row_top
 
-    return row_top(H.af, H.bf, V, H.floor())
+    return row_top(H.af, H.bf, V, H.floor(), parallel)
 
 
 def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
-             V: np.ndarray | None = None, top: np.ndarray | None = None,
+             V: np.ndarray | None = None, top: Future | None = None,
              pieces: bool = False) -> ExactPolytope | None:
     """Exact vertices from the proposed defining sets (merged when equal), their full
     tight sets among the defining halfspaces S, feasibility against every valid
     halfspace, and closure: every extreme ray of every vertex's tangent cone leads to
     another proposed vertex (see the module docstring). ``pieces``: the proposals are
     simplicial pieces (joggled qhull), several per non-simple vertex — one per point
-    is solved (:func:`_one_per_point`)."""
+    is solved (:func:`_one_per_point`). ``top``: the rows' maxima over V
+    (:func:`_row_max`, being computed), else they are computed over the exact
+    vertices' floats."""
     S_set = np.unique(sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
                                       count=sum(map(len, facets)))]).tolist()
     H.exact_all(S_set)
@@ -260,6 +267,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
         shift = np.abs(V[kept] - Vx[of_proposal]).max()
         row_bound = row_bound + l1 * shift
+        top = top.result()
     rows = np.flatnonzero(~(top < -row_bound))  # the rows not surely slack at every vertex
     near = _near_pairs(H, rows, Vx, coarse[rows], c, floor)
     if near is None:
