@@ -144,3 +144,20 @@ def test_rows_violated_by_a_proposal_join_the_next_round(seed, monkeypatch):
     P = fastpath.certified_kernel(H, 4, unit, few)
     assert len(rounds) == 2 and rounds[1] > rounds[0]
     assert P is not None and set(P.fraction_vertices()) == set(slow.fraction_vertices())
+
+
+@pytest.mark.parametrize("k,r", [(3, 3), (4, 4), (5, 5), (4, 3)])
+def test_paired_rows_is_the_first_pair_sharing_k_minus_1_points(k, r):
+    """The compiled pair search of ``_meet`` against a brute force over the pairs of
+    rows (each row k distinct points of 0..k + 2, so many pairs share k − 1)."""
+    from rescon.geometry._certify_nb import paired_rows
+
+    rng = np.random.default_rng([k, r])
+    pts = np.array([[rng.choice(k + 3, size=k, replace=False) for _ in range(r)]
+                    for _ in range(400)], dtype=np.int64)
+    pairs = list(itertools.combinations(range(r), 2))
+    want = [next((g for g, (a, b) in enumerate(pairs)
+                  if len(set(row[a]) & set(row[b])) == k - 1), -1) for row in pts.tolist()]
+    got = paired_rows(pts, k).tolist()
+    assert got == want
+    assert -1 in got and any(g > 0 for g in got)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["KEY_PRIME", "point_keys"]
+__all__ = ["KEY_PRIME", "paired_rows", "point_keys"]
 
 #: the largest prime below 2^31 − 1 (a compile-time constant: the reductions modulo it
 #: compile to multiplications); residues < 2^31, so a product of two fits an int64
@@ -99,3 +99,27 @@ def point_keys(E, at, keys):
             keys[i, r] = num[i, r] * (inv * prefix[t] % p) % p
         inv = inv * flat[t] % p
     return ok
+
+
+@njit(cache=True, nogil=True)
+def paired_rows(pts, k):
+    """For each row set i (pts[i, a]: the k data points of its row a), the index of its
+    first pair of rows a < b, in lexicographic order, that share k − 1 data points;
+    −1 if none shares them."""
+    P, r, _ = pts.shape
+    out = np.full(P, -1, dtype=np.int64)
+    for i in range(P):
+        g = 0
+        for a in range(r):
+            for b in range(a + 1, r):
+                if out[i] < 0:
+                    common = 0
+                    for s in range(k):
+                        for t in range(k):
+                            if pts[i, a, s] == pts[i, b, t]:
+                                common += 1
+                                break
+                    if common == k - 1:
+                        out[i] = g
+                g += 1
+    return out

@@ -605,13 +605,12 @@ def _meet(H, E: np.ndarray, R: np.ndarray, at: np.ndarray, k: int,
     data points; 1 for the row at infinity): λ is the cross product of M
     (:func:`.exact.cross_all`), nonzero as M has full rank (the rows, the one at
     infinity included, are independent, so x spans their null space)."""
+    from ._certify_nb import paired_rows
+
     r = R.shape[1]
-    pts = H.through[R]  # (P, r, k): the data points of each row
+    pts = np.ascontiguousarray(H.through[R], dtype=np.int64)  # (P, r, k): the rows' points
     pairs = list(itertools.combinations(range(r), 2))
-    group = np.full(len(R), -1)
-    for g, (i, j) in enumerate(pairs):
-        common = (pts[:, i, :, None] == pts[:, j, None, :]).any(axis=2).sum(axis=1)
-        group[(group < 0) & (common == k - 1)] = g
+    group = paired_rows(pts, k)
     L = _object_rows([(1, *y) for y in H.Yi], k + 1)
     X = np.empty((len(R), k + 1), dtype=object)
     extra = np.full((len(R), int(direction)), len(E) - 1)  # the row at infinity
