@@ -207,3 +207,35 @@ def _rank(rows) -> int:
                                         ("tiny", 4, 20, 2), ("huge", 4, 20, 2)])
 def test_kernels_bit_identical_to_the_exact_clipping(kind, d, n, F, monkeypatch):
     _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
+
+
+def _octahedral_pyramid():
+    """The pyramid in ℝ⁴ over the octahedron |x| + |y| + |z| ≤ 1 (w = 0) with apex
+    (0, 0, 0, 1): rows s·(x, y, z) + w ≤ 1 for s ∈ {±1}³ and −w ≤ 0. Every vertex is
+    non-simple (the apex on 8 rows, the base vertices on 5), and every ray of the
+    apex's cone is non-simple in its cross-section (4 rows of rank 3): the check
+    recurses into the face figures."""
+    signs = [(a, b, c) for a in (1, -1) for b in (1, -1) for c in (1, -1)]
+    rows = [((*s, 1), 1) for s in signs] + [((0, 0, 0, -1), 0)]
+    verts = [(0, 0, 0, 1)] + [tuple(s * (i == j) for j in range(3)) + (0,)
+                              for i in range(3) for s in (1, -1)]
+    tight = [sum(1 << h for h, (a, b) in enumerate(rows)
+                 if sum(x * y for x, y in zip(a, v, strict=True)) == b) for v in verts]
+    return tight, [a for a, _ in rows]
+
+
+def test_octahedral_pyramid_is_settled_through_the_face_figures():
+    tight, normals = _octahedral_pyramid()
+    assert [t.bit_count() for t in tight] == [8, 5, 5, 5, 5, 5, 5]
+    ok, ends = _closure.combinatorial_rays(tight, normals, 4)
+    assert ok.all()
+    assert ends[0] == [1, 2, 3, 4, 5, 6]
+    assert ends[1] == [0, 3, 4, 5, 6]  # e1: the apex and ±e2, ±e3
+
+
+@pytest.mark.parametrize("gone", range(1, 7))
+def test_octahedral_pyramid_without_a_base_vertex_is_refused(gone):
+    tight, normals = _octahedral_pyramid()
+    tight = tight[:gone] + tight[gone + 1:]
+    ok, _ = _closure.combinatorial_rays(tight, normals, 4)
+    assert not ok[0]
