@@ -239,3 +239,22 @@ def test_octahedral_pyramid_without_a_base_vertex_is_refused(gone):
     tight = tight[:gone] + tight[gone + 1:]
     ok, _ = _closure.combinatorial_rays(tight, normals, 4)
     assert not ok[0]
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("sphere", 4, 20, 1), ("cell24", 4, 28, 4),
+                                        ("nearsame", 5, 13, 1)])
+def test_the_double_description_where_the_check_defers(kind, d, n, F, monkeypatch):
+    """With the check deferring at every non-simple vertex (none defers on these clouds
+    otherwise), their double descriptions give the same kernel as the exact clipping."""
+    real = _closure.combinatorial_rays
+    deferred = []
+
+    def deferring(tight, normals, k):
+        ok, ends = real(tight, normals, k)
+        wide = np.array([t.bit_count() > k for t in tight], dtype=bool)
+        deferred.append(int(wide.sum()))
+        return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
+
+    monkeypatch.setattr(_closure, "combinatorial_rays", deferring)
+    _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
+    assert deferred and deferred[-1] > 0
