@@ -154,9 +154,12 @@ def _faces_closed(faces, r, R, work):
     spent = 0
     while tasks:
         start, n, r = tasks.pop()
-        if n == 0 or (r == 1 and n < 2):
+        if n == 0:
             return False
-        if r == 1:
+        if r == 1:  # exactly two facets over the face, neither's zero set in the other's
+            J = store[start] & store[start + n - 1]
+            if n != 2 or J == store[start] or J == store[start + 1]:
+                return False
             continue
         for a in range(start, start + n):
             G = store[a]
