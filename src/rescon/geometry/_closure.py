@@ -55,6 +55,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._candidates import _popcount
 from .polytope import PRIME, tight_pairs
 
 __all__ = ["combinatorial_rays"]
@@ -239,12 +240,3 @@ def _rank_at_least(R, bits, r, work):
         if rank >= r:
             return True
     return False
-
-
-@njit(cache=True, nogil=True)
-def _popcount(x):
-    n = 0
-    while x:
-        x &= x - 1
-        n += 1
-    return n
