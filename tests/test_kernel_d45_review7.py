@@ -25,6 +25,7 @@ import pytest
 
 import rescon
 from rescon.geometry import _closure, fastpath
+from rescon.geometry import kernel as km
 from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
 
 # --- exact polytopes by brute force -------------------------------------------------
@@ -498,6 +499,7 @@ def _hostile(kind: str, d: int, n: int, F: int) -> np.ndarray:
     Z = rng.normal(size=(n, d))
     return {
         "anisotropic": lambda: Z * np.logspace(-150, 150, d)[None, :],
+        "stretched": lambda: Z * np.logspace(-4, 4, d)[None, :],
         "mixed": lambda: Z * 10.0 ** rng.integers(-300, 300, size=(n, 1)),
         "planes": lambda: _on_planes(np.round(4 * Z)),
         "close_pairs": lambda: 1.0 + 1e-12 * np.vstack([Z, Z + 1e-15 * rng.normal(
@@ -517,18 +519,53 @@ def _on_planes(X: np.ndarray) -> np.ndarray:
     return X
 
 
-HOSTILE = [("anisotropic", 3, 30, 3), ("anisotropic", 4, 20, 2), ("anisotropic", 5, 13, 1),
-           ("mixed", 3, 30, 2), ("mixed", 4, 10, 1), ("planes", 3, 30, 4), ("planes", 4, 20, 3),
-           ("planes", 5, 13, 2), ("close_pairs", 3, 30, 2), ("close_pairs", 4, 20, 2),
-           ("close_pairs", 5, 13, 1), ("doubled_integers", 3, 30, 4),
-           ("doubled_integers", 4, 20, 2), ("doubled_integers", 5, 13, 2),
-           ("far_converged", 3, 30, 3), ("far_converged", 4, 20, 2),
-           ("far_converged", 5, 13, 1), ("simplex", 3, 4, 0), ("simplex", 5, 6, 0)]
+HOSTILE = [("planes", 3, 30, 4), ("planes", 4, 20, 3), ("planes", 5, 13, 2),
+           ("close_pairs", 3, 30, 2), ("close_pairs", 4, 20, 2), ("close_pairs", 5, 13, 1),
+           ("doubled_integers", 3, 30, 4), ("doubled_integers", 4, 20, 2),
+           ("doubled_integers", 5, 13, 2), ("far_converged", 3, 30, 3),
+           ("far_converged", 4, 20, 2), ("far_converged", 5, 13, 1), ("stretched", 4, 20, 2),
+           ("stretched", 5, 13, 1)]
+
+
+def _certified(monkeypatch) -> list[bool]:
+    """Whether each fast path of safe_kernel certified its kernel."""
+    out = []
+    real = km.certified_kernel
+
+    def spy(*args):
+        P = real(*args)
+        out.append(P is not None)
+        return P
+
+    monkeypatch.setattr(km, "certified_kernel", spy)
+    return out
 
 
 @pytest.mark.parametrize("kind,d,n,F", HOSTILE)
-def test_hostile_kernels_identical_to_the_exact_clipping(kind, d, n, F, monkeypatch):
+def test_hostile_kernels_certified_and_identical_to_the_exact_clipping(kind, d, n, F,
+                                                                      monkeypatch):
+    """Points on three common hyperplanes, pairs 1e-15 apart near 1, every integer
+    point twice, clouds converged at 1e200, columns scaled 1e-4..1e4: the fast path
+    certifies, and every output equals the exact clipping's."""
+    certified = _certified(monkeypatch)
     _same_as_clipping(_hostile(kind, d, n, F), F, monkeypatch)
+    assert certified[0]
+
+
+@pytest.mark.parametrize("kind,d,n,F", [
+    ("mixed", 3, 30, 2), ("mixed", 4, 10, 1), ("simplex", 3, 4, 0), ("simplex", 5, 6, 0),
+    ("anisotropic", 3, 30, 3),
+    pytest.param("anisotropic", 4, 20, 2, marks=pytest.mark.slow),
+    pytest.param("anisotropic", 5, 13, 1, marks=pytest.mark.slow)])
+def test_kernels_the_fast_path_declines_identical_to_the_exact_clipping(kind, d, n, F,
+                                                                        monkeypatch):
+    """Rows of magnitudes 1e-300..1e300 mixed, n = d + 1, columns scaled 1e-150..1e150
+    (the fast path is not tried — too few halfspaces — or finds no proposal: a float
+    row's norm is 0, or the Chebyshev LP on unit rows finds no ball in a kernel
+    1e-10 as thin as it is wide)."""
+    certified = _certified(monkeypatch)
+    _same_as_clipping(_hostile(kind, d, n, F), F, monkeypatch)
+    assert not any(certified)
 
 
 @pytest.mark.slow
