@@ -298,18 +298,20 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     else:
         af, af_abs = cofactors(np.ascontiguousarray(Y, dtype=np.float64), subsets[idx])
         af *= sign[:, None]
-    if k == 3 and not exact_floats and expansions:
-        # nearly collinear triples: their float cofactors' error (relative to the
-        # permanents) can exceed a tiny kernel, so take the exact normals, rounded
-        # (error ≤ ε|a_j|); the others keep their cofactors with the permanents scaled
-        # to the smaller c_err
-        c_new = 8 * _EPS  # |af − a| ≤ ε|a|; |bf − b| ≤ ~4.1ε Σ|a_j p0_j|
+    if k >= 3 and not exact_floats and (expansions if k == 3 else exact_view):
+        # nearly dependent subsets (collinear triples; in k ≥ 4 a hyperplane through
+        # far outliers and a tight cluster, whose cofactors cancel ~1e12-fold): their
+        # float cofactors' error (relative to the permanents) can exceed a tiny kernel,
+        # so take the exact normals, rounded (error ≤ ε|a_j| + 2^-1075); the others
+        # keep their cofactors with the permanents scaled to the smaller c_err
+        c_new = max(8, k + 4) * _EPS  # |af − a| ≤ ε|a|; |bf − b| ≤ ~(k + 1.1)ε Σ|a_j p0_j|
         ill = np.flatnonzero(np.abs(af).sum(axis=1) < ILL_CONDITIONED * af_abs.sum(axis=1))
         af_abs = af_abs * (1.1 * c_err / c_new)
         c_err = c_new
         if len(ill):
-            af[ill] = _exact_normals3(Y, through[ill], small) * sign[ill, None]
-            af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS)
+            af[ill] = (_exact_normals3(Y, through[ill], small) if k == 3
+                       else _rounded_cofactors(Y, Yi, through[ill])) * sign[ill, None]
+            af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS) + (k > 3) * MIN_NORMAL
     bf = np.einsum("ij,ij->i", af, p0)
     b_abs = np.einsum("ij,ij->i", af_abs, np.abs(p0))
     if c_err == 0.0 and k >= 3:  # exact rows: drop repeats (coplanar data: one plane many times)
@@ -349,6 +351,19 @@ def _exact_normals3(Y: np.ndarray, triples: np.ndarray, small: bool) -> np.ndarr
         rows.append([float(a[1] * b[2] - a[2] * b[1]), float(a[2] * b[0] - a[0] * b[2]),
                      float(a[0] * b[1] - a[1] * b[0])])
     return np.array(rows, dtype=np.float64).reshape(-1, 3)
+
+
+def _rounded_cofactors(Y: np.ndarray, Yi: list[tuple[int, ...]], subsets: np.ndarray
+                       ) -> np.ndarray:
+    """The cofactor normals of the subsets in the float coordinates Y = Yi / unit (Y
+    exact, unit a power of two): the integer normal over unit^(k−1), each component
+    correctly rounded (Fraction to float)."""
+    k = Y.shape[1]
+    i, j = np.unravel_index(np.abs(Y).argmax(), Y.shape)
+    unit = Fraction(Yi[i][j]) / Fraction(float(Y[i, j]))
+    den = unit ** (k - 1)
+    return np.array([[float(c / den) for c in exact_normal(Yi, sub)]
+                     for sub in subsets.tolist()], dtype=np.float64).reshape(-1, k)
 
 
 def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
