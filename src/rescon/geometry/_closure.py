@@ -34,7 +34,7 @@ vertices and edges of a (m − 1)-polytope (a cross-section), whose graph is con
 For m = 2 the cone has exactly two extreme rays.
 
 **The check.** Found faces R of dimension j over A (rank r = k − j, m = r + 1) are all
-such faces if R ≠ ∅ and: r = 1 and |R| ≥ 2; or r ≥ 2 and for each G ∈ R the joins
+such faces if R ≠ ∅ and: r = 1 and |R| = 2; or r ≥ 2 and for each G ∈ R the joins
 {G ∨ G' : G' ∈ R} are all the (j + 1)-faces containing G — the extreme rays of C/G
 (dimension r), each a 2-face of C/A at G holding a second member G' of R. That is the
 same check one level down (faces of dimension j + 1 over G), except where Z_G is
@@ -43,11 +43,12 @@ and its extreme rays are the r faces with zero sets Z_G − {g}: all r must be j
 Started from the found rays (j = 1, A = {0}), a pass proves they are all the extreme
 rays of C_v, each ending at a proposed vertex; the proposed vertices u found are then
 exactly v's neighbours on P_S. A check that exceeds its work bound, a vertex of more than
-MAX_ROWS (or fewer than k) tight rows, a missing face, or two found faces of one
-dimension whose zero sets contain one another (impossible for distinct faces: the tight
-sets are not exact) fails. The caller then runs the double description of a non-simple
-C_v; a simple v has a ray without an end (every vertex holding k − 1 of its k rows was
-looked at), and the caller refuses.
+MAX_ROWS (or fewer than k) tight rows, a missing face, more than two at r = 1, or two
+found faces of one dimension whose zero sets contain one another (impossible for
+distinct faces: the tight sets are then not exact, e.g. a vertex copied) fails. The
+caller then runs the double description of a non-simple C_v; a simple v has a ray
+without an end (every vertex holding k − 1 of its k rows was looked at), and the caller
+refuses.
 """
 
 from __future__ import annotations
