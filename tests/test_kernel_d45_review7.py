@@ -255,10 +255,11 @@ def _triangle():
 
 
 def test_k2_copy_of_a_vertex_in_place_of_another_is_refused():
-    """In k = 2 the face figure check (r = 1) only counted the faces: a copy of b in
-    place of c gave a two rays along y = 0 (equal zero sets) and b a 'ray' to its copy
-    (zero set of rank 2) — all three settled, the closure accepted the segment with a
-    doubled vertex. Two distinct facets over a common face never nest."""
+    """In k = 2 the face-figure step (r = 1) only counted the faces: with a copy of b
+    in place of c, a had two rays along y = 0 (equal zero sets) and b a 'ray' to its
+    copy (a zero set of rank 2) — all three were settled and the closure accepted a
+    segment with a doubled vertex (failed before 8701402). Two distinct facets over a
+    common face never nest, and there are exactly two."""
     tight, basis, normals = _triangle()
     assert _closed(tight, basis, normals, 2) == [[1, 2], [0, 2], [0, 1]]
     ok, _ = _closure.combinatorial_rays([tight[0], tight[1], tight[1]], normals, 2)
