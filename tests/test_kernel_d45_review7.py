@@ -400,6 +400,41 @@ def test_an_apex_beyond_the_work_bound_is_deferred(n, settled):
     assert _closed(tight[:3] + tight[4:], basis[:3] + basis[4:], normals, 5) is None
 
 
+@pytest.mark.parametrize("kind,d,n,F", [("cell24", 4, 28, 4), ("lattice", 5, 40, 3),
+                                        ("nearsame", 5, 13, 1), ("sphere", 4, 20, 1)])
+def test_the_double_description_refuses_a_dropped_neighbour(kind, d, n, F, monkeypatch):
+    """With the check deferring at every non-simple vertex, the double description and
+    the ray index give a real kernel's graph, and refuse it without a neighbour of a
+    non-simple vertex."""
+    seen = []
+    real = fastpath._closed
+
+    def record(tight, basis, normals, k, start_rays):
+        seen.append((tight, basis, normals, k, real(tight, basis, normals, k, start_rays)))
+        return seen[-1][-1]
+
+    with monkeypatch.context() as mp:
+        mp.setattr(fastpath, "_closed", record)
+        rescon.safe_kernel(_cloud(kind, d, n, F), F)
+    tight, basis, normals, k, N = seen[-1]
+    checked = _closure.combinatorial_rays
+
+    def deferring(tight, normals, k):
+        ok, ends = checked(tight, normals, k)
+        wide = np.array([t.bit_count() > k for t in tight], dtype=bool)
+        return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
+
+    monkeypatch.setattr(_closure, "combinatorial_rays", deferring)
+    assert _closed(tight, basis, normals, k) == N
+    rng = np.random.default_rng(n)
+    wide = [v for v, t in enumerate(tight) if t.bit_count() > k]
+    assert wide
+    for v in rng.choice(wide, min(5, len(wide)), replace=False).tolist():
+        u = int(rng.choice(N[v]))
+        assert _closed(tight[:u] + tight[u + 1:], basis[:u] + basis[u + 1:], normals,
+                       k) is None
+
+
 # --- tampered proposals to _certify ---------------------------------------------------
 
 
