@@ -283,9 +283,10 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     row_bound = coarse
     if V is None or top is None:
         top = _row_max(H, Vx)
-    else:  # the proposals' maxima, moved by at most ‖a‖₁ · max |V − Vx|
+    else:  # the proposals' maxima: the points moved by at most ‖a‖₁ · max |V − Vx|, and
+        # evaluated at |V| ≤ M + shift (rounding c ‖a‖₁ · shift more than at Vx)
         shift = np.abs(V[kept] - Vx[of_proposal]).max()
-        row_bound = row_bound + l1 * shift
+        row_bound = row_bound + (1.0 + c) * l1 * shift
         top = top.result()
     rows = np.flatnonzero(~(top < -row_bound))  # the rows not surely slack at every vertex
     near = _near_pairs(H, rows, Vx, coarse[rows], c, floor)
