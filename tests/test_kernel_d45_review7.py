@@ -27,24 +27,9 @@ import rescon
 from rescon.geometry import _closure, fastpath
 from rescon.geometry import kernel as km
 from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
+from tests.test_kernel_d45_closure import _rank
 
 # --- exact polytopes by brute force -------------------------------------------------
-
-
-def _rank(rows) -> int:
-    M = [[Fraction(x) for x in r] for r in rows]
-    rank = 0
-    for c in range(len(M[0]) if M else 0):
-        piv = next((i for i in range(rank, len(M)) if M[i][c]), None)
-        if piv is None:
-            continue
-        M[rank], M[piv] = M[piv], M[rank]
-        for i in range(len(M)):
-            if i != rank and M[i][c]:
-                f = M[i][c] / M[rank][c]
-                M[i] = [a - f * b for a, b in zip(M[i], M[rank], strict=True)]
-        rank += 1
-    return rank
 
 
 def _det(M) -> int:
