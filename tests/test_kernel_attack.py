@@ -21,6 +21,7 @@ import pytest
 import rescon
 from benchmarks.kernel_clouds import make_cloud
 from rescon.geometry import kernel as km
+from tests.test_review_v2 import _clipped
 
 
 def _spied(X, F):
@@ -39,15 +40,6 @@ def _spied(X, F):
     finally:
         km.certified_kernel = original
     return K, seen["H"], seen["P"]
-
-
-def _exact_clip(X, F):
-    original = km.certified_kernel
-    km.certified_kernel = lambda *a: None
-    try:
-        return rescon.safe_kernel(X, F)
-    finally:
-        km.certified_kernel = original
 
 
 def _check_rows(H):
@@ -70,7 +62,7 @@ def test_attack_fast_path_is_the_exact_clipping(d, n, F):
     K, H, P = _spied(X, F)
     assert P is not None  # the fast path certified it
     _check_rows(H)
-    E = _exact_clip(X, F)
+    E = _clipped(X, F)
     assert K.exact_vertices == E.exact_vertices
     assert K._exact.constraints == E._exact.constraints
 

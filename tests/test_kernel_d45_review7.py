@@ -25,9 +25,9 @@ import pytest
 
 import rescon
 from rescon.geometry import _closure, fastpath
-from rescon.geometry import kernel as km
 from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
 from tests.test_kernel_d45_closure import _rank
+from tests.test_review_r2 import _fast_path_calls
 
 # --- exact polytopes by brute force -------------------------------------------------
 
@@ -547,27 +547,13 @@ HOSTILE = [("planes", 3, 30, 4), ("planes", 4, 20, 3), ("planes", 5, 13, 2),
            ("stretched", 5, 13, 1)]
 
 
-def _certified(monkeypatch) -> list[bool]:
-    """Whether each fast path of safe_kernel certified its kernel."""
-    out = []
-    real = km.certified_kernel
-
-    def spy(*args):
-        P = real(*args)
-        out.append(P is not None)
-        return P
-
-    monkeypatch.setattr(km, "certified_kernel", spy)
-    return out
-
-
 @pytest.mark.parametrize("kind,d,n,F", HOSTILE)
 def test_hostile_kernels_certified_and_identical_to_the_exact_clipping(kind, d, n, F,
                                                                       monkeypatch):
     """Points on three common hyperplanes, pairs 1e-15 apart near 1, every integer
     point twice, clouds converged at 1e200, columns scaled 1e-4..1e4: the fast path
     certifies, and every output equals the exact clipping's."""
-    certified = _certified(monkeypatch)
+    certified = _fast_path_calls(monkeypatch)
     _same_as_clipping(_hostile(kind, d, n, F), F, monkeypatch)
     assert certified[0]
 
@@ -583,7 +569,7 @@ def test_kernels_the_fast_path_declines_identical_to_the_exact_clipping(kind, d,
     (the fast path is not tried — too few halfspaces — or finds no proposal: a float
     row's norm is 0, or the Chebyshev LP on unit rows finds no ball in a kernel
     1e-10 as thin as it is wide)."""
-    certified = _certified(monkeypatch)
+    certified = _fast_path_calls(monkeypatch)
     _same_as_clipping(_hostile(kind, d, n, F), F, monkeypatch)
     assert not any(certified)
 
