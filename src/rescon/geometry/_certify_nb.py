@@ -106,20 +106,26 @@ def paired_rows(pts, k):
     """For each row set i (pts[i, a]: the k data points of its row a), the index of its
     first pair of rows a < b, in lexicographic order, that share k − 1 data points;
     −1 if none shares them."""
-    P, r, _ = pts.shape
-    out = np.full(P, -1, dtype=np.int64)
-    for i in range(P):
-        g = 0
-        for a in range(r):
-            for b in range(a + 1, r):
-                if out[i] < 0:
-                    common = 0
-                    for s in range(k):
-                        for t in range(k):
-                            if pts[i, a, s] == pts[i, b, t]:
-                                common += 1
-                                break
-                    if common == k - 1:
-                        out[i] = g
-                g += 1
+    out = np.empty(pts.shape[0], dtype=np.int64)
+    for i in range(pts.shape[0]):
+        out[i] = _first_pair(pts[i], k)
     return out
+
+
+@njit(cache=True, nogil=True)
+def _first_pair(rows, k):
+    """The index of the first pair a < b (lexicographic) of ``rows`` (each k data
+    points) sharing k − 1 of them, or −1."""
+    g = 0
+    for a in range(rows.shape[0]):
+        for b in range(a + 1, rows.shape[0]):
+            common = 0
+            for s in range(k):
+                for t in range(k):
+                    if rows[a, s] == rows[b, t]:
+                        common += 1
+                        break
+            if common == k - 1:
+                return g
+            g += 1
+    return -1
