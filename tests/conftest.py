@@ -287,3 +287,14 @@ def solve_exact(M, rhs):
     if any(A[i][cols] for i in range(cols, rows)):
         return None
     return [A[i][cols] for i in range(cols)]
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """The scheduler address of a LocalCluster of 2 worker processes on loopback,
+    shared by the tests of one module."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as local:
+        yield local.scheduler_address

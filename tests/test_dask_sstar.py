@@ -147,16 +147,6 @@ def test_split_part_makes_only_the_bottom_frames_parts_of_their_own():
 # ---------------------------------------------------------------- on a Dask cluster
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    """A LocalCluster of 2 worker processes, shared by the tests of this module."""
-    from distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as local:
-        yield local.scheduler_address
-
-
 @pytest.fixture
 def tiny_parts(monkeypatch):
     """Searches go to the cluster after 50 states, in tasks of 300."""

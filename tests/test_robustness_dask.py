@@ -95,16 +95,6 @@ def test_split_part_keeps_the_order_and_every_frame():
 # ---------------------------------------------------------------- on a Dask cluster
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    """A LocalCluster of 2 worker processes, shared by the tests of this module."""
-    from distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as local:
-        yield local.scheduler_address
-
-
 @pytest.fixture
 def tiny_parts(monkeypatch):
     """Searches go to the cluster after 50 states, in tasks of 500."""

@@ -228,16 +228,6 @@ def _tokens(k: int) -> np.ndarray:
 # ---------------------------------------------------------------- on a Dask cluster
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    """A LocalCluster of 2 worker processes on loopback, shared by this module's tests."""
-    from distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as local:
-        yield local.scheduler_address
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize(("n", "p", "seed", "r"), [(22, 0.7, 0, 8), (24, 0.8, 1, 9)])
 def test_split_on_the_cluster_keeps_the_serial_tree_and_records_no_more(cluster, monkeypatch,

@@ -506,20 +506,10 @@ def test_cli_simulates_a_scenario_file_with_a_generated_graph(tmp_path, capsys):
     assert res["N"] == 10 and res["d"] == 2 and res["final_diameter"] < 1
 
 
-@pytest.fixture(scope="module")
-def local2():
-    """A LocalCluster of 2 worker processes, shared by the tests of this module."""
-    from distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster:
-        yield cluster.scheduler_address
-
-
 @pytest.mark.slow
-def test_every_kind_on_two_workers_gives_the_serial_rows(serial_kinds, local2):
+def test_every_kind_on_two_workers_gives_the_serial_rows(serial_kinds, cluster):
     for name, g in (("gen", GEN), ("rob", ROB), ("ker", KER)):
-        _same_rows(rescon.sweep(g, scheduler=local2), serial_kinds[name])
+        _same_rows(rescon.sweep(g, scheduler=cluster), serial_kinds[name])
 
 
 # ---------------------------------------------------------------- progress and bad input
