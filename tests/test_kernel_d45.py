@@ -4,6 +4,7 @@ handles non-simple vertices exactly and agrees with exact clipping (issue 13 §3
 from __future__ import annotations
 
 import itertools
+from math import gcd
 
 import numpy as np
 import pytest
@@ -33,6 +34,12 @@ def _halfspaces(X, F):
     Yf, unit, exact_view = float_view(rows, P.scale)
     H = valid_halfspaces(Yf, rows, np.array(weights), F, exact_view)
     return H, hull, rows, unit
+
+
+def _primitive_verts(P) -> list[tuple[int, ...]]:
+    """P's vertices as primitive homogeneous (w, y), w > 0: the fast path keeps each
+    vertex as it was solved (any positive multiple), the clipping primitive."""
+    return [tuple(v // gcd(*row) for v in row) for row in P.verts]
 
 
 def _both_paths(X, F):
@@ -71,7 +78,7 @@ def test_fast_path_refuses_a_missing_non_simple_vertex():
     # every proposal of one non-simple vertex left out
     P = fastpath._certify(H, 4, unit, first, facets)
     vi = next(i for i, t in enumerate(P.tight) if bin(t).count("1") > 4)
-    target = P.verts[vi]
+    target = _primitive_verts(P)[vi]
     bases = fastpath._bases(H, [[int(first[i]) for i in f] for f in facets], 4)
     keep = [f for f, v in zip(facets, fastpath._solve_all(H, bases, 4), strict=True)
             if v != target]
@@ -155,8 +162,8 @@ def test_extra_rows_of_a_merged_proposal_are_decided_exactly():
     lied[simple] = [*lied[simple], stranger]
     P = fastpath._certify(H, 4, unit, first, lied)
     if P is not None:
-        assert P.tight[P.verts.index(vertex)].bit_count() == honest.tight[
-            honest.verts.index(vertex)].bit_count()
+        assert P.tight[_primitive_verts(P).index(vertex)].bit_count() == honest.tight[
+            _primitive_verts(honest).index(vertex)].bit_count()
 
 
 @pytest.mark.parametrize("d,n,F", [(3, 40, 4), (4, 22, 2), (5, 12, 1)])

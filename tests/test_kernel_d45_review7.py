@@ -25,6 +25,7 @@ import pytest
 
 import rescon
 from rescon.geometry import _closure, fastpath
+from tests.test_kernel_d45 import _primitive_verts
 from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
 from tests.test_kernel_d45_closure import _rank
 from tests.test_review_r2 import _fast_path_calls
@@ -473,9 +474,10 @@ def _tampered(facets, V, k, rng):
 
 
 def _same_polytope(P, Q) -> bool:
-    return sorted(P.verts) == sorted(Q.verts) and sorted(
-        (P.verts[v], *sorted(P.verts[u] for u in e)) for v, e in enumerate(P.edges)) == sorted(
-        (Q.verts[v], *sorted(Q.verts[u] for u in e)) for v, e in enumerate(Q.edges))
+    pv, qv = _primitive_verts(P), _primitive_verts(Q)
+    return sorted(pv) == sorted(qv) and sorted(
+        (pv[v], *sorted(pv[u] for u in e)) for v, e in enumerate(P.edges)) == sorted(
+        (qv[v], *sorted(qv[u] for u in e)) for v, e in enumerate(Q.edges))
 
 
 def _certify(H, k, scale, sel, facets, V, pieces, background: bool):

@@ -252,19 +252,23 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     rows_of = sel.tolist()
     Ts = _bases(H, [[rows_of[i] for i in f] for f in facets], k)
     solved = _one_per_point(H, Ts, k).tolist() if pieces else list(range(len(Ts)))
-    sols = dict(zip(solved, _solve_all(H, [Ts[p] for p in solved], k), strict=True))
-    # None: k dependent rows (a zero-volume piece of a triangulated non-simple vertex),
-    # the other proposals or the closure decide
-    kept = np.array([p for p in solved if sols[p] is not None], dtype=np.int64)
+    X = _solve_rows(H, [Ts[p] for p in solved], k)
+    # x_0 = 0: k dependent rows (a zero-volume piece of a triangulated non-simple
+    # vertex), the other proposals or the closure decide
+    met = X[:, 0] != 0
+    kept = np.asarray(solved, dtype=np.int64)[met]
     if not len(kept):
         return None
-    index: dict[tuple[int, ...], int] = {}  # equal points, equal primitive (w, y)
-    of_proposal = np.fromiter((index.setdefault(sols[p], len(index)) for p in kept.tolist()),
-                              dtype=np.int64, count=len(kept))
-    verts = list(index)
+    W = X[met]
+    # the correctly rounded floats y / (w · unit) of each proposal's point (int / int):
+    # the floats of the vertices, and the key on which equal points are merged
+    Vx = (W[:, 1:] / (W[:, :1] * scale)).astype(np.float64)
+    of_proposal, firsts = _distinct_points(W, Vx)
+    W, Vx = W[firsts], Vx[firsts]
+    verts = list(map(tuple, W.tolist()))
     T_kept = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)[kept]
     # per vertex: k independent rows tight at it (positions in S), its first proposal's
-    basis = np.searchsorted(S, T_kept[np.unique(of_proposal, return_index=True)[1]]).tolist()
+    basis = np.searchsorted(S, T_kept[firsts]).tolist()
     # (vertex, position in S) of the rows tight by construction; more are found below
     tight_v = [np.repeat(of_proposal, k)]
     tight_h = [np.searchsorted(S, T_kept).ravel()]
@@ -273,8 +277,6 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     # exact feasibility, and the complete tight sets within S: floats of the exact
     # vertices (correctly rounded, int / int) with a rounding bound, plus the underflow
     # term, decide the clear cases; inf or NaN is never "clear"
-    W = _object_rows(verts, k + 1)
-    Vx = (W[:, 1:] / (W[:, :1] * scale)).astype(np.float64)
     c = 2.0 * (k + 4) * _EPS
     M = np.abs(Vx).max()
     floor = H.floor()
@@ -556,33 +558,83 @@ def _one_per_point(H, Ts: list[list[int]], k: int) -> np.ndarray:
 
 def _solve_all(H, Ts: list[list[int]], k: int) -> list[tuple[int, ...] | None]:
     """For each list T of k rows, the point where their hyperplanes meet, homogeneous
-    (w, y) with w > 0 and primitive, or None if they do not meet in one point: (w, y)
-    spans the null space of the k × (k+1) integer matrix E_T with rows e_h = (−b_h, a_h).
+    (w, y) with w > 0 and primitive, or None if they do not meet in one point: the rows
+    of :func:`_solve_rows` divided by their gcd (the fast path itself reads them as
+    they come)."""
+    out: list[tuple[int, ...] | None] = []
+    for row in _solve_rows(H, Ts, k).tolist():
+        g = gcd(*row)
+        out.append(tuple(v // g for v in row) if row[0] else None)
+    return out
+
+
+def _solve_rows(H, Ts: list[list[int]], k: int) -> np.ndarray:
+    """For each list T of k rows, a nonzero homogeneous (w, y) spanning the null space
+    of the k × (k+1) integer matrix E_T with rows e_h = (−b_h, a_h), with w > 0 if the
+    rows meet in one point y / w, else w = 0; an object array (len(Ts), k + 1) of
+    Python ints, not reduced by their gcd (its readers do not need it: a point's
+    Fraction, its correctly rounded float, the signs of slacks and :func:`_same_point`
+    are the same for every positive multiple).
 
     The rows are hyperplanes through data points, and :func:`_meet` solves through
     them, on far smaller integers than the cross product of E_T (whose minors share
     factors of a third to two thirds of their bits): when det A_T ≠ 0 — shown modulo a
     prime (:func:`_det_mod`; a multiple of the prime, ~2^-31 of bases, is left to the
     cross product of E_T, which is exact either way) — the null space is the line of
-    the vertex, and any nonzero x with E_T x = 0 spans it; its primitive form with
-    x_0 > 0 is the answer."""
+    the vertex, and any nonzero x with E_T x = 0 spans it. Where det A_T = 0 the cross
+    product of E_T has x_0 = ±det A_T = 0."""
+    X = np.empty((len(Ts), k + 1), dtype=object)
     if not Ts:
-        return []
+        return X
     B, at, E = _row_table(H, Ts, k)
     A = np.array([[v % PRIME for v in a] for a in E[:-1, 1:].tolist()], dtype=np.int64)
     sure = _det_mod(A[at], PRIME) != 0
-    out: list[tuple[int, ...] | None] = [None] * len(Ts)
-    X = np.empty((len(Ts), k + 1), dtype=object)
     if sure.any():
         X[sure] = _meet(H, E, B[sure], at[sure], k)
     if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
         X[~sure] = cross_all(E[at[~sure]])
-    for p, row in enumerate(X.tolist()):
-        if row[0] != 0:
-            g = gcd(*row) if row[0] > 0 else -gcd(*row)
-            out[p] = tuple(v // g for v in row)
-    return out
+    flip = X[:, 0] < 0
+    if flip.any():
+        X[flip] = -X[flip]
+    return X
 
+
+def _distinct_points(W: np.ndarray, Vx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct points among the homogeneous rows W (w > 0), numbered in order of
+    first appearance: for each row its point's number, and for each point its first
+    row. ``Vx``: the rows' correctly rounded floats y / (w · unit) — a function of the
+    point alone, so equal points have bit-identical floats and the floats are a key;
+    rows sharing a key are compared exactly (:func:`_same_point`), and where two
+    distinct points share one (closer than the floats resolve) the rows are grouped
+    one by one."""
+    n, width = Vx.shape
+    keys = np.ascontiguousarray(Vx).view(np.dtype((np.void, 8 * width))).ravel()
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    by_first = np.argsort(first)
+    number = np.empty(len(first), dtype=np.int64)
+    number[by_first] = np.arange(len(first))
+    of_row, firsts = number[inverse.ravel()], first[by_first]
+    shared = np.flatnonzero(firsts[of_row] != np.arange(n)).tolist()
+    rows = W.tolist()
+    if all(_same_point(rows[i], rows[firsts[of_row[i]]]) for i in shared):
+        return of_row, firsts
+    found: dict[bytes, list[int]] = {}  # key → the points (first rows) holding it
+    of_list: list[int] = []
+    first_list: list[int] = []
+    for i, row in enumerate(rows):
+        points = found.setdefault(keys[i].tobytes(), [])
+        j = next((j for j in points if _same_point(row, rows[first_list[j]])), None)
+        if j is None:
+            j = len(first_list)
+            first_list.append(i)
+            points.append(j)
+        of_list.append(j)
+    return np.array(of_list, dtype=np.int64), np.array(first_list, dtype=np.int64)
+
+
+def _same_point(u: list[int], v: list[int]) -> bool:
+    """(w, y) and (w', y') (w, w' > 0) are the same point y / w = y' / w'."""
+    return all(a * v[0] == b * u[0] for a, b in zip(u[1:], v[1:], strict=True))
 
 
 def _det_mod(A: np.ndarray, p: int) -> np.ndarray:

@@ -1,0 +1,106 @@
+"""Safe kernels in d = 4-5 (issue 13 §3): the fast path's vertices as they are solved
+(``fastpath._solve_rows``, not reduced by their gcd) and the merging of equal points
+on their correctly rounded floats (``fastpath._distinct_points``), against Fraction
+brute forces and the exact clipping."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from rescon.geometry import fastpath
+from tests.test_kernel_d45 import _both_paths, _halfspaces, _primitive_verts
+from tests.test_kernel_d45_around2 import _cloud
+from tests.test_kernel_d45_review7 import _same_polytope
+from tests.test_kernel_d45_solve import HOSTILE, _brute, _row_sets
+
+
+def _point(row) -> tuple[Fraction, ...]:
+    return tuple(Fraction(y, row[0]) for y in row[1:])
+
+
+def _floats(W: np.ndarray, unit: int = 1) -> np.ndarray:
+    return (W[:, 1:] / (W[:, :1] * unit)).astype(np.float64)
+
+
+def _check_distinct(rows: list[tuple[int, ...]], unit: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """_distinct_points against grouping the exact points (Fractions), numbered in
+    order of first appearance."""
+    W = np.empty((len(rows), len(rows[0])), dtype=object)
+    W[:] = rows
+    of_row, firsts = fastpath._distinct_points(W, _floats(W, unit))
+    number: dict[tuple[Fraction, ...], int] = {}
+    want = [number.setdefault(_point(r), len(number)) for r in rows]
+    assert of_row.tolist() == want
+    assert firsts.tolist() == [want.index(j) for j in range(len(number))]
+    return of_row, firsts
+
+
+def test_distinct_points_merges_multiples_and_splits_float_twins():
+    """Positive multiples of one point are one point; points closer than the floats
+    resolve (1 and 1 + 10⁻⁴⁰ round alike) stay apart, whichever comes first."""
+    big = 10**40
+    rows = [(1, 1, 0, 0, 0), (3, 3, 0, 0, 0), (big, big + 1, 0, 0, 0),
+            (2 * big, 2 * big + 2, 0, 0, 0), (7, 0, 7, 0, -7), (big, big - 1, 0, 0, 0),
+            (5, 5, 0, 0, 0), (1, 0, 1, 0, -1)]
+    assert len({_floats(np.array([r], dtype=object)).tobytes() for r in rows[:4]}) == 1
+    of_row, _ = _check_distinct(rows)
+    assert of_row.tolist() == [0, 0, 1, 1, 2, 3, 0, 2]
+    _check_distinct(rows[::-1])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_distinct_points_random_multiples_and_twins(seed):
+    """Random points, each repeated at random positive multiples, some with twins
+    that differ below the float resolution (and signed zeros: y = 0 · w)."""
+    rng = np.random.default_rng(seed)
+    base = []
+    for _ in range(12):
+        w = int(rng.integers(1, 10**6)) * 10**30
+        y = [int(v) for v in rng.integers(-10**6, 10**6, size=4)]
+        base.append((w, *(v * 10**30 for v in y)))
+        if rng.random() < 0.5:
+            base.append((w, y[0] * 10**30 + 1, *(v * 10**30 for v in y[1:])))
+        if rng.random() < 0.3:
+            base.append((w, 0, 0, 0, 0))
+    rows = [tuple(int(m) * v for v in base[int(i)])
+            for i, m in zip(rng.integers(len(base), size=60), rng.integers(1, 50, size=60),
+                            strict=True)]
+    _check_distinct(rows, unit=int(rng.choice([1, 2**40])))
+
+
+@pytest.mark.parametrize("kind,d,n,F", HOSTILE)
+def test_solve_rows_are_positive_multiples_of_the_point(kind, d, n, F):
+    """Each row of _solve_rows spans the null space of E_T with w > 0 (a positive
+    multiple of the primitive brute-force point), or has w = 0 where the rows do not
+    meet in one point; _solve_all is its primitive form."""
+    H, hull, _, _ = _halfspaces(_cloud(kind, d, n, F), F)
+    Ts = _row_sets(H, hull.dim, 25, seed=n)
+    X = fastpath._solve_rows(H, Ts, hull.dim)
+    for row, T in zip(X.tolist(), Ts, strict=True):
+        want = _brute(H, T)
+        if want is None:
+            assert row[0] == 0
+            continue
+        assert row[0] > 0 and row[0] % want[0] == 0
+        m = row[0] // want[0]
+        assert list(row) == [m * v for v in want]
+    assert fastpath._solve_all(H, Ts, hull.dim) == [_brute(H, T) for T in Ts]
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("gaussian", 4, 20, 1), ("integer", 4, 14, 2),
+                                        ("huge", 4, 14, 1), ("converged", 4, 20, 2),
+                                        ("gaussian", 5, 12, 1)])
+def test_repeated_proposals_are_one_vertex(kind, d, n, F):
+    """Every proposal listed twice, the second time with its rows reversed (the same
+    point, solved through other pairs of rows: another multiple): the polytope is the
+    honest one, and the exact clipping's."""
+    _, slow, H, unit, first = _both_paths(_cloud(kind, d, n, F), F)
+    _, facets = fastpath._propose(H, first)
+    honest = fastpath._certify(H, d, unit, first, facets)
+    assert honest is not None
+    twice = fastpath._certify(H, d, unit, first, facets + [f[::-1] for f in facets])
+    assert twice is not None and _same_polytope(twice, honest)
+    assert set(_primitive_verts(twice)) == set(slow.verts)
