@@ -104,3 +104,26 @@ def test_repeated_proposals_are_one_vertex(kind, d, n, F):
     twice = fastpath._certify(H, d, unit, first, facets + [f[::-1] for f in facets])
     assert twice is not None and _same_polytope(twice, honest)
     assert set(_primitive_verts(twice)) == set(slow.verts)
+
+
+@pytest.mark.parametrize("p", [2, 3, 2_147_483_647])
+def test_nonsingular_modulo_a_prime_is_the_determinants_residue(p):
+    """_certify_nb.nonsingular against the exact determinant modulo p (and _det_mod,
+    its numpy reference), on random integer matrices with repeated and combined rows
+    (singular over ℚ) and entries that are multiples of p."""
+    from rescon.geometry._certify_nb import nonsingular
+    from rescon.geometry.halfspaces import _int_det
+
+    rng = np.random.default_rng(p)
+    for k in (3, 4, 5):
+        rows = [[int(v) for v in rng.integers(-5, 6, size=k)] for _ in range(12)]
+        rows += [[3 * a + b for a, b in zip(rows[0], rows[1], strict=True)], rows[2][:],
+                 [p * int(v) for v in rng.integers(-3, 4, size=k)]]
+        at = np.array([rng.choice(len(rows), size=k, replace=False) for _ in range(300)]
+                      + [[len(rows) - 3, 0, 1, *range(3, k)][:k],
+                         [len(rows) - 2, 2, *range(4, k + 2)][:k]], dtype=np.int64)
+        A = np.array([[v % p for v in r] for r in rows], dtype=np.int64)
+        got = nonsingular(A, at, p).tolist()
+        want = [_int_det([rows[i] for i in T]) % p != 0 for T in at.tolist()]
+        assert got == want == (fastpath._det_mod(A[at], p) != 0).tolist()
+        assert not all(want) and any(want)

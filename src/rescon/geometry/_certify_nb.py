@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["KEY_PRIME", "paired_rows", "point_keys"]
+__all__ = ["KEY_PRIME", "nonsingular", "paired_rows", "point_keys"]
 
 #: the largest prime below 2^31 − 1 (a compile-time constant: the reductions modulo it
 #: compile to multiplications); residues < 2^31, so a product of two fits an int64
@@ -99,6 +99,42 @@ def point_keys(E, at, keys):
             keys[i, r] = num[i, r] * (inv * prefix[t] % p) % p
         inv = inv * flat[t] % p
     return ok
+
+
+@njit(cache=True, nogil=True)
+def nonsingular(A, at, p):
+    """For each row set i (the rows at[i] of the residues A (m, k) modulo the prime
+    p < 2^31, entries in [0, p)), whether det A_T ≢ 0 (mod p) — then det A_T ≠ 0 — by
+    Gaussian elimination without divisions (row_i ← pivot·row_i − f·row_c, mod p: the
+    pivot is a unit modulo p, so the determinant modulo p changes by a unit factor)."""
+    P, k = at.shape
+    out = np.zeros(P, dtype=np.bool_)
+    R = np.empty((k, k), dtype=np.int64)
+    for i in range(P):
+        for r in range(k):
+            for j in range(k):
+                R[r, j] = A[at[i, r], j]
+        full = True
+        for c in range(k):
+            piv = -1
+            for r in range(c, k):
+                if R[r, c] != 0:
+                    piv = r
+                    break
+            if piv < 0:
+                full = False
+                break
+            if piv != c:
+                for j in range(c, k):
+                    R[c, j], R[piv, j] = R[piv, j], R[c, j]
+            top = R[c, c]
+            for r in range(c + 1, k):
+                f = R[r, c]
+                if f != 0:
+                    for j in range(c, k):
+                        R[r, j] = (top * R[r, j] - f * R[c, j]) % p
+        out[i] = full
+    return out
 
 
 @njit(cache=True, nogil=True)

@@ -579,16 +579,19 @@ def _solve_rows(H, Ts: list[list[int]], k: int) -> np.ndarray:
     The rows are hyperplanes through data points, and :func:`_meet` solves through
     them, on far smaller integers than the cross product of E_T (whose minors share
     factors of a third to two thirds of their bits): when det A_T ≠ 0 — shown modulo a
-    prime (:func:`_det_mod`; a multiple of the prime, ~2^-31 of bases, is left to the
-    cross product of E_T, which is exact either way) — the null space is the line of
+    prime (:func:`._certify_nb.nonsingular`, compiled; :func:`_det_mod` is its numpy
+    reference; a multiple of the prime, ~2^-31 of bases, is left to the cross product
+    of E_T, which is exact either way) — the null space is the line of
     the vertex, and any nonzero x with E_T x = 0 spans it. Where det A_T = 0 the cross
     product of E_T has x_0 = ±det A_T = 0."""
     X = np.empty((len(Ts), k + 1), dtype=object)
     if not Ts:
         return X
+    from ._certify_nb import nonsingular
+
     B, at, E = _row_table(H, Ts, k)
     A = np.array([[v % PRIME for v in a] for a in E[:-1, 1:].tolist()], dtype=np.int64)
-    sure = _det_mod(A[at], PRIME) != 0
+    sure = nonsingular(A.reshape(-1, k), at, PRIME)
     if sure.any():
         X[sure] = _meet(H, E, B[sure], at[sure], k)
     if not sure.all():  # the cross product of E_T: x_0 = ±det A_T (0: no single point)
@@ -614,10 +617,11 @@ def _distinct_points(W: np.ndarray, Vx: np.ndarray) -> tuple[np.ndarray, np.ndar
     number = np.empty(len(first), dtype=np.int64)
     number[by_first] = np.arange(len(first))
     of_row, firsts = number[inverse.ravel()], first[by_first]
-    shared = np.flatnonzero(firsts[of_row] != np.arange(n)).tolist()
-    rows = W.tolist()
-    if all(_same_point(rows[i], rows[firsts[of_row[i]]]) for i in shared):
+    shared = np.flatnonzero(firsts[of_row] != np.arange(n))
+    if all(_same_point(u, v) for u, v in zip(W[shared].tolist(),
+                                             W[firsts[of_row[shared]]].tolist(), strict=True)):
         return of_row, firsts
+    rows = W.tolist()
     found: dict[bytes, list[int]] = {}  # key → the points (first rows) holding it
     of_list: list[int] = []
     first_list: list[int] = []
