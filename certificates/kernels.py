@@ -631,12 +631,12 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     d = len(P[0])
     T = [_scaled_test(v, D) for v in V]
     bits = 2 * max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
-    spent = _cost(len(V) * len(P) * (d + 2), bits)  # the signs / pairs
+    meter = [_cost(len(V) * len(P) * (d + 2), bits), MAX_EVAL_WORK]  # the signs / pairs
+    cache: dict[tuple[int, ...], list[int]] = {}
+    gbits = max((_bit_size(rows) for rows in tight), default=0)
     for (X, e), rows, name in zip(T, tight, names):
-        if spent > MAX_EVAL_WORK:
-            ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
-                      f"({bits // 2}-bit numbers) need work > {MAX_EVAL_WORK}")
-            return "halfspaces: not checked"
+        if meter[0] > meter[1]:
+            break
         if d == 2:
             y1, y2 = _edge_directions([], rows, 2)
             w1, w2 = _inward_normal(y1, y2), _inward_normal(y2, y1)
@@ -647,19 +647,22 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
             count += len(P) - len(pairs)  # points at v
             w = tuple((1 - tau) * a + tau * b for a, b in zip(w1, w2))
         else:
-            base, crossing = _crossing(P, X, e, rows)
-            spent += _cost(len(crossing) * (2 * len(crossing) + len(rows) ** 2), 2 * bits)
-            if spent > MAX_EVAL_WORK:
-                continue  # recorded as unchecked at the top of the loop
-            count, w = _cone3_min(base, crossing, rows)
+            base, signs = _crossing(P, X, e, rows, cache)
+            try:
+                hit = _cells_min(base, signs, rows, d, F, meter, _bit_size(signs), gbits)
+            except _OverBudget:
+                break
+            if hit is None:
+                continue
+            count, w = hit
         if count <= F:
             raise Invalid(f"{name} is not in the safe kernel: its Tukey depth is at most "
                           f"{count} <= F = {F} (the closed halfspaces w·(y - {name}) >= 0 "
                           f"for w near {_fmtv(w)}, in the normal cone of P there, hold "
                           f"{count} points)")
-    if spent > MAX_EVAL_WORK:
+    if meter[0] > meter[1]:
         ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
-                  f"({bits // 2}-bit numbers) need work > {MAX_EVAL_WORK}")
+                  f"({bits // 2}-bit numbers) need work > {meter[1]}")
         return "halfspaces: not checked"
     return "halfspaces (normal fan)"
 
@@ -686,77 +689,221 @@ def _arc_min(pairs: list[tuple[int, int]]) -> tuple[int, Fraction]:
             up.append(Fraction(s1, s1 - s2))
     down.sort()
     up.sort()
-    cuts = sorted({Fraction(0), Fraction(1), *down, *up})
+    # sweep the cuts left to right: on (lo, t) the downs > lo and the ups <= lo count
+    nd, nu = len(down), len(up)
+    i = j = 0
+    count = base + nd
+    lo = Fraction(0)
     best = None
-    for lo, hi in zip(cuts, cuts[1:]):
-        count = base + len(down) - bisect_left(down, hi) + bisect_right(up, lo)
+    while True:
+        if i < nd and (j >= nu or down[i] <= up[j]):
+            t = down[i]
+        elif j < nu:
+            t = up[j]
+        else:
+            t = Fraction(1)
         if best is None or count < best[0]:
-            best = (count, (lo + hi) / 2)
-    assert best is not None
-    return best
+            best = (count, lo, t)
+        if i >= nd and j >= nu:
+            break
+        while i < nd and down[i] == t:
+            count -= 1
+            i += 1
+        while j < nu and up[j] == t:
+            count += 1
+            j += 1
+        lo = t
+    return best[0], (best[1] + best[2]) / 2
 
 
-def _crossing(P: list[list[int]], X: list[int], e: int, normals: list[list[int]]
-              ) -> tuple[int, list[list[int]]]:
-    """(number of points counted on every cell of int N_v, the crossing points as
-    u = e·p − X, i.e. e·D·(p − v)) for N_v = cone(normals), the points P and the vertex
-    v = X / e scaled by D: a point with a·u >= 0 for every normal a is counted
-    everywhere, one with all a·u < 0 nowhere (for w in int N_v), the others cross."""
+def _crossing(P: list[list[int]], X: list[int], e: int, normals: list[list[int]],
+              cache: dict[tuple[int, ...], list[int]]) -> tuple[int, list[list[int]]]:
+    """(number of points counted on every cell of int N_v, the rows [a·u for a in
+    normals] of the crossing points) for N_v = cone(normals), the points P and the
+    vertex v = X / e scaled by D, u = p − X / e = D·(p − v): a point with a·u >= 0 for
+    every normal a is counted everywhere, one with all a·u < 0 nowhere (for w in
+    int N_v), the others cross.  Each normal is tight at v, a·X = e·c with c = D·b an
+    integer, so a·u = a·p − c (small: the slack of p); c is exact or the a·u are
+    computed as (e·a·p − a·X) / e.  ``cache`` keeps [a·p for p in P] per normal a (a
+    facet is tight at many vertices)."""
     base = 0
-    crossing: list[list[int]] = []
-    cs = [_dot(a, X) for a in normals]
-    for p in P:
-        s = [e * _dot(a, p) - c for a, c in zip(normals, cs)]
+    rows: list[list[int]] = []
+    cs = []
+    for a in normals:
+        c, r = divmod(_dot(a, X), e)
+        cs.append(Fraction(c) if r == 0 else Fraction(_dot(a, X), e))
+    exact = all(c.denominator == 1 for c in cs)
+    ci = [c.numerator for c in cs]
+    cols = []
+    for a in normals:
+        key = tuple(a)
+        col = cache.get(key)
+        if col is None:
+            col = cache[key] = [_dot(a, p) for p in P]
+        cols.append(col)
+    for ap in zip(*cols):
+        s = [t - c for t, c in zip(ap, ci)] if exact else \
+            [e * t - c * e for t, c in zip(ap, cs)]  # e·a·u (not reached: the normals are tight)
         if min(s) >= 0:
             base += 1
         elif max(s) > 0:
-            crossing.append([e * t - x for t, x in zip(p, X)])
-    return base, crossing
+            rows.append([int(t) for t in s])
+    return base, rows
 
 
-def _cone3_min(base: int, crossing: list[list[int]], normals: list[list[int]]
-               ) -> tuple[int, tuple[Fraction, ...]]:
-    """(min count over the open cells of int N_v, a direction near the smallest cell) for
-    d = 3, N_v = cone(normals): see :func:`_fan_in_kernel`."""
-    if not crossing:
-        return base, tuple(Fraction(sum(col)) for col in zip(*normals))
+class _OverBudget(Exception):
+    """The normal fan's work limit is reached (the vertex test becomes unchecked)."""
+
+
+def _charge(meter: list[int], steps: int, bits: int) -> None:
+    """Add ``steps`` products on ``bits``-bit integers (:func:`_cost`) to meter[0] before
+    they are spent; raise :class:`_OverBudget` once it exceeds meter[1]."""
+    meter[0] += _cost(steps, bits)
+    if meter[0] > meter[1]:
+        raise _OverBudget
+
+
+def _split_cone(gens: list[list[int]], s: list[int]) -> list[list[int]]:
+    """Generators of cone(gens) ∩ u^⊥, given s = [u·g for g in gens] (u^⊥ through the
+    relative interior of the pointed cone): the g with u·g = 0 and (u·g_i)·g_j −
+    (u·g_j)·g_i for u·g_i > 0 > u·g_j (a point Σ λ_g g of u^⊥, λ >= 0, pairs its positive
+    and negative terms into such combinations)."""
+    out = [g for g, t in zip(gens, s) if t == 0]
+    pos = [(g, t) for g, t in zip(gens, s) if t > 0]
+    out += [[ti * y - tj * x for x, y in zip(gi, gj)]
+            for gi, ti in pos for gj, tj in zip(gens, s) if tj < 0]
+    return out
+
+
+def _ends(gens: list[list[int]]) -> tuple[int, int]:
+    """The two extreme rays of a pointed 2-dimensional cone(gens) (nonzero generators):
+    the generators first and last in the orientation g <= h iff ω(g, h) >= 0, a total
+    preorder on a cone of angle < π, found in one pass each.  ω(g, h) = det of the
+    coordinates (g·a, g·b), (h·a, h·b) for a = gens[0] and b the first generator not
+    parallel to it (|a|²|b|² ≠ (a·b)²): a, b span the plane, so g ↦ (g·a, g·b) is
+    injective on it and ω is a nonzero area form (two d-vector products per generator
+    instead of a d × d determinant per comparison)."""
+    a = gens[0]
+    aa = _dot(a, a)
+    b = next((g for g in gens if _dot(g, g) * aa != _dot(a, g) ** 2), None)
+    if b is None:
+        return 0, 0  # one direction: not 2-dimensional (not reached)
+    c = [(_dot(g, a), _dot(g, b)) for g in gens]
+    i1 = i2 = 0
+    for j, (x, y) in enumerate(c):
+        x1, y1 = c[i1]
+        if x1 * y - y1 * x < 0:
+            i1 = j
+        x2, y2 = c[i2]
+        if x * y2 - y * x2 < 0:
+            i2 = j
+    return i1, i2
+
+
+def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, bound: int,
+               meter: list[int], rbits: int, gbits: int
+               ) -> tuple[int, tuple[Fraction, ...]] | None:
+    """(c, w) with c the smallest count ``base`` + #{q : q·w > 0} over the open cells of
+    relint N (N = cone(gens), pointed, spanning a k-dimensional subspace L of R^d,
+    k >= 3) cut by the hyperplanes q^⊥ ∩ L, and w in (the closure of) such a cell —
+    when c <= ``bound``; None when every cell counts more.  The points q are given by
+    their rows [q·g for g in gens] (each q takes both signs on gens: the points counted
+    on every cell are in ``base``, those counted on none are dropped).
+
+    Every cell C has a facet on some q^⊥ if there is a q: otherwise its closure, cut out
+    by facets of N only, would be all of N, yet q^⊥ splits relint N.  The relative
+    interior of that facet lies in relint(N ∩ q^⊥) and meets no other hyperplane q'^⊥
+    unless q' ∥ q on L, so it lies in one cell C' of the arrangement in relint(N ∩ q^⊥)
+    cut by the other points, and C is the cell beside C' on its side.  So, for u = q:
+    N ∩ u^⊥ = cone(:func:`_split_cone`) spans L ∩ u^⊥ (dimension k − 1, as u^⊥ meets
+    relint N); the points vanishing on it are ∥ u on L ("same" if they have u's sign on
+    a generator g with u·g ≠ 0 — u itself is — else "opposite"), the others are
+    classified on it again (counted on all of it, on none, or crossing), and the cells
+    beside C' count base + (C''s count) + same, resp. + opposite; conversely every
+    (C', side) is a cell.  Hence c = min over u of base + min(same, opposite) + the
+    smallest count in N ∩ u^⊥, by recursion; k − 1 = 2 is one sweep of the arc between
+    its two extreme rays (:func:`_ends`, :func:`_arc_min`).  A generator
+    (u·g_i)·g_j − (u·g_j)·g_i of N ∩ u^⊥ has the row entry (u·g_i)(q·g_j) −
+    (u·g_j)(q·g_i): the rows of the next level come from these, never from q itself.
+
+    Exact pruning: each count beside u^⊥ is >= base + min(same, opposite) + the number
+    of points on all of N ∩ u^⊥, so a u where that exceeds ``bound`` is skipped, and
+    ``bound`` drops below every count found (branch and bound).  Work, charged to
+    ``meter`` before it is spent, weighted by ``rbits`` and ``gbits`` (bounds on the
+    bit sizes of the rows and of the generators; a level at most doubles them): the
+    classification of the rows on the new generators, the generators and the next rows
+    per u; beyond meter[1] :class:`_OverBudget` is raised."""
+    if base > bound:
+        return None
+    if not rows:
+        return base, tuple(Fraction(sum(col)) for col in zip(*gens))
+    d = len(gens[0])
     best: tuple[int, tuple[Fraction, ...]] | None = None
-    for u in crossing:
-        e1, e2 = _arc_ends(u, normals)
-        pairs, same, opposite = [], 0, 0
-        for q in crossing:
-            s1, s2 = _dot(e1, q), _dot(e2, q)
-            if s1 or s2:
-                pairs.append((s1, s2))
-            elif _dot(u, q) > 0:
-                same += 1
+    for su in rows:
+        if bound < base:
+            break
+        # the generators of N ∩ u^⊥ (:func:`_split_cone`) as columns: q·g_i for u·g_i = 0,
+        # ti·(q·g_j) + tj·(q·g_i) for ti = u·g_i > 0, tj = −u·g_j > 0
+        zero = [i for i, t in enumerate(su) if t == 0]
+        pos = [i for i, t in enumerate(su) if t > 0]
+        cols = [(i, i, 0, 1) for i in zero]
+        cols += [(i, j, su[i], -t) for i in pos for j, t in enumerate(su) if t < 0]
+        i0 = pos[0]  # u·g_i0 > 0
+        _charge(meter, len(rows) * 2 * len(cols), 2 * rbits)
+        same = opposite = on = 0
+        rest: list[list[int]] = []  # rows of the points crossing N ∩ u^⊥
+        for r in rows:
+            plus = minus = False
+            for i, j, ti, tj in cols:
+                x, y = r[i], r[j]
+                if x >= 0 and y >= 0:
+                    if x or y:
+                        plus = True
+                elif x <= 0 and y <= 0:
+                    minus = True
+                else:
+                    t = ti * y + tj * x
+                    if t > 0:
+                        plus = True
+                    elif t < 0:
+                        minus = True
+                if plus and minus:
+                    rest.append(r)
+                    break
             else:
-                opposite += 1
-        count, tau = _arc_min(pairs)
-        count += base + min(same, opposite)
-        if best is None or count < best[0]:
-            best = (count, tuple((1 - tau) * a + tau * b for a, b in zip(e1, e2)))
-    assert best is not None
+                if plus:
+                    on += 1
+                    if base + on > bound:
+                        break
+                elif not minus:  # q vanishes on N ∩ u^⊥: ∥ u on L
+                    if r[i0] > 0:
+                        same += 1
+                    else:
+                        opposite += 1
+        m = base + min(same, opposite)
+        if m + on > bound:
+            continue
+        _charge(meter, len(cols) * 2 * d + len(rest) * 2 * len(cols), 2 * (rbits + gbits))
+        sub = _split_cone(gens, su)
+        if k == 3:  # N ∩ u^⊥ is 2-dimensional: the arc between its extreme rays
+            c1, c2 = _ends(sub)
+            (i1, j1, t1, u1), (i2, j2, t2, u2) = cols[c1], cols[c2]
+            count, tau = _arc_min([(t1 * r[j1] + u1 * r[i1], t2 * r[j2] + u2 * r[i2])
+                                   for r in rest])
+            if m + on + count <= bound:
+                e1, e2 = sub[c1], sub[c2]
+                best = (m + on + count, tuple((1 - tau) * a + tau * b for a, b in zip(e1, e2)))
+                bound = best[0] - 1
+        else:
+            keep = list({_primitive(g): c for c, g in enumerate(sub)}.values())  # dedup
+            hit = _cells_min(on, [[cols[c][2] * r[cols[c][1]] + cols[c][3] * r[cols[c][0]]
+                                   for c in keep] for r in rest],
+                             [sub[c] for c in keep], k - 1, bound - m, meter, 2 * rbits + 1,
+                             rbits + gbits + 1)
+            if hit is not None:  # its count is <= bound - m
+                best = (m + hit[0], hit[1])
+                bound = best[0] - 1
     return best
-
-
-def _arc_ends(u: list[int], normals: list[list[int]]) -> tuple[list[int], list[int]]:
-    """The two extreme rays of the 2-dimensional cone N ∩ u^⊥, N = cone(normals) pointed
-    and u^⊥ through its interior: N ∩ u^⊥ is generated by the normals a with a·u = 0 and
-    (−a_j·u)·a_i + (a_i·u)·a_j for a_i·u > 0 > a_j·u; its extreme rays e1, e2 are the
-    generators first and last in the orientation g <= h iff u·(g × h) >= 0 (a total
-    preorder on a cone of angle < π), found in one pass each."""
-    s = [_dot(a, u) for a in normals]
-    gens = [a for a, t in zip(normals, s) if t == 0]
-    gens += [[-sj * x + si * y for x, y in zip(ai, aj)]
-             for ai, si in zip(normals, s) if si > 0 for aj, sj in zip(normals, s) if sj < 0]
-    e1 = e2 = gens[0]
-    for g in gens[1:]:
-        if _det([u, e1, g]) < 0:
-            e1 = g
-        if _det([u, g, e2]) < 0:
-            e2 = g
-    return e1, e2
 
 
 # --------------------------------------------------------------------------- #
@@ -1197,7 +1344,7 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
         for i, parts in enumerate(vp):
             _tverberg(parts, f"proof.vertex_parts[{i}]", pts, F, V[i], names[i], ctx)
         how = "tverberg"
-    elif spanned and d == dim and d in (2, 3):
+    elif spanned and d == dim and d >= 2:
         # a zero normal (0·x <= b, tight when b = 0) adds nothing to N_v: dropped, as
         # the d = 3 sweep needs nonzero generators of N_v ∩ u^⊥
         how = _fan_in_kernel(pts, F, V, [[Fi[j][0] for j in on if any(Fi[j][0])]
