@@ -603,7 +603,7 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
 
 def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[int]]],
                    names: list[str], ctx: Any) -> str:
-    """P = conv(V) ⊆ Psi for a full-dimensional polytope P in d = 2 or 3 (vert(P) = V
+    """P = conv(V) ⊆ Psi for a full-dimensional polytope P in R^d, d >= 2 (vert(P) = V
     already proved; ``tight[i]``: the nonzero integer normals of the facets tight at V[i]), by
     the normal fan:
 
@@ -614,15 +614,17 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     v maximising a over P has a ∈ N_v and {a·y >= a·v} is inside it.  Conversely a
     vertex failing the test has depth <= F.)  N_v = cone(tight normals) is pointed and
     full-dimensional, and the count is smallest on an open cell of int N_v cut by the
-    planes (p − v)^⊥ (at a boundary point it is at least that of a nearby cell).
+    hyperplanes (p − v)^⊥ (at a boundary point it is at least that of a nearby cell;
+    the points p = v count everywhere).
     d = 2: N_v is the arc between w1 ⊥ y1 and w2 ⊥ y2 (the edge directions y of P at v),
-    one sweep (:func:`_arc_min`).  d = 3: a point p with a·(p − v) >= 0 for every tight
-    normal a is counted on every cell, one with all < 0 on none; the circles (p − v)^⊥
-    of the others ("crossing" points) cut int N_v, and every cell has a side on one of
-    them: for each crossing p, sweep the arc (p − v)^⊥ ∩ N_v; the cell beside a piece of
-    it holds the points positive there, and of the points q with q − v ∥ p − v those on
-    the side chosen (min over the two sides).  Work: n·d products per vertex plus K²
-    per vertex with K crossing points, bit-weighted; beyond MAX_EVAL_WORK unchecked."""
+    one sweep (:func:`_arc_min`).  d >= 3: a point p with a·(p − v) >= 0 for every tight
+    normal a is counted on every cell, one with all < 0 on none; the others ("crossing")
+    cut int N_v, and :func:`_cells_min` finds whether some cell counts <= F by recursion
+    on the dimension (every cell has a facet on a crossing hyperplane; d = 3: one arc
+    sweep per crossing point), from the rows a·(p − v) (the slacks of p in the tight
+    facets, scaled by D) alone.  Work: n·d products per vertex (the slacks a·p of each
+    facet once), plus the recursion's, charged as it runs, bit-weighted; beyond
+    MAX_EVAL_WORK unchecked."""
     part = "vertices in the safe kernel (proof 'halfspaces', normal fan)"
     sp = _scaled_points(pts, ctx, part)
     if sp is None:
@@ -829,10 +831,10 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
     Exact pruning: each count beside u^⊥ is >= base + min(same, opposite) + the number
     of points on all of N ∩ u^⊥, so a u where that exceeds ``bound`` is skipped, and
     ``bound`` drops below every count found (branch and bound).  Work, charged to
-    ``meter`` before it is spent, weighted by ``rbits`` and ``gbits`` (bounds on the
-    bit sizes of the rows and of the generators; a level at most doubles them): the
-    classification of the rows on the new generators, the generators and the next rows
-    per u; beyond meter[1] :class:`_OverBudget` is raised."""
+    ``meter`` before it is spent, weighted by ``rbits`` and ``gbits`` (the bit sizes of
+    the rows and of the generators; :func:`_cost`): per u, the classification of the
+    rows on the new generators (only the two extreme rays when k = 3), the generators
+    and the next rows; beyond meter[1] :class:`_OverBudget` is raised."""
     if base > bound:
         return None
     if not rows:
@@ -849,7 +851,13 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         cols = [(i, i, 0, 1) for i in zero]
         cols += [(i, j, su[i], -t) for i in pos for j, t in enumerate(su) if t < 0]
         i0 = pos[0]  # u·g_i0 > 0
-        _charge(meter, len(rows) * 2 * len(cols), 2 * rbits)
+        sub = None
+        if k == 3 and len(cols) > 2:  # N ∩ u^⊥ = the cone over its two extreme rays
+            _charge(meter, len(cols) * 8 * d, max(rbits, gbits))
+            sub = _split_cone(gens, su)
+            c1, c2 = _ends(sub)
+            cols, sub = [cols[c1], cols[c2]], [sub[c1], sub[c2]]
+        _charge(meter, len(rows) * 2 * len(cols), rbits)
         same = opposite = on = 0
         rest: list[list[int]] = []  # rows of the points crossing N ∩ u^⊥
         for r in rows:
@@ -883,23 +891,24 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         m = base + min(same, opposite)
         if m + on > bound:
             continue
-        _charge(meter, len(cols) * 2 * d + len(rest) * 2 * len(cols), 2 * (rbits + gbits))
-        sub = _split_cone(gens, su)
+        _charge(meter, len(cols) * 2 * d + len(rest) * 2 * len(cols), max(rbits, gbits))
+        if sub is None:
+            sub = _split_cone(gens, su)
         if k == 3:  # N ∩ u^⊥ is 2-dimensional: the arc between its extreme rays
-            c1, c2 = _ends(sub)
-            (i1, j1, t1, u1), (i2, j2, t2, u2) = cols[c1], cols[c2]
+            (i1, j1, t1, u1), (i2, j2, t2, u2) = cols[0], cols[-1]
             count, tau = _arc_min([(t1 * r[j1] + u1 * r[i1], t2 * r[j2] + u2 * r[i2])
                                    for r in rest])
             if m + on + count <= bound:
-                e1, e2 = sub[c1], sub[c2]
+                e1, e2 = sub[0], sub[-1]
                 best = (m + on + count, tuple((1 - tau) * a + tau * b for a, b in zip(e1, e2)))
                 bound = best[0] - 1
         else:
             keep = list({_primitive(g): c for c, g in enumerate(sub)}.values())  # dedup
-            hit = _cells_min(on, [[cols[c][2] * r[cols[c][1]] + cols[c][3] * r[cols[c][0]]
-                                   for c in keep] for r in rest],
-                             [sub[c] for c in keep], k - 1, bound - m, meter, 2 * rbits + 1,
-                             rbits + gbits + 1)
+            nrows = [[cols[c][2] * r[cols[c][1]] + cols[c][3] * r[cols[c][0]] for c in keep]
+                     for r in rest]
+            ngens = [sub[c] for c in keep]
+            hit = _cells_min(on, nrows, ngens, k - 1, bound - m, meter, _bit_size(nrows),
+                             _bit_size(ngens))
             if hit is not None:  # its count is <= bound - m
                 best = (m + hit[0], hit[1])
                 bound = best[0] - 1
