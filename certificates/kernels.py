@@ -680,42 +680,45 @@ def _arc_min(pairs: list[tuple[int, int]]) -> tuple[int, Fraction]:
     """(min count, a tau of it) over the open intervals of (0, 1) between breakpoints of
     #{(s1, s2) : (1 − tau)·s1 + tau·s2 > 0}, for pairs not both 0: counted on all of
     (0, 1) when s1, s2 >= 0, on none when both <= 0, else for tau below (s1 > 0 > s2)
-    or above (s1 < 0 < s2) t = s1 / (s1 − s2)."""
-    base, down, up = 0, [], []
+    or above (s1 < 0 < s2) t = s1 / (s1 − s2).
+
+    The breakpoints are sorted by the float s1 / (s1 − s2) first — Python's int / int is
+    correctly rounded, hence monotone (t < t' gives fl(t) <= fl(t'), also on underflow),
+    so only runs of equal floats need the exact order, which they then get (exact
+    rationals); cuts are merged by exact equality."""
+    base, ev = 0, []  # (float, num, den, delta): t = num / den, den > 0
     for s1, s2 in pairs:
         if s1 >= 0 and s2 >= 0:
             base += 1
         elif s1 > 0 > s2:
-            down.append(Fraction(s1, s1 - s2))
+            ev.append((s1 / (s1 - s2), s1, s1 - s2, -1))  # counted below t
         elif s1 < 0 < s2:
-            up.append(Fraction(s1, s1 - s2))
-    down.sort()
-    up.sort()
+            ev.append((s1 / (s1 - s2), -s1, s2 - s1, 1))  # counted above t
+    ev.sort(key=lambda x: x[0])
+    i = 0
+    while i < len(ev):  # exact order inside runs of equal floats
+        j = i + 1
+        while j < len(ev) and ev[j][0] == ev[i][0]:
+            j += 1
+        if j - i > 1:
+            ev[i:j] = sorted(ev[i:j], key=lambda x: Fraction(x[1], x[2]))
+        i = j
     # sweep the cuts left to right: on (lo, t) the downs > lo and the ups <= lo count
-    nd, nu = len(down), len(up)
-    i = j = 0
-    count = base + nd
-    lo = Fraction(0)
-    best = None
+    count = base + sum(x[3] < 0 for x in ev)
+    lo: tuple[int, int] = (0, 1)
+    best: tuple[int, tuple[int, int], tuple[int, int]] | None = None
+    i = 0
     while True:
-        if i < nd and (j >= nu or down[i] <= up[j]):
-            t = down[i]
-        elif j < nu:
-            t = up[j]
-        else:
-            t = Fraction(1)
+        t = (ev[i][1], ev[i][2]) if i < len(ev) else (1, 1)
         if best is None or count < best[0]:
             best = (count, lo, t)
-        if i >= nd and j >= nu:
+        if i == len(ev):
             break
-        while i < nd and down[i] == t:
-            count -= 1
+        while i < len(ev) and ev[i][1] * t[1] == t[0] * ev[i][2]:
+            count += ev[i][3]
             i += 1
-        while j < nu and up[j] == t:
-            count += 1
-            j += 1
         lo = t
-    return best[0], (best[1] + best[2]) / 2
+    return best[0], (Fraction(*best[1]) + Fraction(*best[2])) / 2
 
 
 def _crossing(P: list[list[int]], X: list[int], e: int, normals: list[list[int]],
@@ -778,27 +781,30 @@ def _split_cone(gens: list[list[int]], s: list[int]) -> list[list[int]]:
 
 
 def _ends(gens: list[list[int]]) -> tuple[int, int]:
-    """The two extreme rays of a pointed 2-dimensional cone(gens) (nonzero generators):
-    the generators first and last in the orientation g <= h iff ω(g, h) >= 0, a total
-    preorder on a cone of angle < π, found in one pass each.  ω(g, h) = det of the
-    coordinates (g·a, g·b), (h·a, h·b) for a = gens[0] and b the first generator not
-    parallel to it (|a|²|b|² ≠ (a·b)²): a, b span the plane, so g ↦ (g·a, g·b) is
-    injective on it and ω is a nonzero area form (two d-vector products per generator
-    instead of a d × d determinant per comparison)."""
+    """The indices of two extreme rays of a pointed 2-dimensional cone(gens) (nonzero
+    generators): the generators first and last in the orientation g <= h iff
+    ω(g, h) >= 0, a total preorder on a cone of angle < π, found in one pass each.
+    ω(g, h) = g_i h_j − g_j h_i for coordinates i, j where a = gens[0] and the first
+    generator b not parallel to it have a nonzero 2 × 2 minor: the projection to (i, j)
+    is then injective on the plane span(a, b), so ω is a nonzero area form on it."""
     a = gens[0]
-    aa = _dot(a, a)
-    b = next((g for g in gens if _dot(g, g) * aa != _dot(a, g) ** 2), None)
-    if b is None:
+    i = next(t for t, x in enumerate(a) if x)
+    j = None
+    for g in gens[1:]:
+        j = next((t for t, x in enumerate(g) if a[i] * x != a[t] * g[i]), None)
+        if j is not None:
+            break
+    if j is None:
         return 0, 0  # one direction: not 2-dimensional (not reached)
-    c = [(_dot(g, a), _dot(g, b)) for g in gens]
+    c = [(g[i], g[j]) for g in gens]
     i1 = i2 = 0
-    for j, (x, y) in enumerate(c):
+    for t, (x, y) in enumerate(c):
         x1, y1 = c[i1]
         if x1 * y - y1 * x < 0:
-            i1 = j
+            i1 = t
         x2, y2 = c[i2]
         if x * y2 - y * x2 < 0:
-            i2 = j
+            i2 = t
     return i1, i2
 
 
@@ -852,8 +858,8 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         cols += [(i, j, su[i], -t) for i in pos for j, t in enumerate(su) if t < 0]
         i0 = pos[0]  # u·g_i0 > 0
         sub = None
-        if k == 3 and len(cols) > 2:  # N ∩ u^⊥ = the cone over its two extreme rays
-            _charge(meter, len(cols) * 8 * d, max(rbits, gbits))
+        if k == 3 and len(cols) > 4:  # N ∩ u^⊥ = the cone over its two extreme rays
+            _charge(meter, len(cols) * (2 * d + 4), max(rbits, gbits))
             sub = _split_cone(gens, su)
             c1, c2 = _ends(sub)
             cols, sub = [cols[c1], cols[c2]], [sub[c1], sub[c2]]
@@ -895,11 +901,12 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         if sub is None:
             sub = _split_cone(gens, su)
         if k == 3:  # N ∩ u^⊥ is 2-dimensional: the arc between its extreme rays
-            (i1, j1, t1, u1), (i2, j2, t2, u2) = cols[0], cols[-1]
+            c1, c2 = _ends(sub) if len(sub) > 2 else (0, len(sub) - 1)
+            (i1, j1, t1, u1), (i2, j2, t2, u2) = cols[c1], cols[c2]
             count, tau = _arc_min([(t1 * r[j1] + u1 * r[i1], t2 * r[j2] + u2 * r[i2])
                                    for r in rest])
             if m + on + count <= bound:
-                e1, e2 = sub[0], sub[-1]
+                e1, e2 = sub[c1], sub[c2]
                 best = (m + on + count, tuple((1 - tau) * a + tau * b for a, b in zip(e1, e2)))
                 bound = best[0] - 1
         else:

@@ -225,3 +225,39 @@ def test_cells_min_is_at_most_every_sampled_cell(d):
         assert on <= c <= on + zero
         if c > 0:
             assert kernels._cells_min(0, rows, G, d, c - 1, [0, 10**12], 8, 8) is None
+
+
+def _arc_min_reference(pairs):
+    """The sweep as it was before the float-keyed sort (Fractions and bisection)."""
+    from bisect import bisect_left, bisect_right
+
+    base, down, up = 0, [], []
+    for s1, s2 in pairs:
+        if s1 >= 0 and s2 >= 0:
+            base += 1
+        elif s1 > 0 > s2:
+            down.append(Fraction(s1, s1 - s2))
+        elif s1 < 0 < s2:
+            up.append(Fraction(s1, s1 - s2))
+    down.sort()
+    up.sort()
+    cuts = sorted({Fraction(0), Fraction(1), *down, *up})
+    best = None
+    for lo, hi in zip(cuts, cuts[1:]):
+        count = base + len(down) - bisect_left(down, hi) + bisect_right(up, lo)
+        if best is None or count < best[0]:
+            best = (count, (lo + hi) / 2)
+    return best
+
+
+@settings(max_examples=300, deadline=None)
+@given(pairs=st.lists(st.tuples(st.integers(-6, 6), st.integers(-6, 6)), max_size=12),
+       scale=st.sampled_from([1, 2**80, 10**400]), tiny=st.integers(0, 3))
+def test_arc_min_is_the_exact_sweep(pairs, scale, tiny):
+    """The float-keyed sort gives the exact sweep: ties (equal breakpoints), huge
+    numbers, and breakpoints closer than a float can tell apart (t and t + 1/10^400)."""
+    pairs = [(a * scale, b * scale) for a, b in pairs if a or b]
+    if tiny:  # breakpoints equal as floats, different exactly
+        big = 10**400
+        pairs += [(big, -big), (big + tiny, -big), (-big - tiny, big)][:tiny]
+    assert kernels._arc_min(pairs) == _arc_min_reference(pairs)
