@@ -227,8 +227,8 @@ def _den_lcm(vectors: list[Vec], limit: int | None = None) -> int:
 
 
 def _bit_size(rows: list[list[int]]) -> int:
-    """Largest bit length of an entry."""
-    return max((abs(t).bit_length() for r in rows for t in r), default=0)
+    """Largest bit length of an entry (that of the largest |entry|)."""
+    return max((max(max(r), -min(r)).bit_length() for r in rows if r), default=0)
 
 
 def _cost(work: int, bits: int) -> int:
@@ -718,7 +718,8 @@ def _arc_min(pairs: list[tuple[int, int]]) -> tuple[int, Fraction]:
             count += ev[i][3]
             i += 1
         lo = t
-    return best[0], (Fraction(*best[1]) + Fraction(*best[2])) / 2
+    (n1, d1), (n2, d2) = best[1], best[2]
+    return best[0], Fraction(n1 * d2 + n2 * d1, 2 * d1 * d2)  # the interval's midpoint
 
 
 def _crossing(P: list[list[int]], X: list[int], e: int, normals: list[list[int]],
