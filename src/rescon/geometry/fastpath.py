@@ -303,8 +303,9 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     hs = rows[near_r]
     slacks = _int64_slacks(H, scale, verts, hs, near_v)
     if slacks is None:  # in Python integers: a·y − b·w, all pairs at once
-        H.exact_all(np.unique(hs).tolist())
-        E = _homogeneous(H, hs.tolist(), k)[:-1]  # (−b, a)
+        used, at = np.unique(hs, return_inverse=True)
+        H.exact_all(used.tolist())
+        E = _homogeneous(H, used.tolist(), k)[at.ravel()]  # (−b, a), each row built once
         slacks = (E * W[near_v]).sum(axis=1) if len(hs) else np.zeros(0, dtype=object)
     if (slacks > 0).any():
         return None
