@@ -545,7 +545,8 @@ class _Side:
     ``cut[k]`` / ``keep[k]`` hold the fields with m_v > k / ≤ k; ``D`` is the deficit
     table of V (a member's field 2^(w−1) + min(t[v], n) − 1, all ones for the nodes of
     ``gone``, those with t[v] ≤ 0, never in a closed set); ``charged``: the nodes the
-    ``crowded`` leaf checks besides the earlier roots (a ``charged_tree``'s Q_k)."""
+    ``crowded`` leaf checks besides the earlier roots (a ``charged_tree``'s Q_k);
+    ``most``: max_v min(t[v], n), so that a member's deficit is below it."""
 
     t: list[int]
     cut: list[int]
@@ -553,6 +554,7 @@ class _Side:
     D: int
     gone: int
     charged: list[int]
+    most: int
 
     def least_in(self, Q: int, n: int) -> int:
         """min_{v∈Q} m_v for a packed Q (n + 1 when Q = ∅): a binary search on ``keep``."""
@@ -627,6 +629,19 @@ class _Replay:
             self.less[w * (field[v] + 1)] = sum(1 << (w * field[j]) for j in _bits(out[v]))
         self.full = self.pack(g.full)
         self.side = self.threshold_side([r] * n)
+        self.pin: list[int] = []
+        self.rows: list[int] = []
+
+    def capped_tables(self) -> None:
+        """The tables of the capped leaves (:meth:`capped`): ``pin[i]``, the packed N(i),
+        and ``rows[i]``, the Σ of the ``less`` rows of N(i) (field v: |N(i) ∩ N(v)|);
+        n + |E| steps and n·w bits each (nothing when the tables were beyond the limit)."""
+        g, w, field = self.g, self.w, self.field
+        if self.work > MAX_SEARCH_WORK:
+            return
+        self.work += (g.n + g.m) * self.unit + 2 * g.n * g.n * w // 64
+        self.pin = [self.pack(mk) for mk in g.inmask]
+        self.rows = [sum(self.less[w * (field[u] + 1)] for u in _bits(mk)) for mk in g.inmask]
 
     def threshold_side(self, t: list[int], charged: int = 0) -> _Side:
         """The :class:`_Side` of the per-node thresholds ``t`` (t[v] for node v): a member
@@ -648,7 +663,7 @@ class _Replay:
                 D |= self.ones << (w * self.field[v])
                 gone |= 1 << top[v]
         self.work += 3 * n * self.unit
-        return _Side(t, cut, acc, D, gone, _bits(charged))
+        return _Side(t, cut, acc, D, gone, _bits(charged), min(max(t), n))
 
     def pack(self, mask: int) -> int:
         """The packed form of the node set ``mask`` (a bitmask)."""
@@ -729,7 +744,7 @@ class _Replay:
         (packed; B = gone ∪ order[:k]): with order[k] ∈ S1 for the thresholds of ``a`` on
         S1's side and ``b`` on S2's, then, unless a is b, with the sides swapped. The
         position after them, or −1 − pos when the replay stops at pos (work limit)."""
-        shrink, top, ntok = self.shrink, self.top, len(tree)
+        shrink, top, ntok, n = self.shrink, self.top, len(tree), self.g.n
         chain = {side: shrink(self.full, side.D, side.gone | gone, side) for side in (a, b)}
         B, before = gone, []
         for k in range(self.g.n):
@@ -771,6 +786,15 @@ class _Replay:
                     elif t == -4:
                         if self.crowded(S, before, s1) is None:
                             raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
+                    elif t <= -5:
+                        if Q1 & S:
+                            Q1, QD1 = shrink(Q1, QD1, S, s2)
+                        if P1 & X:
+                            P1 = shrink(P1, PD1, X, s1)[0]
+                        i, j = divmod(-5 - t, n)
+                        if (i > j or not S >> top[i] & S >> top[j] & 1
+                                or self.capped(i, j, S, P1, Q1, QD1, s1, s2)):
+                            raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
                     else:
                         if Q1 & S:
                             Q1 = shrink(Q1, QD1, S, s2)[0]
@@ -783,6 +807,172 @@ class _Replay:
             before.append(order[k])
             chain = {side: shrink(*chain[side], S0, side) for side in chain}
         return pos
+
+    def capped(self, i: int, j: int, S: int, P: int, Q: int, D: int, s1: _Side,
+               s2: _Side) -> int:
+        """The capped core of Q (packed, exact, with its D) for the members i, j of the
+        packed S (i = j: one member): the largest Q' ⊆ Q whose members v have, for
+        m = i, j, |N(v) ∩ Q' \\ c_m| + min(sl_m, |N(v) ∩ Q' ∩ c_m|) ≥ d_v − t_v + 1
+        (t: ``s2``'s thresholds), c_m = N(m) ∩ P \\ S, sl_m = |c_m| − need_m,
+        need_m = |N(m) \\ S| − t_m + 1 (t: ``s1``'s); 0 (empty) when an sl_m < 0.
+
+        Every U2 of the state lies in it (FORMAT.md, the −5 − (i·n + j) leaf): U1 ⊆ P
+        holds m and ≥ need_m nodes of c_m, so |U2 ∩ c_m| ≤ sl_m, and each v ∈ U2 has
+        ≥ d_v − t_v + 1 in-neighbours in U2, at most min(sl_m, |N(v) ∩ U2 ∩ c_m|) of
+        them in c_m; the conditions only weaken as Q' shrinks, so peeling keeps U2.
+        (sl_m may be lowered to |c_m ∩ Q|: min(sl_m, e) is the same for every
+        e ≤ |c_m ∩ Q|.)
+
+        Packed (when sl_m + ``s2.most`` ≤ 2^(w−1), else :meth:`capped_slow`): a
+        member's D field is 2^(w−1) + δ_v, δ_v = min(t_v, n) − 1 − |N(v) \\ Q'|
+        (= |N(v) ∩ Q'| − (d_v − t_v + 1) when t_v ≤ n; else δ_v ≥ |N(v) ∩ Q'| and v is
+        never peeled, rightly), δ_v < most; E_m holds e_v = |N(v) ∩ Q' ∩ c_m| < n in
+        field v (the ``less`` rows of c_m ∩ Q', lowered for each removed node of c_m).
+        v is peeled when δ_v < 0 (D's guard bit cleared, as in :meth:`shrink`) or
+        δ_v − e_v + sl_m < 0: the guard bit of the field of D − E_m + sl_m, taken on
+        the members only, those with δ_v < 0 set to all ones (every field stays in
+        [1, 2^w): no borrow, no carry).
+
+        A nonempty Z ⊆ C meeting the conditions has, for each member v,
+        d_v − t_v + 1 ≤ min(|Z| − 1, |Z \\ c_m| + sl_m), so m_v ≤
+        min(|C|, |C \\ c_m| + sl_m + 1) (m_v as in :meth:`shrink`): the same cut as
+        there shows the capped core empty early. Work: one step per round, cut, node of
+        c_m ∩ Q and removed node."""
+        pin, half = self.pin, 1 << (self.w - 1)
+        c1 = pin[i] & P & ~S
+        sl1 = c1.bit_count() - (pin[i] & ~S).bit_count() + s1.t[i] - 1
+        if sl1 < 0:
+            return 0
+        q1 = c1 & Q
+        sl1 = min(sl1, q1.bit_count())
+        if i == j:
+            if sl1 + s2.most > half:
+                return self.capped_slow((c1, sl1, c1, sl1), Q, s2)
+            return self.capped_one(c1, sl1, self.row_sum(i, q1), Q, D, s2)
+        c2 = pin[j] & P & ~S
+        sl2 = c2.bit_count() - (pin[j] & ~S).bit_count() + s1.t[j] - 1
+        if sl2 < 0:
+            return 0
+        q2 = c2 & Q
+        sl2 = min(sl2, q2.bit_count())
+        if max(sl1, sl2) + s2.most > half:
+            return self.capped_slow((c1, sl1, c2, sl2), Q, s2)
+        less, sh, ones, cut, keep = self.less, self.w - 1, self.ones, s2.cut, s2.keep
+        E1, E2, steps = self.row_sum(i, q1), self.row_sum(j, q2), 1
+        U = Q
+        while True:
+            steps += 1
+            std = U & ~D  # δ_v < 0
+            pos = (U & D) >> sh
+            M = (U >> sh) * ones
+            Dm = (D & M) | (std >> sh) * ones
+            todo = std | U & ~((Dm - (E1 & M) + sl1 * pos) & (Dm - (E2 & M) + sl2 * pos))
+            if not todo:
+                break
+            U ^= todo
+            k = U.bit_count()
+            k1 = (U & ~c1).bit_count() + sl1 + 1
+            k2 = (U & ~c2).bit_count() + sl2 + 1
+            k = k if k < k1 else k1
+            k = k if k < k2 else k2
+            if U & cut[k]:
+                C = U
+                while C & cut[k]:
+                    C &= keep[k]
+                    k = min(C.bit_count(), (C & ~c1).bit_count() + sl1 + 1,
+                            (C & ~c2).bit_count() + sl2 + 1)
+                    steps += 1
+                if not C:
+                    U = 0
+                    break
+            D |= (todo >> sh) * ones
+            steps += todo.bit_count()
+            while todo:
+                low = todo & -todo
+                todo ^= low
+                row = less[low.bit_length()]
+                D -= row
+                if c1 & low:
+                    E1 -= row
+                if c2 & low:
+                    E2 -= row
+        self.work += steps * self.unit
+        return U
+
+    def capped_one(self, c: int, sl: int, E: int, Q: int, D: int, s2: _Side) -> int:
+        """:meth:`capped` for one member (c, sl; E its e_v), its packed path."""
+        less, sh, ones, cut, keep = self.less, self.w - 1, self.ones, s2.cut, s2.keep
+        U, steps = Q, 1
+        while True:
+            steps += 1
+            std = U & ~D  # δ_v < 0
+            M = (U >> sh) * ones
+            todo = std | U & ~(((D & M) | (std >> sh) * ones) - (E & M)
+                               + sl * ((U & D) >> sh))
+            if not todo:
+                break
+            U ^= todo
+            k = U.bit_count()
+            k2 = (U & ~c).bit_count() + sl + 1
+            k = k if k < k2 else k2
+            if U & cut[k]:
+                C = U
+                while C & cut[k]:
+                    C &= keep[k]
+                    k = C.bit_count()
+                    k2 = (C & ~c).bit_count() + sl + 1
+                    k = k if k < k2 else k2
+                    steps += 1
+                if not C:
+                    U = 0
+                    break
+            D |= (todo >> sh) * ones
+            steps += todo.bit_count()
+            while todo:
+                low = todo & -todo
+                todo ^= low
+                row = less[low.bit_length()]
+                D -= row
+                if c & low:
+                    E -= row
+        self.work += steps * self.unit
+        return U
+
+    def row_sum(self, i: int, q: int) -> int:
+        """Σ of the ``less`` rows of the packed set q ⊆ N(i): field v holds the number
+        of its members that send to v (< n: no carry); from ``rows[i]``, the sum over
+        N(i), when N(i) \\ q is the smaller (work: one step per row added or taken)."""
+        less, rest = self.less, self.pin[i] & ~q
+        sign = q.bit_count() > rest.bit_count()
+        E, m = (self.rows[i], rest) if sign else (0, q)
+        self.work += m.bit_count() * self.unit
+        while m:
+            low = m & -m
+            m ^= low
+            if sign:
+                E -= less[low.bit_length()]
+            else:
+                E += less[low.bit_length()]
+        return E
+
+    def capped_slow(self, caps: tuple[int, int, int, int], Q: int, s2: _Side) -> int:
+        """:meth:`capped` by peeling node by node on unpacked sets (any sl; work: one
+        step per node examined); ``caps`` = (c1, sl1, c2, sl2), packed c."""
+        inmask, deg, t = self.g.inmask, self.deg, s2.t
+        c1, sl1, c2, sl2 = caps
+        c1, c2, U = self.unpack(c1), self.unpack(c2), self.unpack(Q)
+        steps, changed = 0, True
+        while changed and U:
+            changed = False
+            for v in _bits(U):
+                steps += 1
+                inside, want = inmask[v] & U, deg[v] - t[v] + 1
+                if any((inside & ~c).bit_count() + min(sl, (inside & c).bit_count()) < want
+                       for c, sl in ((c1, sl1), (c2, sl2))):
+                    U &= ~(1 << v)
+                    changed = True
+        self.work += steps * self.unit
+        return self.pack(U)
 
     def crowded(self, S: int, before: list[int], side: _Side) -> int | None:
         """A node j of ``before`` or of the side's charged nodes with more than d_j − t_j
@@ -831,6 +1021,12 @@ class _Replay:
         if t == -4:
             return (f"{head}: no earlier root or charged node of its side has more than "
                     f"d_j - t_j in-neighbours in S = {fmt(S)}")
+        if t <= -5:
+            i, j = divmod(-5 - t, self.g.n)
+            if i > j or not S >> self.top[i] & S >> self.top[j] & 1:
+                return f"{head}: nodes {i} <= {j} are not both in S = {fmt(S)}"
+            return (f"{head}: the capped core of Q = {fmt(Q)} for nodes {i}, {j} is "
+                    f"nonempty (S = {fmt(S)}, P = {fmt(P)})")
         need1, need2 = self.sizes(S, Q, s1, s2)
         return (f"{head}: |S1| >= {need1} and |S2| >= {need2} fit in |P u Q| = "
                 f"{(P | Q).bit_count()} (S = {fmt(S)}, X = {fmt(X)}, B = {fmt(B)})")
@@ -1052,6 +1248,7 @@ def _charged_replay(g: Graph, r: int, s: int, order: list[int], tree: list[int] 
     with |Q1| ≤ c1, |Q2| ≤ c2, no charged nodes (closed sets for smaller thresholds are
     closed for these, so its pairs are among the part's)."""
     rp = _Replay(g, r, f"{where}.charged_tree")
+    rp.capped_tables()
 
     def uniform_types() -> Iterator[tuple[int, _Side, _Side]]:
         sides = {c: rp.threshold_side([r + min(c, d) for d in rp.deg]) if c else rp.side
@@ -1080,7 +1277,7 @@ def _proof_cost_search(p: dict, where: str, g: Graph, r: int, s: int, ctx: _Ctx)
     if p.get("charged_tree") is not None:
         if p.get("tree") is not None:
             raise Invalid(f"{where}: 'tree' and 'charged_tree' are exclusive")
-        tree = _tokens(p["charged_tree"], f"{where}.charged_tree", g.n, -4)
+        tree = _tokens(p["charged_tree"], f"{where}.charged_tree", g.n, -4 - g.n * g.n)
         stopped = _charged_replay(g, r, s, order, tree, where, "uniform" in p)
         if not stopped:
             return "cost_search (charged tree replayed)"

@@ -14,9 +14,13 @@ from hypothesis import strategies as st
 
 import rescon
 from rescon.graphs import robustness as rb
-from rescon.graphs.charged import charged_tree, configurations, count_configurations
+from rescon.graphs.charged import (
+    charged_order,
+    charged_tree,
+    configurations,
+    count_configurations,
+)
 from rescon.graphs.indexed import index_graph
-from rescon.graphs.search import search_order
 from tests.test_checker import C, _validator, digraph, in_masks, is_robust, rand_edges, rho_and_s
 from tests.test_rho_tree import _cut_branch
 
@@ -28,7 +32,8 @@ def _graph(n, edges):
 
 
 def _proof(ig, tree):
-    return {"method": "cost_search", "order": search_order(ig).tolist(), "charged_tree": list(tree)}
+    return {"method": "cost_search", "order": charged_order(ig).tolist(),
+            "charged_tree": list(tree)}
 
 
 def _cert(ig, r, s, proof):

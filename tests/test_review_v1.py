@@ -17,10 +17,10 @@ from benchmarks.baselines import leblanc_max_s, leblanc_rho
 from rescon.graphs import bounds as bd
 from rescon.graphs import robustness as rb
 from rescon.graphs._kernels import pair_walk
-from rescon.graphs.charged import charged_tree
+from rescon.graphs.charged import charged_order, charged_tree
 from rescon.graphs.facts import clear_cache
 from rescon.graphs.indexed import index_graph
-from rescon.graphs.search import SearchOutcome, SizedRun, cost_tree, search_order
+from rescon.graphs.search import SearchOutcome, SizedRun, cost_tree
 from tests.test_checker import C, digraph, in_masks, is_robust, rand_edges, rho_and_s
 
 pytestmark = pytest.mark.usefixtures("fresh_facts")
@@ -45,7 +45,12 @@ def _end(tree, k):
 
 
 def _surgeries(tree):
-    """Every branch cut to each leaf kind, and every branch with its children swapped."""
+    """Every branch cut to each leaf kind, every branch with its children swapped, and
+    each of the first 6 leaves turned into each other kind (the capped one on node 0:
+    -5)."""
+    for k in [k for k, t in enumerate(tree) if t < 0][:6]:
+        yield from (tree[:k] + [leaf] + tree[k + 1:] for leaf in (-1, -2, -3, -4, -5)
+                    if leaf != tree[k])
     for k, t in enumerate(tree):
         if t < 0:
             continue
@@ -61,7 +66,7 @@ def test_surgery_on_charged_trees_never_proves_a_false_claim(seed, n, p):
     s*(r) + 1 and on the graph minus an arc: whatever the checker accepts is true."""
     edges = rand_edges(random.Random(seed), n, p)
     ig = index_graph(_graph(n, edges))
-    order = search_order(ig).tolist()
+    order = charged_order(ig).tolist()
     rho, _ = rho_and_s(n, in_masks(n, edges))
     fewer = edges[1:]
     accepted = rejected = 0
@@ -87,7 +92,7 @@ def test_charged_trees_at_the_64_node_limit_are_replayed(n, steps, r, s):
     ig = index_graph(G)
     tree = charged_tree(ig, r, s)
     assert tree is not None
-    edges, order = ig.edges(), search_order(ig).tolist()
+    edges, order = ig.edges(), charged_order(ig).tolist()
     assert C.check(_cert(n, edges, r, s, order, tree)).verdict == "valid"
     assert C.check(_cert(n, edges, r + 1, s, order, tree)).verdict == "invalid"
 

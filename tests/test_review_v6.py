@@ -164,7 +164,8 @@ def _part_trees(ig, r: int, s: int, uniform: bool) -> list[list[int]]:
     from rescon.graphs._charged_kernels import config_tree
     from rescon.graphs.search import _kernel_inputs
 
-    _, inmask, outmask, order = _kernel_inputs(ig)
+    _, inmask, outmask, _ = _kernel_inputs(ig)
+    order = ch.charged_order(ig)
     masks, deg = ig.in_masks(), ig.in_degrees
     if uniform:
         parts = [((), (), [r + min(c1, d) for d in deg], [r + min(c2, d) for d in deg])
@@ -187,9 +188,8 @@ def test_a_charged_tree_without_one_of_its_parts_is_invalid():
     """Charged and uniform trees (s = 2, 3) of random digraphs: the parts recorded one by
     one concatenate to the recorded tree, which is valid; without any one part (a
     configuration or a type dropped) it is invalid."""
-    from rescon.graphs.charged import charged_tree, uniform_tree
+    from rescon.graphs.charged import charged_order, charged_tree, uniform_tree
     from rescon.graphs.indexed import index_graph
-    from rescon.graphs.search import search_order
     from tests.test_checker import digraph
 
     dropped = 0
@@ -207,7 +207,7 @@ def test_a_charged_tree_without_one_of_its_parts_is_invalid():
                 assert whole == list((uniform_tree if uniform else charged_tree)(ig, r, s))
 
                 def verdict(tree, uniform=uniform, s=s, r=r, ig=ig):
-                    proof = {"method": "cost_search", "order": search_order(ig).tolist(),
+                    proof = {"method": "cost_search", "order": charged_order(ig).tolist(),
                              "charged_tree": tree, **({"uniform": True} if uniform else {})}
                     return C.check({"rescon_certificate": 1, "kind": "rs_robust",
                                     "graph": ig.graph_json(), "r": r, "s": s,

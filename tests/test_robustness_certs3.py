@@ -13,9 +13,8 @@ from itertools import combinations
 import networkx as nx
 import pytest
 
-from rescon.graphs.charged import charged_tree, uniform_tree, uniform_types
+from rescon.graphs.charged import charged_order, charged_tree, uniform_tree, uniform_types
 from rescon.graphs.indexed import index_graph
-from rescon.graphs.search import search_order
 from tests.test_checker import C, digraph, in_masks, is_robust, rand_edges, rho_and_s
 
 pytestmark = pytest.mark.usefixtures("fresh_facts")
@@ -119,7 +118,7 @@ def _rules_agree(seed, n, p):
 
 
 def _cert(ig, r, s, charged, **extra):
-    proof = {"method": "cost_search", "order": search_order(ig).tolist(),
+    proof = {"method": "cost_search", "order": charged_order(ig).tolist(),
              "charged_tree": list(charged), **extra}
     return {"rescon_certificate": 1, "kind": "rs_robust", "graph": ig.graph_json(),
             "r": r, "s": s, "proof": proof}
@@ -165,8 +164,8 @@ def test_charged_nodes_justify_crowded_leaves(monkeypatch):
     def blind(self, t, charged=0):
         return real(self, t)
 
-    needing = [(ig, r, s, tree) for ig, r, s, tree in _recorded()
-               if -4 in tree]
+    needing = [(ig, r, s, tree) for ig, r, s, tree in _recorded(seeds=range(60))
+               if -4 in tree]  # rarer since the capped leaves (5 of 60 seeds)
     assert needing
     real = C._Replay.threshold_side
     monkeypatch.setattr(C._Replay, "threshold_side", blind)

@@ -26,8 +26,8 @@ from .indexed import IndexedGraph
 if TYPE_CHECKING:
     from .bounds import Pair
 
-__all__ = ["MAX_CONFIGS", "charged_tree", "configurations", "count_configurations",
-           "uniform_excluded", "uniform_tree", "uniform_types"]
+__all__ = ["MAX_CONFIGS", "charged_order", "charged_tree", "configurations",
+           "count_configurations", "uniform_excluded", "uniform_tree", "uniform_types"]
 
 MAX_CONFIGS = 20_000  # beyond, no charged tree is tried (each configuration costs ≥ n tokens)
 
@@ -45,6 +45,15 @@ def configurations(n: int, c: int) -> Iterator[tuple[tuple[int, ...], tuple[int,
                 yield Q1, tuple(v for j, v in enumerate(rest) if not mask >> j & 1)
 
 
+def charged_order(ig: IndexedGraph) -> np.ndarray:
+    """The root order of the charged trees: descending in-degree, ties by index (the
+    first roots, hard to close, end their subtrees soonest, and later roots find their
+    easy nodes in B). ER(30, 0.5), r = 8, s = 3 with the capped leaf: 1.7× fewer tokens
+    (directed) and 4.3× (undirected) than ``search.search_order``'s ascending one."""
+    deg = np.array(ig.in_degrees)
+    return np.lexsort((np.arange(ig.n), -deg)).astype(np.int64)
+
+
 def count_configurations(n: int, c: int) -> int:
     """The number of :func:`configurations`."""
     return 1 + sum(comb(n, k) << (k - 1) for k in range(1, c + 1))
@@ -52,8 +61,8 @@ def count_configurations(n: int, c: int) -> int:
 
 def charged_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = None,
                  max_tokens: int = 4_000_000) -> tuple[int, ...] | None:
-    """The charged tree proving (r, s)-robustness, in the order
-    ``search.search_order(ig)``; None for r < 1, beyond ``max_tokens`` tokens (also when
+    """The charged tree proving (r, s)-robustness, in the order :func:`charged_order`;
+    None for r < 1, beyond ``max_tokens`` tokens (also when
     the first configuration's tree times the number of configurations passes twice that),
     ``MAX_CONFIGS`` configurations or ``deadline``; ValueError when a configuration has
     a violating pair (a pair cheaper than s)."""
@@ -126,7 +135,8 @@ def _record(ig: IndexedGraph, parts: Iterator[tuple], count: int, deadline: floa
     from ._charged_kernels import OVERFLOW, config_tree
     from .search import _kernel_inputs
 
-    _, inmask, outmask, order = _kernel_inputs(ig)
+    _, inmask, outmask, _ = _kernel_inputs(ig)
+    order = charged_order(ig)
     tokens = np.empty(max_tokens, dtype=np.int32)
     ntok = 0
     for index, (Q1, Q2, t1, t2) in enumerate(parts):

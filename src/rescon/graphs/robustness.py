@@ -40,7 +40,7 @@ from .._progress import progress_bar
 from .._validate import integer
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
-from .charged import charged_tree, uniform_excluded, uniform_tree
+from .charged import charged_order, charged_tree, uniform_excluded, uniform_tree
 from .distributed import searches_for
 from .facts import Facts, facts_for, implied_proof
 from .indexed import IndexedGraph, index_graph
@@ -285,7 +285,8 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
         key, (tree, extra) = "charged_tree", _charged(ig, r, s, deadline)
     if tree is None:
         return proof
-    return {"method": "cost_search", "order": search_order(ig).tolist(), key: list(tree),
+    order = charged_order(ig) if key == "charged_tree" else search_order(ig)
+    return {"method": "cost_search", "order": order.tolist(), key: list(tree),
             **extra, "info": {**proof.get("info", {}), "decided_by": method}}
 
 
