@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["KEY_PRIME", "nonsingular", "paired_rows", "point_keys"]
+__all__ = ["KEY_PRIME", "nonsingular", "paired_rows", "point_keys", "tight_through"]
 
 #: the largest prime below 2^31 − 1 (a compile-time constant: the reductions modulo it
 #: compile to multiplications); residues < 2^31, so a product of two fits an int64
@@ -135,6 +135,66 @@ def nonsingular(A, at, p):
                         R[r, j] = (top * R[r, j] - f * R[c, j]) % p
         out[i] = full
     return out
+
+
+@njit(cache=True, nogil=True)
+def tight_through(through, basis, hs, vs):
+    """For each pair i, whether the hyperplane of row hs[i] provably contains the point
+    v = vs[i] from the data points alone: some nonempty G ⊆ basis[v] (k independent rows
+    meeting only at v) has common points C_G = ⋂_{g∈G} through[g] with |C_G| = k − |G| + 1,
+    all on row hs[i] (C_G ⊆ through[hs[i]]).
+
+    Proof: C_G ⊆ through[g] is affinely independent (k points spanning a hyperplane),
+    so flat(C_G) has dimension k − |G|; it lies in ⋂_G H_g, of dimension k − |G| (the rows
+    are independent): the two are equal, and v ∈ ⋂_G H_g. Every exact row is the
+    hyperplane through its points, so C_G ⊆ H_h, hence flat(C_G) ⊆ H_h and v ∈ H_h.
+    False proves nothing (the caller decides the pair exactly). k² ≤ 62: the points of
+    v's basis rows are bits of an int64."""
+    k = through.shape[1]
+    out = np.zeros(len(hs), dtype=np.bool_)
+    points = np.empty(k * k, dtype=np.int64)
+    masks = np.empty(k, dtype=np.int64)
+    for i in range(len(hs)):
+        n = 0  # the distinct points of v's basis rows, each a bit
+        for a in range(k):
+            g = basis[vs[i], a]
+            m = 0
+            for s in range(k):
+                p = through[g, s]
+                j = 0
+                while j < n and points[j] != p:
+                    j += 1
+                if j == n:
+                    points[n] = p
+                    n += 1
+                m |= np.int64(1) << j
+            masks[a] = m
+        on = 0  # those on row hs[i]
+        for s in range(k):
+            for j in range(n):
+                if points[j] == through[hs[i], s]:
+                    on |= np.int64(1) << j
+                    break
+        for G in range(1, 1 << k):
+            common = np.int64(-1)
+            size = 0
+            for a in range(k):
+                if G >> a & 1:
+                    common &= masks[a]
+                    size += 1
+            if common & ~on == 0 and _popcount(common) == k - size + 1:
+                out[i] = True
+                break
+    return out
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _popcount(x):
+    c = 0
+    while x:
+        x &= x - 1
+        c += 1
+    return c
 
 
 @njit(cache=True, nogil=True)

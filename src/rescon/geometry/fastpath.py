@@ -301,15 +301,20 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     fresh = known[np.minimum(np.searchsorted(known, pair), len(known) - 1)] != pair
     near_r, near_v = near_r[fresh], near_v[fresh]
     hs = rows[near_r]
-    slacks = _int64_slacks(H, scale, verts, hs, near_v)
+    # the pairs whose row provably passes through the vertex (a flat of data points on
+    # the row holds it: :func:`._certify_nb.tight_through`) are tight; the others are
+    # decided on the integers
+    on = _tight_through(H, T_kept[firsts], hs, near_v, k)
+    rest = np.flatnonzero(~on)
+    slacks = _int64_slacks(H, scale, verts, hs[rest], near_v[rest])
     if slacks is None:  # in Python integers: a·y − b·w, all pairs at once
-        used, at = np.unique(hs, return_inverse=True)
+        used, at = np.unique(hs[rest], return_inverse=True)
         H.exact_all(used.tolist())
         E = _homogeneous(H, used.tolist(), k)[at.ravel()]  # (−b, a), each row built once
-        slacks = (E * W[near_v]).sum(axis=1) if len(hs) else np.zeros(0, dtype=object)
+        slacks = (E * W[near_v[rest]]).sum(axis=1) if len(rest) else np.zeros(0, dtype=object)
     if (slacks > 0).any():
         return None
-    on = slacks == 0
+    on[rest] = slacks == 0
     at = np.minimum(np.searchsorted(S, hs[on]), len(S) - 1)
     in_S = S[at] == hs[on]
     tight_v.append(near_v[on][in_S])
@@ -482,6 +487,19 @@ def _near_pairs(H, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray, c: floa
 
     return near_pairs(H.af[rows], H.bf[rows], H.af_abs[rows], H.b_abs[rows], Vx, coarse,
                       H.c_err, c, floor)
+
+
+def _tight_through(H, basis: np.ndarray, hs: np.ndarray, vs: np.ndarray, k: int) -> np.ndarray:
+    """For each pair (hs[i], vs[i]), True where row hs[i] provably passes through vertex
+    vs[i] by the data points of the rows alone (:func:`._certify_nb.tight_through`;
+    ``basis``: per vertex its k independent rows tight by construction, as rows of H);
+    False where that proves nothing (and for k² > 62)."""
+    if k * k > 62 or not len(hs):
+        return np.zeros(len(hs), dtype=np.bool_)
+    from ._certify_nb import tight_through
+
+    return tight_through(np.ascontiguousarray(H.through, dtype=np.int64), basis,
+                         np.asarray(hs, dtype=np.int64), np.asarray(vs, dtype=np.int64))
 
 
 def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
