@@ -860,7 +860,7 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         i0 = pos[0]  # u·g_i0 > 0
         sub = None
         if k == 3 and len(cols) > 4:  # N ∩ u^⊥ = the cone over its two extreme rays
-            _charge(meter, len(cols) * (2 * d + 4), max(rbits, gbits))
+            _charge(meter, len(cols) * (2 * d + 4), rbits + gbits)  # the ends' products
             sub = _split_cone(gens, su)
             c1, c2 = _ends(sub)
             cols, sub = [cols[c1], cols[c2]], [sub[c1], sub[c2]]
@@ -898,7 +898,8 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         m = base + min(same, opposite)
         if m + on > bound:
             continue
-        _charge(meter, len(cols) * 2 * d + len(rest) * 2 * len(cols), max(rbits, gbits))
+        # the generators (and their gcds or orientations) and the next rows
+        _charge(meter, len(cols) * 3 * d + len(rest) * 2 * len(cols), rbits + gbits)
         if sub is None:
             sub = _split_cone(gens, su)
         if k == 3:  # N ∩ u^⊥ is 2-dimensional: the arc between its extreme rays
