@@ -649,8 +649,9 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
             count += len(P) - len(pairs)  # points at v
             w = tuple((1 - tau) * a + tau * b for a, b in zip(w1, w2))
         else:
-            base, signs = _crossing(P, X, e, rows, cache)
             try:
+                _charge(meter, len(P) * max(0, len(rows) - d), bits)  # slacks beyond d facets
+                base, signs = _crossing(P, X, e, rows, cache)
                 hit = _cells_min(base, signs, rows, d, F, meter, _bit_size(signs), gbits)
             except _OverBudget:
                 break
