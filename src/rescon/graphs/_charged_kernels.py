@@ -109,12 +109,15 @@ def capped_member(S: np.uint64, P: np.uint64, Q: np.uint64, inmask: np.ndarray,
     i.e. in c. U2 avoids U1, so |U2 ∩ c| ≤ |c| − need_m = sl; and U2 ⊆ Q is closed:
     each j ∈ U2 has ≥ d_j − t2[j] + 1 in-neighbours in U2, of which at most
     min(sl, |N(j) ∩ U2 ∩ c|) in c. So U2 lies in the capped core (peeling never
-    removes a member of U2), and none exists when it is empty. (ER(30, 0.5), r = 8,
+    removes a member of U2), and none exists when it is empty; none exists either when
+    sl < 0 (m cannot be closed in U1; the checker takes that as an empty core too).
+    (ER(30, 0.5), r = 8,
     s = 3: pairs, tried where no single member does, save ~35 % of the tokens.)"""
     n = inmask.shape[0]
     idx = np.empty(64, dtype=np.int64)
     cs = np.empty(64, dtype=np.uint64)
     sls = np.empty(64, dtype=np.int64)
+    qs = np.empty(64, dtype=np.uint64)
     k = 0
     m = S
     while m:
@@ -124,12 +127,16 @@ def capped_member(S: np.uint64, P: np.uint64, Q: np.uint64, inmask: np.ndarray,
         if need > 0:
             c = inmask[i] & P & ~S
             idx[k], cs[k], sls[k] = i, c, popcount(c) - need
-            if capped_core(Q, c, sls[k], c, sls[k], inmask, t2) == ZERO:
+            if sls[k] < 0:
+                return i * n + i  # no U1 (never met below a -2 leaf: there S ⊆ P)
+            qs[k] = capped_core(Q, c, sls[k], c, sls[k], inmask, t2)
+            if qs[k] == ZERO:
                 return i * n + i
             k += 1
     for a in range(k):
         for b in range(a + 1, k):
-            if capped_core(Q, cs[a], sls[a], cs[b], sls[b], inmask, t2) == ZERO:
+            # the pair's core lies in both single ones: peel from their intersection
+            if capped_core(qs[a] & qs[b], cs[a], sls[a], cs[b], sls[b], inmask, t2) == ZERO:
                 return idx[a] * n + idx[b]
     return -1
 
