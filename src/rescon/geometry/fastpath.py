@@ -11,7 +11,9 @@ rule); the proposal is accepted only if, in exact arithmetic,
 
 1. every proposed vertex v satisfies every valid halfspace, and its tight set within
    the defining halfspaces S (the rows of all proposals) is computed exactly — so
-   conv(V) ⊆ Ψ by the characterisation theorem;
+   conv(V) ⊆ Ψ by the characterisation theorem (a row the floats cannot place is tight
+   where a flat of data points on it holds v, :func:`._certify_nb.tight_through` — on
+   the bench clouds every such row — else its slack is computed on the integers);
 2. every extreme ray of every vertex's tangent cone {d : a_h·d ≤ 0, h tight at v}
    leads to another proposed vertex: for a simple vertex the rays keep all but one of
    its k rows tight; for a non-simple one they are the directions u − v to the
