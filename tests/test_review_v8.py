@@ -1,0 +1,177 @@
+"""Review V8 (issue 13): hostile tests of this session's changes.
+
+A. The d = 4–5 fast path: ``_distinct_points`` (float keys, exact ties), the compiled
+   nonsingularity test mod p (``_certify_nb.nonsingular``), ``tight_through``.
+B. The checker's normal fan in d ≥ 3 (``certificates/kernels.py``).
+C. Capped charged-tree leaves (``certificates/cost_tree.py``, ``graphs/_charged_kernels``).
+"""
+
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from rescon.geometry import _certify_nb, fastpath
+from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
+
+# --- A. the fast path ----------------------------------------------------------------
+
+
+def _det(M) -> Fraction:
+    M = [[Fraction(x) for x in r] for r in M]
+    out = Fraction(1)
+    for c in range(len(M)):
+        piv = next((i for i in range(c, len(M)) if M[i][c]), None)
+        if piv is None:
+            return Fraction(0)
+        if piv != c:
+            M[c], M[piv] = M[piv], M[c]
+            out = -out
+        out *= M[c][c]
+        for i in range(c + 1, len(M)):
+            f = M[i][c] / M[c][c]
+            M[i] = [a - f * b for a, b in zip(M[i], M[c], strict=True)]
+    return out
+
+
+@pytest.mark.parametrize("k", [2, 3, 4, 5])
+def test_nonsingular_never_calls_a_singular_system_nonsingular(k):
+    """``nonsingular`` against exact determinants on small integer rows full of
+    dependencies (copies, sums, zero rows), rows whose determinant is a nonzero multiple
+    of p (must say "maybe singular"), and residues near p: True ⇒ det ≠ 0 and
+    det ≢ 0 (mod p) ⇒ True."""
+    from rescon.geometry.polytope import PRIME
+
+    rng = np.random.default_rng(k)
+    rows = [list(r) for r in rng.integers(-2, 3, size=(40, k)).tolist()]
+    rows += [[a + b for a, b in zip(rows[i], rows[i + 1], strict=True)] for i in range(10)]
+    rows += [[0] * k, rows[0], [PRIME - 1] * k, [PRIME] + [0] * (k - 1)]
+    rows += [[2**40 + i] + [3**j for j in range(k - 1)] for i in range(3)]
+    # det = PRIME·(something nonzero): a diagonal with PRIME in one entry
+    for j in range(k):
+        rows.append([PRIME if c == j else 0 for c in range(k)])
+        rows.append([1 if c == j else 0 for c in range(k)])
+    m = len(rows)
+    A = np.array([[v % PRIME for v in r] for r in rows], dtype=np.int64)
+    sets = [rng.choice(m, k, replace=False).tolist() for _ in range(3000)]
+    sets += [[m - 2 * k + 2 * j + (j != 0) for j in range(k)]]  # PRIME · e_0, e_1, …
+    sets += [list(range(m - 2 * k, m, 2))]  # PRIME · I
+    at = np.array(sets, dtype=np.int64)
+    got = _certify_nb.nonsingular(A, at, PRIME)
+    for T, ok in zip(sets, got.tolist(), strict=True):
+        det = _det([rows[i] for i in T])
+        if ok:
+            assert det != 0, T
+        if det.numerator % PRIME:
+            assert ok, T
+    assert not got[-1] and not got[-2]  # det = PRIME^j ≠ 0, "maybe singular"
+
+
+def _lattice_rows(rng, k: int, n: int, m: int):
+    """n lattice points in {0, 1, 2}^k (many on common hyperplanes) and m rows through k
+    affinely independent ones (exact primitive (a, b))."""
+    Y = [tuple(p) for p in rng.integers(0, 3, size=(4 * n, k)).tolist()]
+    Y = list(dict.fromkeys(Y))[:n]
+    through, ab = [], []
+    while len(through) < m:
+        T = sorted(rng.choice(len(Y), k, replace=False).tolist())
+        D = [[x - y for x, y in zip(Y[t], Y[T[0]], strict=True)] for t in T[1:]]
+        a = tuple(int((-1) ** j * _det([[r[c] for c in range(k) if c != j] for r in D]))
+                  for j in range(k))
+        if any(a):
+            through.append(T)
+            ab.append((a, sum(x * y for x, y in zip(a, Y[T[0]], strict=True))))
+    return Y, np.array(through, dtype=np.int64), ab
+
+
+@pytest.mark.parametrize("k", [3, 4, 5])
+def test_tight_through_only_claims_exactly_tight_pairs(k):
+    """Brute force: random lattice points (many points on common hyperplanes, rows
+    sharing k − 1 or fewer points), vertices solved from k independent rows; every pair
+    (row, vertex) ``tight_through`` calls tight has exact slack 0 — and it finds some."""
+    rng = np.random.default_rng([k, 8])
+    Y, through, ab = _lattice_rows(rng, k, 3 * k + 2, 120)
+    basis, verts = [], []
+    while len(basis) < 60:
+        # bases sharing points: a row and others through some of its points
+        B = sorted(rng.choice(len(through), k, replace=False).tolist())
+        A = [ab[h][0] for h in B]
+        det = _det(A)
+        if det == 0:
+            continue
+        # Cramer: v = A⁻¹ b
+        v = []
+        for j in range(k):
+            Aj = [[ab[h][1] if c == j else ab[h][0][c] for c in range(k)] for h in B]
+            v.append(_det(Aj) / det)
+        basis.append(B)
+        verts.append(v)
+    hs = np.repeat(np.arange(len(through)), len(verts))
+    vs = np.tile(np.arange(len(verts)), len(through))
+    got = _certify_nb.tight_through(through, np.array(basis, dtype=np.int64), hs, vs)
+    claimed = 0
+    for h, v, ok in zip(hs.tolist(), vs.tolist(), got.tolist(), strict=True):
+        slack = sum(Fraction(a) * x for a, x in zip(ab[h][0], verts[v], strict=True)) - ab[h][1]
+        if ok:
+            claimed += 1
+            assert slack == 0, (h, v)
+    assert claimed >= len(verts)  # at least the basis rows themselves
+
+
+def test_tight_through_on_a_hand_made_flat():
+    """k = 3: rows g1, g2 share the two points {p, q} (their line holds v); a row h
+    through p and q holds v (True); a row through p alone and two other points does
+    not have to (False unless another flat proves it)."""
+    # points (0,0,0) (1,0,0) (0,1,0) (0,0,1) (1,1,1) (2,0,5) (0,3,1)
+    # g1 = {0,1,2} (z = 0), g2 = {0,1,3} (y = 0), g3 = {2,3,4}: v on the x-axis
+    through = np.array([[0, 1, 2], [0, 1, 3], [2, 3, 4], [0, 1, 5], [0, 5, 6]],
+                       dtype=np.int64)
+    basis = np.array([[0, 1, 2]], dtype=np.int64)
+    got = _certify_nb.tight_through(through, basis, np.array([3, 4]), np.array([0, 0]))
+    assert got.tolist() == [True, False]
+
+
+def test_distinct_points_merge_exactly_whatever_the_floats():
+    """Homogeneous rows of distinct points closer than a float resolves (1e-300 apart
+    around 1, 1/(2^200) apart, points rounding to the same subnormal or to 0), equal
+    points written with different positive scalings, and keys forced equal: equal
+    points merge, distinct ones never do."""
+    pts = [(Fraction(1), Fraction(2)), (1 + Fraction(1, 10**300), Fraction(2)),
+           (Fraction(1), 2 + Fraction(1, 2**200)), (Fraction(1, 2**1100), Fraction(0)),
+           (Fraction(1, 2**1101), Fraction(0)), (Fraction(0), Fraction(0)),
+           (Fraction(-1, 2**1100), Fraction(0)), (Fraction(10**300), Fraction(1)),
+           (Fraction(10**300) + 1, Fraction(1))]
+    rng = np.random.default_rng(8)
+    order = rng.integers(0, len(pts), size=60).tolist()
+    rows = []
+    for i in order:
+        x, y = pts[i]
+        w = x.denominator * y.denominator * int(rng.integers(1, 1000))
+        rows.append([w, int(x * w), int(y * w)])
+    W = np.empty((len(rows), 3), dtype=object)
+    W[:] = rows
+    Vx = (W[:, 1:] / W[:, :1]).astype(np.float64)
+    for V in (Vx, np.zeros_like(Vx), np.round(Vx)):
+        of_row, firsts = fastpath._distinct_points(W, V)
+        assert len(firsts) == len(set(order))
+        for i, j in itertools.combinations(range(len(order)), 2):
+            assert (of_row[i] == of_row[j]) == (order[i] == order[j])
+        assert all(of_row[f] == n for n, f in enumerate(firsts.tolist()))
+        assert sorted(firsts.tolist()) == firsts.tolist()  # numbered by first appearance
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("lattice", 4, 40, 3), ("grid", 4, 20, 2),
+                                        ("integer", 4, 20, 3), ("nearsame", 5, 13, 1),
+                                        ("cell24", 4, 28, 4)])
+def test_kernels_unchanged_when_every_float_key_collides(kind, d, n, F, monkeypatch):
+    """The float keys of ``_distinct_points`` made to collide (all equal, or rounded to
+    integers of the scaled coordinates): the exact ties decide, the kernel stays bit
+    for bit the exact clipping's."""
+    real = fastpath._distinct_points
+    for coarse in (np.zeros_like, lambda V: np.round(V / 8)):
+        with monkeypatch.context() as mp:
+            mp.setattr(fastpath, "_distinct_points", lambda W, V, c=coarse: real(W, c(V)))
+            _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
