@@ -273,3 +273,20 @@ def test_benchmark_kernels_in_d4_are_verified(family, n, F):
     res = check(cert)
     assert res.verdict == "valid", (res.reason, res.unchecked)
     assert "normal fan" in res.reason
+
+
+def test_kernel_point_by_its_kernel_in_d4():
+    """A kernel_point certificate whose proof is the kernel itself (checked as a
+    safe_kernel, by the fan) is valid in d = 4 too; a point just outside is not."""
+    X = np.random.default_rng(3).standard_normal((12, 4))
+    c = rescon.safe_kernel(X, 2).certificate
+    v, w = (c["vertices"][i] for i in (0, c["adjacency"][0][0]))
+    x = [str((Fraction(a) + Fraction(b)) / 2) for a, b in zip(v, w)]  # on an edge of Ψ
+    proof = {"method": "kernel", **{k: c[k] for k in kernels.KERNEL_KEYS}}
+    cert = {"rescon_certificate": 1, "kind": "kernel_point", "points": c["points"], "F": 2,
+            "x": x, "proof": proof}
+    res = check(cert)
+    assert res.verdict == "valid" and "normal fan" in res.reason, res.reason
+    h = c["facets"][0]
+    out = [str(Fraction(t) + Fraction(a) * 10**6) for t, a in zip(x, h["a"])]
+    assert check({**cert, "x": out}).verdict == "invalid"
