@@ -130,9 +130,9 @@ def test_split_part_makes_only_the_bottom_frames_parts_of_their_own():
     """The decision search's split (search.split_part) as documented: the frames above
     the ``singles`` bottom ones together. It made every frame below the top ``singles``
     a part of its own (9 frames, singles = 2: 8 parts instead of 3)."""
-    ig = index_graph(nx.gnp_random_graph(22, 0.7, seed=0, directed=True))
-    run = search.PartRun(search._kernel_inputs(ig), 8, search.whole_part(ig.n), 0)
-    steps = 100
+    ig = index_graph(nx.gnp_random_graph(50, 0.5, seed=50000, directed=True))
+    run = search.PartRun(search._kernel_inputs(ig), 13, search.whole_part(ig.n), 0)
+    steps = 100  # (G(22, 0.7), r = 8 ends too soon since the capped prune)
     while run.advance(steps) == K.RUNNING and run.rest().frames.shape[0] < 6:
         steps += 100
     rest = run.rest()

@@ -120,8 +120,9 @@ def _slack_zero_root(engine: str):
             if S & ~allowed:
                 continue
             slack, cand = K.tightest_member(S, S, allowed, inmask, r, ig.n)
-            if engine == "decide":
-                expanded = _decision_step(inputs, r, root, True).state[K.ST_SP] > 0
+            if engine == "decide":  # expanded with and without a tree (the capped prune)
+                expanded = all(_decision_step(inputs, r, root, rec).state[K.ST_SP] > 0
+                               for rec in (True, False))
             else:
                 expanded = _charged_step(inputs, r, root).state[K.CS_SP] > 0
             if slack == 0 and expanded:

@@ -22,6 +22,7 @@ from numba import njit
 from ._kernels import (
     U1,
     ZERO,
+    capped_core,
     core_after_removal,
     crowded,
     leaf_code,
@@ -67,32 +68,6 @@ def _branch(S: np.uint64, P: np.uint64, Q: np.uint64, inmask: np.ndarray, outmas
         if v > best:
             best, u = v, j
     return u
-
-
-@njit(cache=True, nogil=True)
-def capped_core(Q: np.uint64, c1: np.uint64, sl1: int, c2: np.uint64, sl2: int,
-                inmask: np.ndarray, t: np.ndarray) -> np.uint64:
-    """The largest Q' ⊆ Q whose members j have, for (c, sl) = (c1, sl1) and (c2, sl2),
-    |N(j) ∩ Q' \\ c| + min(sl, |N(j) ∩ Q' ∩ c|) ≥ d_j − t[j] + 1, by peeling (the left
-    sides only grow with Q', so such sets are closed under union). Every closed set
-    (thresholds t) inside Q with at most sl_k members in c_k (k = 1, 2) lies in it
-    (:func:`capped_member`)."""
-    changed = True
-    while changed and Q:
-        changed = False
-        m = Q
-        while m:
-            j = low_index(m)
-            b = U1 << np.uint64(j)
-            m &= ~b
-            inside = inmask[j] & Q
-            want = popcount(inmask[j]) - t[j] + 1
-            x1 = min(popcount(inside & c1), sl1)
-            x2 = min(popcount(inside & c2), sl2)
-            if popcount(inside & ~c1) + x1 < want or popcount(inside & ~c2) + x2 < want:
-                Q &= ~b
-                changed = True
-    return Q
 
 
 @njit(cache=True, nogil=True)
