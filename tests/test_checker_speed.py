@@ -225,3 +225,15 @@ def test_tampered_kernel_point_proofs_are_rejected(name):
     f(cert)
     res = check(cert)
     assert res.verdict == "invalid" and needle in res.reason, (name, res.reason)
+
+
+@pytest.mark.slow
+def test_d4_kernel_points_carry_the_kernel():
+    """In d = 4 the checker's normal fan makes the "kernel" proof checkable; before, a
+    kernel point of n = 40 points carried the (b) proof, whose C(40, 4) hyperplanes are
+    beyond the checker's enumeration limit ('unchecked')."""
+    X = np.random.default_rng(40).standard_normal((40, 4))
+    _, cert = rescon.kernel_point(X, 1)
+    assert cert["proof"]["method"] == "kernel"
+    res = check(cert)
+    assert res.verdict == "valid", (res.reason, res.unchecked)

@@ -45,13 +45,14 @@ KERNEL_PROOF_KEYS = ("dim", "vertices", "equalities", "facets", "adjacency")
 
 
 def point_certificate(K: SafeKernel, x: Vec) -> dict[str, Any]:
-    """A ``kernel_point`` certificate: for a full-dimensional kernel in d = 2, 3 the
+    """A ``kernel_point`` certificate: for a full-dimensional kernel in d = 2–4 the
     kernel itself ("kernel" proof: the checker verifies Ψ = P by the vertex adjacency
-    and the normal fan in O(#V·n)-ish work, then x ∈ P), else the checker's own
-    enumeration of the hyperplanes through data points ("halfspaces")."""
+    and the normal fan, then x ∈ P), else the checker's own enumeration of the
+    hyperplanes through data points ("halfspaces"; in d ≥ 5 the adjacency check of
+    the kernel's often non-simple vertices is beyond the checker's limits sooner)."""
     d = K.points.shape[1]
     proof: dict[str, Any] = {"method": "halfspaces"}
-    if K.dim == d and d in (2, 3):
+    if K.dim == d and d in (2, 3, 4):
         kc = K.certificate
         proof = {"method": "kernel", **{k: kc[k] for k in KERNEL_PROOF_KEYS}}
     return {"rescon_certificate": 1, "kind": "kernel_point", "points": K.points.tolist(),
