@@ -327,3 +327,102 @@ def test_fan_decides_tiny_d5_instances():
     assert (len(pts), F, len(V)) == (9, 0, 8)
     names = [f"v{i}" for i in range(len(V))]
     assert _verdict(C, K._fan_in_kernel, pts, F, V, tight, names) == "valid"
+
+
+def _by_enumeration(cert: dict):
+    """check(cert) with V ⊆ Ψ decided by (b) instead of the normal fan."""
+    import copy
+
+    from rescon_certificates import kernels
+    from rescon_certificates.check import check
+
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(kernels, "_fan_in_kernel",
+                  lambda pts, F, V, tight, names, ctx:
+                  kernels._in_kernel_halfspaces(pts, F, V, names, ctx, "vertices"))
+        m.setattr(kernels, "MAX_HALFSPACE_WORK", 10**9)
+        return check(copy.deepcopy(cert))
+
+
+@pytest.mark.parametrize("d,n,F", [(3, 10, 2), (4, 10, 2), (4, 12, 3), (5, 11, 1)])
+def test_certificate_of_a_nudged_cloud(d, n, F):
+    """The certificate of Ψ(X', F) presented for X, X' = X with one point moved by one
+    ulp, by 2^-20 of its size, or onto another point (a duplicate), and with a facet
+    dropped or its offset moved by 2^-60: the checker (fan) and the enumeration (b)
+    never disagree on valid / invalid, and the true kernel stays valid."""
+    import copy
+
+    from rescon_certificates.check import check
+
+    import rescon
+
+    rng = np.random.default_rng([d, n, F, 8])
+    decided = set()
+    for trial in range(6):
+        X = np.round(rng.normal(size=(n, d)) * 8) / 8
+        i = int(rng.integers(n))
+        Y = X.copy()
+        move = trial % 3
+        if move == 0:
+            Y[i, 0] = np.nextafter(Y[i, 0], np.inf)
+        elif move == 1:
+            Y[i] += 2.0**-20 * rng.normal(size=d)
+        else:
+            Y[i] = X[(i + 1) % n]
+        K = rescon.safe_kernel(Y, F)
+        if K.is_empty or K.dim < d:
+            continue
+        own = check(copy.deepcopy(K.certificate))
+        assert own.verdict != "invalid", own.reason
+        cert = copy.deepcopy(K.certificate)
+        cert["points"] = [[repr(float(x)) for x in p] for p in X] if isinstance(
+            cert["points"][0][0], str) else X.tolist()
+        variants = [cert]
+        dropped = copy.deepcopy(cert)
+        del dropped["facets"][int(rng.integers(len(dropped["facets"])))]
+        variants.append(dropped)
+        moved = copy.deepcopy(cert)
+        f = moved["facets"][0]
+        f["b"] = str(Fraction(f["b"]) + Fraction(1, 2**60))
+        variants.append(moved)
+        for c in variants:
+            fan, ref = check(copy.deepcopy(c)), _by_enumeration(c)
+            if "unchecked" in (fan.verdict, ref.verdict):
+                continue
+            assert fan.verdict == ref.verdict, (trial, fan.reason, ref.reason)
+            decided.add(fan.verdict)
+    assert "invalid" in decided
+
+
+@pytest.mark.parametrize("d,n,F", [(3, 10, 2), (4, 11, 2), (5, 10, 1)])
+def test_kernel_certificate_with_interior_points_added(d, n, F):
+    """The certificate of Ψ(X, F) presented for X plus copies of points of Ψ (its
+    vertex mean, a vertex, the midpoint of two vertices — exact rationals): every
+    facet keeps its outside count, so Ψ' ⊆ P ⊆ Ψ ⊆ Ψ' and the claim is true; the
+    checker must not call it invalid. Claimed for F + 1 as well: the fan's verdict
+    equals (b)'s."""
+    import copy
+
+    from rescon_certificates.check import check
+
+    import rescon
+
+    rng = np.random.default_rng([d, n, F, 9])
+    X = np.round(rng.normal(size=(n, d)) * 4) / 4
+    K = rescon.safe_kernel(X, F)
+    assert K.dim == d
+    V = [tuple(Fraction(x) for x in v) for v in K.exact_vertices]
+    mean = tuple(sum(c) / len(V) for c in zip(*V))
+    mid = tuple((a + b) / 2 for a, b in zip(V[0], V[-1], strict=True))
+    decided = set()
+    for extra in ([mean], [mean, mean], [V[0]], [mid, V[1], mean]):
+        cert = copy.deepcopy(K.certificate)
+        cert["points"] = [*cert["points"], *([str(x) for x in q] for q in extra)]
+        got = check(copy.deepcopy(cert))
+        assert got.verdict != "invalid", got.reason
+        up = {**copy.deepcopy(cert), "F": F + 1}
+        fan, ref = check(copy.deepcopy(up)), _by_enumeration(up)
+        if "unchecked" not in (fan.verdict, ref.verdict):
+            assert fan.verdict == ref.verdict, (fan.reason, ref.reason)
+            decided.add(fan.verdict)
+    assert decided
