@@ -268,3 +268,27 @@ def test_the_capped_prune_shortens_dense_decisions():
     ig = index_graph(nx.gnp_random_graph(40, 0.8, seed=1, directed=True))
     out = decide_r_robust(ig, 15)
     assert out.status == "robust" and out.nodes < 4_500_000
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_charged_engine_with_the_capped_prune_finds_the_brute_force_s_star(seed):
+    """min_cost_step alone (its capped prune: ``_kernels.capped_charged``) gives s*(r),
+    the largest s with (r, s)-robustness, for every r ≤ ρ of random digraphs n = 7..9."""
+    from rescon.graphs import _kernels as K
+    from rescon.graphs import search
+    from tests.test_checker import is_robust
+
+    rng = random.Random(2000 + seed)
+    for _ in range(5):
+        n = rng.randint(7, 9)
+        edges = rand_edges(rng, n, rng.choice([0.4, 0.6, 0.75, 0.9]), undirected=rng.random() < 0.3)
+        ig = index_graph(digraph(n, edges))
+        inm = in_masks(n, ig.edges())
+        _, inmask, outmask, order = search._kernel_inputs(ig)
+        for r in range(1, rho_and_s(n, inm)[0] + 1):
+            run = search._CostRun(K, n, (0, n), n)
+            while run.state[K.CS_STATUS] == K.RUNNING:
+                K.min_cost_step(inmask, outmask, order, r, 0, run.stack, run.depth, run.state,
+                                run.ubuf, 1 << 16, run.progress)
+            s_star = max(s for s in range(1, n + 1) if is_robust(n, inm, r, s))
+            assert min(int(run.state[K.CS_BEST]), n) == s_star, (seed, n, r)

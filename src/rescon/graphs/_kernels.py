@@ -555,6 +555,32 @@ def cheapest_side(U: np.uint64, least: int, budget: int, inmask: np.ndarray, r: 
     return -1
 
 
+@njit(cache=True, nogil=True)
+def capped_charged(S: np.uint64, X: np.uint64, M: np.uint64, W: np.uint64,
+                   inmask: np.ndarray, r: int, budget: int) -> bool:
+    """True when no S2 below the charged-set search's state (S, X, M) fits: some member
+    i of M (closed in S1) with need_i = |N(i) \\ S| − r + 1 > 0 has sl_i = |c_i| − need_i
+    < 0 or an empty :func:`capped_core` of W for (c_i, sl_i) at threshold r + budget,
+    c_i = N(i) \\ S \\ X. W ⊇ A2, the uncharged part of S2 (``core_hard`` below).
+
+    Proof: i keeps ≤ r − 1 in-neighbours outside S1 ⊆ V \\ X, so ≥ need_i of c_i lie in
+    S1 and S2 (disjoint) holds ≤ sl_i of them. A member j of A2 has ≥ d_j − r + 1
+    in-neighbours in S2 = A2 ∪ Q2, |Q2| ≤ budget: |N(j) ∩ A2 \\ c_i| +
+    min(sl_i, |N(j) ∩ A2 ∩ c_i|) + budget ≥ d_j − r + 1, the capped condition at
+    threshold r + budget; A2 ≠ ∅ lies in the capped core."""
+    m = M
+    while m:
+        i = low_index(m)
+        m &= ~(U1 << np.uint64(i))
+        need = popcount(inmask[i] & ~S) - r + 1
+        if need > 0:
+            c = inmask[i] & ~S & ~X
+            sl = popcount(c) - need
+            if sl < 0 or capped_core(W, c, sl, c, sl, inmask, r + budget) == ZERO:
+                return True
+    return False
+
+
 # rows of the cost-search stack
 CK_S, CK_X, CK_C, CK_M = 0, 1, 2, 3
 COST_STACK_WIDTH = 4
@@ -671,6 +697,9 @@ def min_cost_step(
                 free = C | F
                 if M & ~core_hard(full & ~X & ~free, free, X, inmask, r, budget - k):
                     prune = True
+                else:
+                    prune = capped_charged(S, X, M, core_hard(rest, ZERO, S | B, inmask, r,
+                                                              budget), inmask, r, budget)
         if prune:
             progress[0] += 0.5 ** depth / n
             continue
