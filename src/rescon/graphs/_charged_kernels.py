@@ -10,7 +10,9 @@ for the thresholds t1, t2: an r-robustness decision with per-node, per-side thre
 searched as ``_kernels.decide_step`` searches r-robustness, with its primitives (which
 take per-node thresholds), plus two leaves: maximal pairs of least cost, and the capped
 core (``capped_member``: what the other set may take from a member's candidates is
-capped by its need; ER(30, 0.5), r = 8, s = 3: 15–39× fewer tokens)
+capped by its need; ER(30, 0.5), r = 8, s = 3: 15–39× fewer tokens with one member,
+and with pairs, ``_branch`` and ``charged.charged_order`` 41.1M → 0.40M and
+30.8M → 0.10M)
 (certificates/FORMAT.md, ``cost_search`` with a ``charged_tree``).
 """
 

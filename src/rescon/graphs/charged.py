@@ -92,7 +92,8 @@ def uniform_tree(ig: IndexedGraph, r: int, s: int, *, deadline: float | None = N
     with |Q1| ≤ c1, |Q2| ≤ c2 at once (r + |N(i) ∩ Q_k| ≤ t_k(i)). None for r < 1 or
     s < 2, beyond ``max_tokens`` or ``deadline``, or when a type has a violating pair
     (always for s ≥ 3 at r = ρ: (1, 1) asks for two (r + 1)-closed sets). ER(30, 0.5),
-    s = 2: on one graph of three, 0.33M tokens where the configurations take 2.2M."""
+    s = 2: on one graph of three, 0.33M tokens where the configurations took 2.2M before
+    the capped leaf (13k with it)."""
     if r < 1 or s < 2:
         return None
     deg = ig.in_degrees
