@@ -426,3 +426,81 @@ def test_kernel_certificate_with_interior_points_added(d, n, F):
             assert fan.verdict == ref.verdict, (fan.reason, ref.reason)
             decided.add(fan.verdict)
     assert decided
+
+
+# --- C. capped charged-tree leaves ---------------------------------------------------
+
+
+def _charged_cert(ig, r, s, tree, order):
+    return {"rescon_certificate": 1, "kind": "rs_robust", "graph": ig.graph_json(), "r": r,
+            "s": s, "proof": {"method": "cost_search", "order": order,
+                              "charged_tree": list(tree)}}
+
+
+def _greediest_tree(ig, n, r, s, order, limit):
+    """The most aggressive charged tree the checker lets through, built token by token
+    with the checker as the oracle: at each state any leaf it accepts (-1 … -4, then
+    every capped leaf −5 − (i·n + j), i ≤ j), else the first node it accepts as a branch.
+    ("tree", tokens) when the checker calls the tree valid, ("stuck", tokens) when no
+    token is accepted at some state, ("limit", tokens) beyond ``limit`` tokens."""
+    from tests.test_checker import C
+
+    leaves = [-1, -2, -3, -4] + [-5 - (i * n + j) for i in range(n) for j in range(i, n)]
+    toks: list[int] = []
+    while len(toks) < limit:
+        for cand in leaves + list(range(n)):
+            res = C.check(_charged_cert(ig, r, s, toks + [cand], order))
+            if res.verdict == "valid":
+                return "tree", toks + [cand]
+            if "ends early" in res.reason or "ends before" in res.reason:
+                toks.append(cand)
+                break
+        else:
+            return "stuck", toks
+    return "limit", toks
+
+
+def _greedy_claims(seeds, nodes):
+    import random
+
+    from rescon.graphs.charged import charged_order
+    from rescon.graphs.indexed import index_graph
+    from tests.test_checker import digraph, in_masks, is_robust, rand_edges, rho_and_s
+
+    capped = controls = 0
+    for seed in seeds:
+        rng = random.Random(seed)
+        n = rng.choice(nodes)
+        ig = index_graph(digraph(n, rand_edges(rng, n, rng.choice([0.4, 0.6, 0.8, 0.9]),
+                                               rng.random() < 0.3)))
+        inm = in_masks(n, ig.edges())
+        rho, _ = rho_and_s(n, inm)
+        order = charged_order(ig).tolist()
+        for r in range(1, rho + 1):
+            s_star = 1
+            while s_star < n and is_robust(n, inm, r, s_star + 1):
+                s_star += 1
+            if s_star < n:  # a false claim: the checker must never be talked into it
+                how, toks = _greediest_tree(ig, n, r, s_star + 1, order, 1500)
+                assert how != "tree", (seed, n, r, s_star, toks)
+                capped += sum(t <= -5 for t in toks)
+            how, toks = _greediest_tree(ig, n, r, s_star, order, 150)  # a true one
+            assert how != "stuck", (seed, n, r, s_star, toks)
+            controls += how == "tree"
+    return capped, controls
+
+
+def test_the_greediest_charged_tree_never_proves_a_false_claim():
+    """Random digraphs (n = 5; directed and undirected, p 0.4–0.9), every r ≤ ρ: a
+    tree for s*(r) + 1 (brute force) built from whatever the checker accepts — every
+    capped leaf it lets through — never becomes valid; for s*(r) the same builder
+    finds a valid tree (or a long one), so the oracle is not vacuous."""
+    capped, controls = _greedy_claims(range(8), [5])
+    assert capped > 0 and controls >= 3
+
+
+@pytest.mark.slow
+def test_the_greediest_charged_tree_never_proves_a_false_claim_n6_n7():
+    """The same on n = 6, 7 (~2 min)."""
+    capped, controls = _greedy_claims(range(100, 124), [6, 7])
+    assert capped > 0
