@@ -505,3 +505,101 @@ def test_the_greediest_charged_tree_never_proves_a_false_claim_n6_n7():
     """The same on n = 6, 7 (~2 min)."""
     capped, controls = _greedy_claims(range(100, 124), [6, 7])
     assert capped > 0
+
+
+def _checker_before(tmp_path):
+    """check() of the checker as it was before this session (e79e53b), or None."""
+    import importlib.util
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    arch = subprocess.run(["git", "-C", str(root), "archive", "e79e53b", "certificates"],
+                          capture_output=True)
+    if arch.returncode:
+        return None
+    subprocess.run(["tar", "-x", "-C", str(tmp_path)], input=arch.stdout, check=True)
+    spec = importlib.util.spec_from_file_location("check_e79e53b",
+                                                  tmp_path / "certificates" / "check.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["check_e79e53b"] = mod
+    spec.loader.exec_module(mod)
+    return mod.check
+
+
+@pytest.mark.slow
+def test_rescon_s_star_is_brute_force_with_charged_trees(monkeypatch):
+    """Hundreds of random digraphs (n = 4–9, p 0.3–0.9, directed and undirected), the
+    sized tree switched off and the checker's enumeration too (MAX_ENUM_N = 0), so every
+    proof of s* ≥ 2 is a charged tree (plain or uniform): (ρ, s*) equals brute force,
+    the certificate is valid, and claimed for s* + 1 it is invalid. ~15 CPU-s."""
+    import copy
+    import random
+
+    import rescon
+    from rescon.graphs import robustness as R
+    from rescon.graphs.facts import clear_cache
+    from tests.test_checker import C, digraph, in_masks, rand_edges, rho_and_s
+
+    monkeypatch.setattr(R, "cost_tree", lambda *a, **k: None)
+    monkeypatch.setattr(R, "MAX_ENUM_N", 0)
+    charged = capped = 0
+    for seed in range(300):
+        clear_cache()
+        rng = random.Random(seed)
+        n = rng.randint(4, 9)
+        edges = rand_edges(rng, n, rng.uniform(0.3, 0.9), rng.random() < 0.4)
+        G = digraph(n, edges)
+        rho, s = rho_and_s(n, in_masks(n, edges))
+        for method in ("search", "dp"):
+            rep = rescon.robustness(G, method=method)
+            assert (rep.r_max, rep.s_max) == (rho, s), (seed, method)
+            res = C.check(copy.deepcopy(rep.certificate))
+            assert res.verdict == "valid", (seed, method, res.reason)
+            proof = rep.certificate.get("lower_s") or {}
+            if "charged_tree" in proof:
+                charged += 1
+                capped += any(t <= -5 for t in proof["charged_tree"])
+                if s < n:
+                    assert C.check({**copy.deepcopy(rep.certificate), "s": s + 1}
+                                   ).verdict == "invalid", seed
+    assert charged > 200 and capped > 0
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_kernel_verdicts_in_d2_d3_unchanged_since_e79e53b(d, tmp_path):
+    """rescon's kernel certificates (random, integer and duplicated clouds) and their
+    F + 1 / F − 1 claims, and the examples: the same verdict from the checker before
+    this session and now."""
+    import copy
+    import json
+    from pathlib import Path
+
+    from rescon_certificates.check import check
+
+    import rescon
+
+    old = _checker_before(tmp_path)
+    if old is None:
+        pytest.skip("no git history")
+    certs = [json.loads(p.read_text()) for p in
+             sorted((Path(__file__).resolve().parent.parent / "certificates" / "examples")
+                    .glob("*.json"))]
+    rng = np.random.default_rng([d, 8])
+    for trial in range(10):
+        n = int(rng.integers(d + 2, 12))
+        X = [rng.normal(size=(n, d)), np.round(rng.normal(size=(n, d)) * 2),
+             np.repeat(np.round(rng.normal(size=((n + 1) // 2, d)) * 2), 2, axis=0)][trial % 3]
+        F = int(rng.integers(0, max(1, len(X) // (d + 1))))
+        K = rescon.safe_kernel(X, F)
+        certs.append(K.certificate)
+        certs.append({**copy.deepcopy(K.certificate), "F": F + 1})
+        if F:
+            certs.append({**copy.deepcopy(K.certificate), "F": F - 1})
+    verdicts = set()
+    for c in certs:
+        a, b = check(copy.deepcopy(c)), old(copy.deepcopy(c))
+        assert a.verdict == b.verdict, (a.reason, b.reason)
+        verdicts.add(a.verdict)
+    assert {"valid", "invalid"} <= verdicts
