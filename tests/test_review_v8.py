@@ -14,6 +14,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
+import rescon
 from rescon.geometry import _certify_nb, fastpath
 from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
 
@@ -603,3 +604,59 @@ def test_kernel_verdicts_in_d2_d3_unchanged_since_e79e53b(d, tmp_path):
         assert a.verdict == b.verdict, (a.reason, b.reason)
         verdicts.add(a.verdict)
     assert {"valid", "invalid"} <= verdicts
+
+
+def _on_hyperplanes(d: int, n: int, seed: int, kind: str) -> np.ndarray:
+    rng = np.random.default_rng([d, n, seed, 88])
+    Z = np.round(rng.normal(size=(n, d)) * 3)
+    if kind == "one_plane":  # two thirds on x_0 = 1: many rows coincide
+        Z[: 2 * n // 3, 0] = 1
+    elif kind == "two_planes":  # on x_0 = 1 and x_1 = x_0
+        Z[: n // 2, 0] = 1
+        Z[n // 2:, 1] = Z[n // 2:, 0]
+    elif kind == "collinear":  # a third on one line
+        Z[: n // 3] = np.outer(np.arange(n // 3) - n // 6, np.arange(1, d + 1))
+    elif kind == "ulp_lattice":  # 1 + small multiples of one ulp
+        Z = 1.0 + 2.0**-52 * Z
+    return Z
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("one_plane", 4, 18, 2), ("two_planes", 4, 18, 2),
+                                        ("collinear", 4, 18, 2), ("ulp_lattice", 4, 16, 2),
+                                        ("one_plane", 5, 13, 1), ("ulp_lattice", 5, 12, 1)])
+def test_conservative_stand_ins_keep_the_kernel(kind, d, n, F, monkeypatch):
+    """Data with many points on common hyperplanes / lines and a one-ulp lattice; the
+    fast path's internal shortcuts replaced by their most conservative answers — every
+    (row, vertex) pair near (the float filter keeps nothing out), ``tight_through``
+    proving nothing, ``nonsingular`` always "maybe singular" (the cross products
+    solve every basis) — and as they are: the kernel is the exact clipping's, bit for
+    bit."""
+    import rescon.geometry._candidates as cand
+    import rescon.geometry._certify_nb as nb
+    from tests.test_review_r2 import _fast_path_calls
+
+    X = _on_hyperplanes(d, n, 0, kind)
+    with monkeypatch.context() as mp:
+        calls = _fast_path_calls(mp)
+        rescon.safe_kernel(X, F)
+    assert calls and calls[-1]  # the fast path certifies this kernel
+    _same_as_clipping(X, F, monkeypatch)
+    real_near = cand.near_pairs
+    used = []
+
+    def all_pairs(af, bf, af_abs, b_abs, Vx, coarse, c_err, c, floor):
+        used.append(1)
+        got = real_near(af, bf, af_abs, b_abs, Vx, coarse, c_err, c, floor)
+        if got is None:
+            return None
+        r, v = np.meshgrid(np.arange(len(af)), np.arange(len(Vx)), indexing="ij")
+        return r.ravel().astype(np.int64), v.ravel().astype(np.int64)
+
+    with monkeypatch.context() as mp:
+        mp.setattr(cand, "near_pairs", all_pairs)
+        mp.setattr(nb, "tight_through", lambda through, basis, hs, vs:
+                   np.zeros(len(hs), dtype=np.bool_))
+        mp.setattr(nb, "nonsingular", lambda A, at, p: np.zeros(len(at), dtype=np.bool_))
+        calls = _fast_path_calls(mp)
+        _same_as_clipping(X, F, monkeypatch)
+    assert used and calls[0]  # the stand-ins ran, and the fast path still certified
