@@ -345,7 +345,8 @@ def _by_enumeration(cert: dict):
         return check(copy.deepcopy(cert))
 
 
-@pytest.mark.parametrize("d,n,F", [(3, 10, 2), (4, 10, 2), (4, 12, 3), (5, 11, 1)])
+@pytest.mark.parametrize("d,n,F", [(3, 10, 2), (4, 10, 2), (4, 12, 3),
+                                   pytest.param(5, 11, 1, marks=pytest.mark.slow)])
 def test_certificate_of_a_nudged_cloud(d, n, F):
     """The certificate of Ψ(X', F) presented for X, X' = X with one point moved by one
     ulp, by 2^-20 of its size, or onto another point (a duplicate), and with a facet
@@ -395,7 +396,8 @@ def test_certificate_of_a_nudged_cloud(d, n, F):
     assert "invalid" in decided
 
 
-@pytest.mark.parametrize("d,n,F", [(3, 10, 2), (4, 11, 2), (5, 10, 1)])
+@pytest.mark.parametrize("d,n,F", [(3, 10, 2), (4, 11, 2),
+                                   pytest.param(5, 10, 1, marks=pytest.mark.slow)])
 def test_kernel_certificate_with_interior_points_added(d, n, F):
     """The certificate of Ψ(X, F) presented for X plus copies of points of Ψ (its
     vertex mean, a vertex, the midpoint of two vertices — exact rationals): every
@@ -660,3 +662,26 @@ def test_conservative_stand_ins_keep_the_kernel(kind, d, n, F, monkeypatch):
         calls = _fast_path_calls(mp)
         _same_as_clipping(X, F, monkeypatch)
     assert used and calls[0]  # the stand-ins ran, and the fast path still certified
+
+
+@pytest.mark.slow
+def test_rescon_s_star_is_brute_force_after_the_capped_prunes():
+    """The decision engines' capped prunes (decide_step, min_cost_step): (ρ, s*) by
+    ``method="search"`` and ``"auto"`` equal brute force on 300 random digraphs
+    (n = 7–11, p 0.3–0.95, directed and undirected; 1100 of them agreed in review)."""
+    import random
+
+    import rescon
+    from rescon.graphs.facts import clear_cache
+    from tests.test_checker import digraph, in_masks, rand_edges, rho_and_s
+
+    for seed in range(300):
+        rng = random.Random(seed)
+        n = rng.randint(7, 11)
+        edges = rand_edges(rng, n, rng.uniform(0.3, 0.95), rng.random() < 0.4)
+        G = digraph(n, edges)
+        want = rho_and_s(n, in_masks(n, edges))
+        for method in ("search", "auto"):
+            clear_cache()
+            rep = rescon.robustness(G, method=method)
+            assert (rep.r_max, rep.s_max) == want, (seed, method)
