@@ -685,3 +685,29 @@ def test_rescon_s_star_is_brute_force_after_the_capped_prunes():
             clear_cache()
             rep = rescon.robustness(G, method=method)
             assert (rep.r_max, rep.s_max) == want, (seed, method)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_d4_kernel_point_certificates_reject_a_point_just_outside(seed):
+    """kernel_point in d = 4 with the "kernel" proof (52bc154): a vertex of Ψ is valid;
+    the vertex pushed outward across a facet tight there by 2^-60 of the facet's normal
+    is invalid (and the F + 1 claim is never valid)."""
+    import copy
+
+    from rescon_certificates.check import check
+
+    from rescon.geometry.points import point_certificate
+
+    X = np.random.default_rng(seed).normal(size=(14, 4))
+    K = rescon.safe_kernel(X, 2)
+    c = point_certificate(K, tuple(float(x) for x in K.vertices[0]))
+    assert c["proof"]["method"] == "kernel"
+    V = [tuple(Fraction(x) for x in v) for v in c["proof"]["vertices"]]
+    f = c["proof"]["facets"][0]
+    a, b = [Fraction(x) for x in f["a"]], Fraction(f["b"])
+    v = next(v for v in V if sum(x * y for x, y in zip(a, v, strict=True)) == b)
+    for eps, want in ((Fraction(0), "valid"), (Fraction(1, 2**60), "invalid")):
+        bad = copy.deepcopy(c)
+        bad["x"] = [str(x + eps * y) for x, y in zip(v, a, strict=True)]
+        assert check(bad).verdict == want
+    assert check({**copy.deepcopy(c), "F": 3}).verdict != "valid"
