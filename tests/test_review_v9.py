@@ -27,6 +27,8 @@ from functools import cache
 import networkx as nx
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import rescon
 from rescon.graphs import _kernels as K
@@ -457,3 +459,100 @@ def test_the_api_matches_the_brute_force_for_every_r_and_s(name, G, kw):
     """robustness, is_rs_robust (r = 0..⌈n/2⌉ + 1, s = 1..n) and max_s with
     method="search", their certificates valid."""
     assert not api_faults(G, **kw)
+
+
+# --------------------------------------------------------------------------- #
+# split on Dask, and beyond the brute force's sizes
+# --------------------------------------------------------------------------- #
+
+
+def _dp(ig, r: int) -> int:
+    """s*(r) by the subset DP (0: not r-robust), which shares no code with the prunes."""
+    return int(K.min_pair_cost(np.array(ig.in_masks(), dtype=np.uint64), r)[0])
+
+
+@pytest.mark.slow
+def test_the_prunes_hold_in_the_split_searches_on_dask(cluster, monkeypatch):
+    """Searches go to the cluster after 50 states, in tasks of 500: the decision search
+    without a tree (its parts prune with ``capped_single``) and min_cost_pair (the
+    charged engine's parts with ``capped_charged``) give the DP's answers."""
+    from rescon.graphs import distributed
+
+    monkeypatch.setattr(search, "_SLICE", 50)
+    monkeypatch.setattr(distributed, "LOCAL_NODES", 50)
+    monkeypatch.setattr(distributed, "TASK_NODES", 500)
+    most = 0
+    for n, p, seed in ((16, 0.6, 1), (18, 0.8, 2), (17, 0.5, 3)):
+        ig = index_graph(nx.gnp_random_graph(n, p, seed=seed, directed=True))
+        rho = max(r for r in range(1, n) if _dp(ig, r) >= 1)
+        for r in (rho - 1, rho, rho + 1):
+            with distributed.searches_on(scheduler=cluster):
+                out = search.decide_r_robust(ig, r, record=False)
+                cost = search.min_cost_pair(ig, r, n) if r >= 1 else None
+            assert (out.status == "robust") == (r <= rho), (n, p, seed, r)
+            most = max(most, out.nodes)
+            if cost is not None:
+                assert min(cost.best, n) == _dp(ig, r), (n, p, seed, r)
+    assert most > 2000  # many tasks of 500 states
+
+
+@pytest.mark.slow
+def test_the_engines_match_the_subset_dp_on_er_15_to_20():
+    """30 seeded ER(15..20, p) graphs: ρ by the decision search without a tree, s*(ρ − 1)
+    and s*(ρ) by the charged engine alone, as the DP finds them (the review ran 100,
+    n ≤ 22, and the e79e53b engines on 15 more of n = 23..25: all equal)."""
+    for k in range(30):
+        rng = random.Random(k)
+        n = rng.randint(15, 20)
+        p = rng.choice([0.3, 0.5, 0.7, 0.85])
+        ig = index_graph(nx.gnp_random_graph(n, p, seed=rng.randrange(10**9),
+                                             directed=rng.random() < 0.7))
+        r = 1
+        while _decide(ig, r, False)[0] == K.UNSAT:
+            r += 1
+        rho = r - 1
+        assert _dp(ig, rho + 1) == 0 and (rho == 0 or _dp(ig, rho) >= 1), k
+        for r in range(max(1, rho - 1), rho + 1):
+            assert _charged_engine(ig, r, n)[0] == _dp(ig, r), (k, r)
+
+
+# --------------------------------------------------------------------------- #
+# the checker's capped leaf
+# --------------------------------------------------------------------------- #
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_the_checker_accepts_a_capped_leaf_only_where_no_pair_lies_below(data):
+    """The checker's capped core (packed or slow path) of a random state of a random
+    digraph, per-side thresholds 1..n + 2: when it is empty for members i ≤ j of S, no
+    U1 ⊇ S avoiding X closed for t1 and nonempty U2 avoiding U1 ∪ B closed for t2
+    exist (enumeration)."""
+    n = data.draw(st.integers(4, 8))
+    p = data.draw(st.sampled_from([0.3, 0.5, 0.7, 0.9, 1.0]))
+    rng = random.Random(data.draw(st.integers(0, 10**6)))
+    inm = _rand_inmask(rng, n, p, data.draw(st.booleans()))
+    edges = [[u, v] for v in range(n) for u in range(n) if inm[v] >> u & 1]
+    t1, t2 = ([data.draw(st.integers(1, n + 2)) for _ in range(n)] for _ in range(2))
+    g = C._graph({"n": n, "edges": edges})
+    rp = C._Replay(g, 1, "t")
+    rp.capped_tables()
+    side1, side2 = rp.threshold_side(t1), rp.threshold_side(t2)
+    full = (1 << n) - 1
+    closed1 = [U for U in range(1, 1 << n) if all(
+        (inm[i] & ~U).bit_count() < t1[i] for i in range(n) if U >> i & 1)]
+    closed2 = [U for U in range(1, 1 << n) if all(
+        (inm[i] & ~U).bit_count() < t2[i] for i in range(n) if U >> i & 1)]
+    for _ in range(6):
+        S, X, B = _state(rng, n)
+        P = rp.shrink(rp.full, side1.D, side1.gone | rp.pack(X), side1)[0]
+        Q, QD = rp.shrink(rp.full, side2.D, side2.gone | rp.pack(S | B), side2)
+        assert rp.unpack(P) == _core(full & ~X, inm, t1)
+        assert rp.unpack(Q) == _core(full & ~S & ~B, inm, t2)
+        members = [i for i in range(n) if S >> i & 1]
+        for i in members:
+            for j in members:
+                if i <= j and not rp.capped(i, j, rp.pack(S), P, Q, QD, side1, side2):
+                    assert not any(U1 & S == S and not U1 & X and not U2 & (U1 | B)
+                                   for U1 in closed1 for U2 in closed2), (inm, t1, t2, S, X, B,
+                                                                          i, j)
