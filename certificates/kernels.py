@@ -50,6 +50,8 @@ MAX_RATIONAL_CHARS = 100_000  # longest "p/q" string (exact vertex means get lon
 #: C(u, k) * (u + #test points + normal cost) for (b); beyond: unchecked
 MAX_HALFSPACE_WORK = 4_000_000
 MAX_POLY_WORK = 3_000_000  # vertex / ray enumeration of P; beyond: unchecked
+#: d >= 4: the normal fan's share, in multiples of (b)'s work, before (b) takes over
+FAN_OVER_ENUMERATION = 50
 MAX_NUMBER_BITS = 32_768  # numerator / denominator of one input rational; beyond: unchecked
 MAX_DIGITS = MAX_NUMBER_BITS * 30_103 // 100_000 + 1  # decimal digits of such a number
 MAX_SCALE_BITS = 65_536  # a common denominator (of all points, of a sum); beyond: unchecked
@@ -624,7 +626,9 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     sweep per crossing point), from the rows a·(p − v) (the slacks of p in the tight
     facets, scaled by D) alone.  Work: n·d products per vertex (the slacks a·p of each
     facet once), plus the recursion's, charged as it runs, bit-weighted; beyond
-    MAX_EVAL_WORK unchecked."""
+    MAX_EVAL_WORK unchecked.  In d >= 4, where the products of generators can outgrow
+    the C(u, d) enumeration on small inputs, a fan that spends FAN_OVER_ENUMERATION times
+    the work of (b) while (b) is within MAX_HALFSPACE_WORK hands over to (b)."""
     part = "vertices in the safe kernel (proof 'halfspaces', normal fan)"
     sp = _scaled_points(pts, ctx, part)
     if sp is None:
@@ -633,7 +637,10 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     d = len(P[0])
     T = [_scaled_test(v, D) for v in V]
     bits = 2 * max(_bit_size(P), _bit_size([x + [e] for x, e in T]))
-    meter = [_cost(len(V) * len(P) * (d + 2), bits), MAX_EVAL_WORK]  # the signs / pairs
+    enum = _enumeration_work(P, len(T), d, bits // 2) if d >= 4 else MAX_HALFSPACE_WORK + 1
+    fallback = enum <= MAX_HALFSPACE_WORK  # (b) would decide: the fan gets a share of it
+    budget = min(MAX_EVAL_WORK, FAN_OVER_ENUMERATION * enum) if fallback else MAX_EVAL_WORK
+    meter = [_cost(len(V) * len(P) * (d + 2), bits), budget]  # the signs / pairs
     cache: dict[tuple[int, ...], list[int]] = {}
     gbits = max((_bit_size(rows) for rows in tight), default=0)
     for (X, e), rows, name in zip(T, tight, names):
@@ -663,11 +670,20 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
                           f"{count} <= F = {F} (the closed halfspaces w·(y - {name}) >= 0 "
                           f"for w near {_fmtv(w)}, in the normal cone of P there, hold "
                           f"{count} points)")
+    if meter[0] > meter[1] and fallback:
+        return _in_kernel_halfspaces(pts, F, V, names, ctx, "vertices")
     if meter[0] > meter[1]:
         ctx.trust("halfspaces", f"{part}: {len(V)} vertices and {len(P)} points "
                   f"({bits // 2}-bit numbers) need work > {meter[1]}")
         return "halfspaces: not checked"
     return "halfspaces (normal fan)"
+
+
+def _enumeration_work(P: list[list[int]], tests: int, d: int, bits: int) -> int:
+    """The work of (b) (:func:`_in_kernel_halfspaces`) for ``tests`` points against the
+    distinct points of the full-dimensional scaled cloud P in R^d."""
+    u = len({tuple(p) for p in P})
+    return _cost(math.comb(u, d) * (u + tests + _normal_steps(d)), bits)
 
 
 def _inward_normal(y: tuple[int, ...], other: tuple[int, ...]) -> list[int]:

@@ -171,8 +171,9 @@ def test_fan_work_limit_is_unchecked_not_invalid(monkeypatch):
     monkeypatch.setattr(kernels, "_arc_min", lambda pairs: calls.append(1) or real(pairs))
     fan = kernels._fan_in_kernel
 
-    def tight_fan(*args):  # the limit is lowered for the fan only, after steps 1–6
+    def tight_fan(*args):  # the limits are lowered for step 7 only, after steps 1–6
         monkeypatch.setattr(kernels, "MAX_EVAL_WORK", len(K.certificate["vertices"]) * n * (d + 2))
+        monkeypatch.setattr(kernels, "MAX_HALFSPACE_WORK", 0)  # no hand-over to (b)
         return fan(*args)
 
     monkeypatch.setattr(kernels, "_fan_in_kernel", tight_fan)

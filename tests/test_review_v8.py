@@ -313,21 +313,24 @@ def test_fan_agrees_with_the_enumeration_on_arbitrary_polytopes(d):
     assert seen == {"valid", "invalid"}
 
 
-@pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="the d = 5 fan spends its whole work budget "
-                   "(~5 CPU-s) on n = 9 points and gives 'unchecked', where (b)'s "
-                   "C(9, 5) = 126 hyperplanes decide in milliseconds")
-def test_fan_decides_tiny_d5_instances():
+@pytest.mark.parametrize("seed", [4, 8, 12, 25, 27, 33, 36])
+def test_fan_decides_tiny_d5_instances(seed):
     """Seed 4 of :func:`_fan_instance` in d = 5: 9 points, F = 0, 8 vertices, valid by
-    (b) (seeds 8, 12, 25, 27, 33, 36 alike: n = 7–11, 4–6 CPU-s each).
-    Proposed fix (kernels.kind_safe_kernel / _fan_in_kernel): fall back to
-    (b) when the fan is over budget and (b)'s work is within MAX_HALFSPACE_WORK, or
-    pick the cheaper of the two."""
+    (b) (seeds 8, 12, 25, 27, 33, 36 alike: n = 7–11). The fan spent its whole work
+    budget (4–6 CPU-s) and said 'unchecked', where (b)'s C(9, 5) = 126 hyperplanes
+    decide in milliseconds; now it hands over to (b) after FAN_OVER_ENUMERATION times
+    (b)'s work."""
     C, K, _ = _kernels_modules()
-    pts, F, V, tight = _fan_instance(4, 5)
-    assert (len(pts), F, len(V)) == (9, 0, 8)
+    pts, F, V, tight = _fan_instance(seed, 5)
+    if seed == 4:
+        assert (len(pts), F, len(V)) == (9, 0, 8)
     names = [f"v{i}" for i in range(len(V))]
-    assert _verdict(C, K._fan_in_kernel, pts, F, V, tight, names) == "valid"
+    new = _verdict(C, K._fan_in_kernel, pts, F, V, tight, names)
+    ref = _verdict(C, lambda *a: K._in_kernel_halfspaces(*a[:4], a[4], "vertices"),
+                   pts, F, V, names)
+    assert new == ref != "unchecked", (new, ref)
+    if seed == 4:
+        assert new == "valid"
 
 
 def _by_enumeration(cert: dict):
