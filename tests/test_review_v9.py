@@ -556,3 +556,21 @@ def test_the_checker_accepts_a_capped_leaf_only_where_no_pair_lies_below(data):
                     assert not any(U1 & S == S and not U1 & X and not U2 & (U1 | B)
                                    for U1 in closed1 for U2 in closed2), (inm, t1, t2, S, X, B,
                                                                           i, j)
+
+
+@st.composite
+def _digraphs(draw):
+    """A digraph on 4..8 nodes: arcs drawn one by one (hypothesis shrinks them away)."""
+    n = draw(st.integers(4, 8))
+    arcs = draw(st.sets(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)),
+                        max_size=n * (n - 1)))
+    G = nx.DiGraph()
+    G.add_nodes_from(range(n))
+    G.add_edges_from(arcs)  # self-loops too: ignored
+    return G
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(G=_digraphs())
+def test_the_engines_match_the_brute_force_on_hypothesis_digraphs(G):
+    assert not engine_faults(G, trees=False)
