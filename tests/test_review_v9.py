@@ -473,27 +473,27 @@ def _dp(ig, r: int) -> int:
 
 @pytest.mark.slow
 def test_the_prunes_hold_in_the_split_searches_on_dask(cluster, monkeypatch):
-    """Searches go to the cluster after 50 states, in tasks of 500: the decision search
-    without a tree (its parts prune with ``capped_single``) and min_cost_pair (the
-    charged engine's parts with ``capped_charged``) give the DP's answers."""
+    """Searches go to the cluster after 50 states, in tasks of 100: the decision search
+    without a tree (its parts prune with ``capped_single``; 100..2000 states each) and
+    min_cost_pair (the charged engine's parts with ``capped_charged``; 20k..75k states)
+    give the DP's answers at r = ρ, ρ + 1 on ER(20..22, 0.7..0.85) digraphs."""
     from rescon.graphs import distributed
 
     monkeypatch.setattr(search, "_SLICE", 50)
     monkeypatch.setattr(distributed, "LOCAL_NODES", 50)
-    monkeypatch.setattr(distributed, "TASK_NODES", 500)
-    most = 0
-    for n, p, seed in ((16, 0.6, 1), (18, 0.8, 2), (17, 0.5, 3)):
+    monkeypatch.setattr(distributed, "TASK_NODES", 100)
+    most = most_cost = 0
+    for n, p, seed in ((20, 0.7, 0), (20, 0.85, 1), (22, 0.85, 3)):
         ig = index_graph(nx.gnp_random_graph(n, p, seed=seed, directed=True))
         rho = max(r for r in range(1, n) if _dp(ig, r) >= 1)
-        for r in (rho - 1, rho, rho + 1):
+        for r in (rho, rho + 1):
             with distributed.searches_on(scheduler=cluster):
                 out = search.decide_r_robust(ig, r, record=False)
-                cost = search.min_cost_pair(ig, r, n) if r >= 1 else None
+                cost = search.min_cost_pair(ig, r, n)
             assert (out.status == "robust") == (r <= rho), (n, p, seed, r)
-            most = max(most, out.nodes)
-            if cost is not None:
-                assert min(cost.best, n) == _dp(ig, r), (n, p, seed, r)
-    assert most > 2000  # many tasks of 500 states
+            assert min(cost.best, n) == _dp(ig, r), (n, p, seed, r)
+            most, most_cost = max(most, out.nodes), max(most_cost, cost.nodes)
+    assert most > 500 and most_cost > 20_000  # many tasks
 
 
 @pytest.mark.slow
