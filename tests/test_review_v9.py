@@ -14,9 +14,10 @@
 * the split searches on a Dask cluster (slow) and ER(15..22) digraphs against the
   subset DP (slow; the DP shares no code with the prunes).
 
-Each over-pruning mutation of the two prunes tried during the review (slack − 1 in
-either, threshold r + budget − 1 or r in ``capped_charged``) fails the engine tests on
-the first 150 random graphs of ``_random_graphs``.
+The tests can fail: each over-pruning mutation of the prunes tried during the review
+(slack − 1 in either, threshold r + budget − 1 or r in ``capped_charged``) fails 6–7 of
+the fast tests, and the checker with its capped slack lowered by one fails the
+hypothesis test of the checker's capped leaf. No fault was found in the code itself.
 """
 
 from __future__ import annotations
