@@ -477,13 +477,15 @@ def test_the_prunes_hold_in_the_split_searches_on_dask(cluster, monkeypatch):
     """Searches go to the cluster after 50 states, in tasks of 100: the decision search
     without a tree (its parts prune with ``capped_single``; 100..2000 states each) and
     min_cost_pair (the charged engine's parts with ``capped_charged``; 20k..75k states)
-    give the DP's answers at r = ρ, ρ + 1 on ER(20..22, 0.7..0.85) digraphs."""
+    give the DP's answers at r = ρ, ρ + 1 on ER(20..22, 0.7..0.85) digraphs; so does
+    the charged engine alone, finished on the cluster in tasks of 2000 states."""
     from rescon.graphs import distributed
 
     monkeypatch.setattr(search, "_SLICE", 50)
     monkeypatch.setattr(distributed, "LOCAL_NODES", 50)
     monkeypatch.setattr(distributed, "TASK_NODES", 100)
-    most = most_cost = 0
+    monkeypatch.setattr(distributed, "COST_TASK_NODES", 2000)
+    most = most_cost = most_alone = 0
     for n, p, seed in ((20, 0.7, 0), (20, 0.85, 1), (22, 0.85, 3)):
         ig = index_graph(nx.gnp_random_graph(n, p, seed=seed, directed=True))
         rho = max(r for r in range(1, n) if _dp(ig, r) >= 1)
@@ -494,7 +496,18 @@ def test_the_prunes_hold_in_the_split_searches_on_dask(cluster, monkeypatch):
             assert (out.status == "robust") == (r <= rho), (n, p, seed, r)
             assert min(cost.best, n) == _dp(ig, r), (n, p, seed, r)
             most, most_cost = max(most, out.nodes), max(most_cost, cost.nodes)
-    assert most > 500 and most_cost > 20_000  # many tasks
+            # the charged engine alone, split on the cluster (min_cost_pair's answer may
+            # come from the sized engine)
+            run = search.CostPartRun(search._kernel_inputs(ig), "charged", r, -1,
+                                     search.whole_cost_part(n), n)
+            run.advance(50)
+            assert not run.finished
+            with distributed.searches_on(scheduler=cluster):
+                alone = distributed.finish_cost_on_cluster(
+                    distributed.active(), [run], {"charged": 1.0}, run.best, run.pair())
+            assert alone.engine == "charged" and min(alone.best, n) == _dp(ig, r), (n, seed, r)
+            most_alone = max(most_alone, alone.nodes)
+    assert most > 500 and most_cost > 20_000 and most_alone > 20_000  # many tasks
 
 
 @pytest.mark.slow
