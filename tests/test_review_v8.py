@@ -17,25 +17,14 @@ import pytest
 import rescon
 from rescon.geometry import _certify_nb, fastpath
 from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
+from tests.test_review_v5 import _det as _fraction_det
 
 # --- A. the fast path ----------------------------------------------------------------
 
 
 def _det(M) -> Fraction:
-    M = [[Fraction(x) for x in r] for r in M]
-    out = Fraction(1)
-    for c in range(len(M)):
-        piv = next((i for i in range(c, len(M)) if M[i][c]), None)
-        if piv is None:
-            return Fraction(0)
-        if piv != c:
-            M[c], M[piv] = M[piv], M[c]
-            out = -out
-        out *= M[c][c]
-        for i in range(c + 1, len(M)):
-            f = M[i][c] / M[c][c]
-            M[i] = [a - f * b for a, b in zip(M[i], M[c], strict=True)]
-    return out
+    """The exact determinant of an integer / rational matrix."""
+    return _fraction_det([[Fraction(x) for x in r] for r in M])
 
 
 @pytest.mark.parametrize("k", [2, 3, 4, 5])
