@@ -147,13 +147,18 @@ def _scaled(cert: dict, factor: Fraction) -> dict:
 
 
 @pytest.mark.parametrize("d", [4, pytest.param(5, marks=pytest.mark.slow)])
-def test_enlarged_kernel_is_refuted_by_the_fan(d):
+def test_enlarged_kernel_is_refuted_by_the_fan(d, monkeypatch):
     """Ψ scaled by 1 + 1e-6 keeps <= F points outside each facet (no data point in
-    between), so only the vertex test can refute it; the fan does, in d = 4, 5."""
+    between), so only the vertex test can refute it; the fan does, in d = 4, 5 (in
+    d = 5, n = 10 it would hand over to the cheaper (b) after 50× (b)'s work: both
+    routes decide; the fan is then run to its own limit)."""
     n, F = (14, 2) if d == 4 else (10, 1)  # d = 5: steps 4–5 within their work limit
     X = np.random.default_rng(d).standard_normal((n, d))
     K = rescon.safe_kernel(X, F)
     assert K.dim == d
+    assert check(K.certificate).verdict == "valid"
+    assert check(_scaled(K.certificate, 1 + Fraction(1, 10**6))).verdict == "invalid"
+    monkeypatch.setattr(kernels, "FAN_OVER_ENUMERATION", 10**12)  # no hand-over to (b)
     res = check(K.certificate)
     assert res.verdict == "valid" and "normal fan" in res.reason, res.reason
     res = check(_scaled(K.certificate, 1 + Fraction(1, 10**6)))
