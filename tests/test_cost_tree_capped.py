@@ -21,20 +21,11 @@ from rescon.graphs._charged_kernels import capped_core, capped_member
 from rescon.graphs.charged import charged_order, charged_tree
 from rescon.graphs.indexed import index_graph
 from tests.test_checker import C, digraph, in_masks, rand_edges, rho_and_s
+from tests.test_robustness_certs3 import _core
 
 pytestmark = pytest.mark.usefixtures("fresh_facts")
 
 DATA = Path(__file__).parent / "data" / "charged_trees_before_capped.json"
-
-
-def _core(U: int, inm: list[int], t: list[int]) -> int:
-    """Largest subset of U whose members i have < t[i] in-neighbours outside it."""
-    while True:
-        drop = [i for i in range(len(inm)) if U >> i & 1 and (inm[i] & ~U).bit_count() >= t[i]]
-        if not drop:
-            return U
-        for i in drop:
-            U &= ~(1 << i)
 
 
 def _closed(U: int, inm: list[int], t: list[int]) -> bool:

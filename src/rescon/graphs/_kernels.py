@@ -210,7 +210,7 @@ def capped_single(S: np.uint64, P: np.uint64, Q: np.uint64, inmask: np.ndarray,
     (c_i, sl_i), c_i = N(i) ∩ P \\ S: then no pair lies below the decision state
     (S, P, Q) (proof: ``_charged_kernels.capped_member``, the charged tree's capped
     leaf; thresholds t on both sides). The decision search prunes with it while it
-    records no tree (ER(50, 0.5), r = 13: 1.1·10⁹ states, 4.1·10⁷ with it)."""
+    records no tree (ER(50, 0.5), r = 13: 1.1·10⁹ states, 3.7–4.1·10⁷ with it)."""
     m = S
     while m:
         i = low_index(m)

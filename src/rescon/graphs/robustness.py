@@ -270,7 +270,7 @@ def _replayed(ig: IndexedGraph, r: int, s: int, proof: Proof, deadline: float | 
     i.e. (r, s)-robustness), if it is recorded within ``TREE_SECONDS`` (dense graphs:
     4.9k tokens below s = 1 on ER(30, 0.8), where the decision tree has > 4M), else, for
     s ≥ 2, the charged tree (charged.charged_tree: one decision tree per set of charged
-    nodes; ER(30, 0.5) with s = 2: 1.9–2.7M tokens, where the sized tree has > 30M) or,
+    nodes; ER(30, 0.5) with s = 2: 13–138 k tokens, where the sized tree has > 30M) or,
     when it is smaller, the uniform charged tree (charged.uniform_tree: one decision tree
     per type of charges), recorded within ``TREE_SECONDS``, resp. ``CHARGED_SECONDS``; the
     deciding method stays in ``info.decided_by``. Otherwise ``proof`` itself."""
