@@ -436,6 +436,7 @@ class _Engine:
 
     def __init__(self, run: CostPartRun) -> None:
         self.name, self.n = run.engine, run.inmask.shape[0]
+        self.masks = (run.inmask, run.outmask, run.order)  # the engines' orders differ
         self.tree = _Tree(run.recording)
         self.waiting: list[tuple[int, CostPart]] = []
         self.running = 0
@@ -506,7 +507,7 @@ def finish_cost_on_cluster(
     client = cluster.client()
     workers = _Workers(client)
     first = runs[0]
-    masks, lower = (first.inmask, first.outmask, first.order), first.lower
+    lower = first.lower
     order = tuple(first.order.tolist())
     slots = max(sum(client.nthreads().values()), 1)
     engines = [_Engine(run) for run in runs]
@@ -523,7 +524,7 @@ def finish_cost_on_cluster(
                 if taken is None:
                     break
                 eng, (pid, part, room) = taken
-                running[client.submit(run_cost_part, masks, eng.name, first.r, lower, part,
+                running[client.submit(run_cost_part, eng.masks, eng.name, first.r, lower, part,
                                       best, room, COST_TASK_NODES, pure=False)] = (eng, pid)
             done = workers.finished(running)
             for fut in done:
