@@ -67,6 +67,10 @@ MAX_ROWS = 62
 #: join computations per vertex before the check gives up (the double description
 #: decides then)
 WORK = 200_000
+#: vertices with at most this many tight rows register their (k − 1)-subsets as keys
+#: for the simple vertices' pass (:func:`_simple_ends`; C(10, 4) = 210 keys at most in
+#: k = 5); a simple vertex sharing k − 1 rows with a larger one is left to the scan
+KEYED_ROWS = 10
 
 
 def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int
@@ -83,17 +87,25 @@ def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int
     h_ptr = np.searchsorted(h_of[by_row], np.arange(len(normals) + 1)).astype(np.int64)
     residues = np.array([[x % PRIME for x in a] for a in normals], dtype=np.int64)
     ok = np.zeros(len(tight), dtype=np.bool_)
-    ptr, ends = _closures(v_ptr, h_of.astype(np.int64), h_ptr,
-                          v_of[by_row].astype(np.int64), residues.reshape(-1, k), k, ok)
+    v_rows, h_verts = h_of.astype(np.int64), v_of[by_row].astype(np.int64)
+    pre = np.zeros(len(tight), dtype=np.bool_)
+    pre_ends = np.zeros((len(tight), k), dtype=np.int64)
+    if k >= 2 and len(normals) ** (k - 1) < 2**62:  # the keys fit int64
+        _simple_ends(v_ptr, v_rows, h_ptr, h_verts, len(normals), k, KEYED_ROWS, pre,
+                     pre_ends)
+    ptr, ends = _closures(v_ptr, v_rows, h_ptr, h_verts, residues.reshape(-1, k), k, ok,
+                          pre, pre_ends)
     ends = ends.tolist()
     return ok, [ends[a:b] for a, b in zip(ptr[:-1].tolist(), ptr[1:].tolist(), strict=True)]
 
 
 @njit(cache=True, nogil=True)
-def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok):
+def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok, pre, pre_ends):
     """:func:`combinatorial_rays` on the incidences in CSR form (v_rows[v_ptr[v]:
     v_ptr[v + 1]]: the rows of vertex v, increasing; h_verts likewise the vertices of
-    each row): ok[v], and the ends of the passing vertices (ends[ptr[v]:ptr[v + 1]])."""
+    each row): ok[v], and the ends of the passing vertices (ends[ptr[v]:ptr[v + 1]]).
+    The simple vertices with ``pre`` set pass with the k ends ``pre_ends`` (found by
+    :func:`_simple_ends`, the same as the check's: see there) without a scan."""
     n = len(v_ptr) - 1
     count = np.zeros(n, dtype=np.int64)
     mask = np.zeros(n, dtype=np.int64)
@@ -108,6 +120,15 @@ def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok):
         ptr[v + 1] = ptr[v]
         t = v_ptr[v + 1] - v_ptr[v]
         if t < k or t > MAX_ROWS:
+            continue
+        if pre[v]:
+            ok[v] = True
+            if ptr[v] + k > len(ends):
+                grown = np.empty(2 * (ptr[v] + k), dtype=np.int64)
+                grown[:ptr[v]] = ends[:ptr[v]]
+                ends = grown
+            ends[ptr[v]:ptr[v] + k] = np.sort(pre_ends[v])
+            ptr[v + 1] = ptr[v] + k
             continue
         # the vertices sharing rows with v: how many, and which (bits over v's rows)
         m = 0
@@ -142,6 +163,122 @@ def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok):
         ends[ptr[v]:ptr[v] + f] = np.sort(found_u[:f])
         ptr[v + 1] = ptr[v] + f
     return ptr, ends[:ptr[-1]]
+
+
+@njit(cache=True, nogil=True)
+def _simple_ends(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed, pre, pre_ends):
+    """The check at simple vertices (k tight rows, independent) from keys instead of a
+    scan: sets pre[v] and the k ends pre_ends[v] where it passes; a vertex it leaves
+    unset is scanned by :func:`_closures` (which then refuses it or not, as always).
+
+    At a simple v the scan finds U = {u ≠ v : |T(u) ∩ T(v)| ≥ k − 1} and passes iff
+    u ↦ T(u) ∩ T(v) maps U one-to-one onto the k sets Z_g = T(v) − {g} (a u with
+    T(u) ⊇ T(v), two u on one Z_g or a Z_g on none fails :func:`_faces_closed`:
+    equal or nested zero sets, fewer than r joins), with ends U. Every vertex u of
+    k − 1 ≤ |T(u)| ≤ ``keyed`` rows (fewer than k only in tampered input) registers
+    each (k − 1)-subset of T(u) as a key (its rows p₁ < … < p_{k−1} in base
+    ``n_rows``); a simple v sharing k − 1 rows with a
+    larger u is left unset (such u are few: their rows are scanned). For the other
+    simple v, U is the set of owners ≠ v of the keys Z_g, and the map is one-to-one
+    onto the Z_g iff each Z_g has exactly one owner u_g ≠ v and g ∉ T(u_g) (then
+    T(u_g) ∩ T(v) = Z_g, and u_g holds no other Z_g', whose union with Z_g is T(v)):
+    the scan's verdict and ends, exactly."""
+    n = len(v_ptr) - 1
+    total = 0
+    for u in range(n):
+        t = v_ptr[u + 1] - v_ptr[u]
+        if k - 1 <= t <= keyed:
+            c = 1
+            for i in range(k - 1):  # C(t, k − 1)
+                c = c * (t - i) // (i + 1)
+            total += c
+    keys = np.empty(total, dtype=np.int64)
+    owners = np.empty(total, dtype=np.int64)
+    idx = np.empty(k - 1, dtype=np.int64)
+    e = 0
+    for u in range(n):
+        t = v_ptr[u + 1] - v_ptr[u]
+        if t < k - 1 or t > keyed:
+            continue
+        rows = v_rows[v_ptr[u]:v_ptr[u + 1]]
+        for i in range(k - 1):
+            idx[i] = i
+        while True:
+            key = np.int64(0)
+            for i in range(k - 1):
+                key = key * n_rows + rows[idx[i]]
+            keys[e] = key
+            owners[e] = u
+            e += 1
+            i = k - 2
+            while i >= 0 and idx[i] == t - k + 1 + i:
+                i -= 1
+            if i < 0:
+                break
+            idx[i] += 1
+            for j in range(i + 1, k - 1):
+                idx[j] = idx[j - 1] + 1
+    order = np.argsort(keys)
+    keys = keys[order]
+    owners = owners[order]
+    # the simple vertices sharing k − 1 rows with a vertex of more than ``keyed`` rows
+    left = np.zeros(n, dtype=np.bool_)
+    count = np.zeros(n, dtype=np.int64)
+    touched = np.empty(n, dtype=np.int64)
+    for u in range(n):
+        if v_ptr[u + 1] - v_ptr[u] <= keyed:
+            continue
+        m = 0
+        for j in range(v_ptr[u], v_ptr[u + 1]):
+            h = v_rows[j]
+            for f in range(h_ptr[h], h_ptr[h + 1]):
+                w = h_verts[f]
+                if count[w] == 0:
+                    touched[m] = w
+                    m += 1
+                count[w] += 1
+        for f in range(m):
+            w = touched[f]
+            if count[w] >= k - 1 and w != u:
+                left[w] = True
+            count[w] = 0
+    for v in range(n):
+        if v_ptr[v + 1] - v_ptr[v] != k or left[v]:
+            continue
+        rows = v_rows[v_ptr[v]:v_ptr[v + 1]]
+        passed = True
+        for g in range(k):
+            key = np.int64(0)
+            for i in range(k):
+                if i != g:
+                    key = key * n_rows + rows[i]
+            lo = np.searchsorted(keys, key)
+            hi = np.searchsorted(keys, key, side="right")
+            u = -1
+            for f in range(lo, hi):
+                w = owners[f]
+                if w == v:
+                    continue
+                if u >= 0:  # a second owner
+                    u = -2
+                    break
+                u = w
+            if u < 0:
+                passed = False
+                break
+            a = v_ptr[u]  # g ∉ T(u): rows of u are increasing
+            b = v_ptr[u + 1]
+            while a < b:
+                mid = (a + b) // 2
+                if v_rows[mid] < rows[g]:
+                    a = mid + 1
+                else:
+                    b = mid
+            if a < v_ptr[u + 1] and v_rows[a] == rows[g]:
+                passed = False
+                break
+            pre_ends[v, g] = u
+        pre[v] = passed
 
 
 @njit(cache=True, nogil=True)
