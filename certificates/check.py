@@ -49,6 +49,7 @@ MAX_ENUM_N = 20  # largest n the checker enumerates itself ("enumeration", "dp")
 MAX_N = 1_000_000  # resource limit on graph / matrix size
 MAX_GRAPH_WORK = 20_000_000  # (n + #edges) * ceil(n / 1024): reading a graph or support
 MAX_SEARCH_WORK = 25_000_000  # steps replaying a search tree (_Replay; ~5 s)
+ROW_SUMS = 1 << 16  # row sums a replay keeps (_Replay.row_sum)
 
 
 VERDICTS = ("valid", "invalid", "unchecked")
@@ -631,6 +632,7 @@ class _Replay:
         self.side = self.threshold_side([r] * n)
         self.pin: list[int] = []
         self.rows: list[int] = []
+        self.sums: dict[int, int] = {}
 
     def capped_tables(self) -> None:
         """The tables of the capped leaves (:meth:`capped`): ``pin[i]``, the packed N(i),
@@ -786,14 +788,14 @@ class _Replay:
                     elif t == -4:
                         if self.crowded(S, before, s1) is None:
                             raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
-                    elif t <= -5:
-                        if Q1 & S:
-                            Q1, QD1 = shrink(Q1, QD1, S, s2)
+                    elif t <= -5:  # Q1 \\ S is peeled inside capped()
                         if P1 & X:
                             P1 = shrink(P1, PD1, X, s1)[0]
                         i, j = divmod(-5 - t, n)
                         if (i > j or not S >> top[i] & S >> top[j] & 1
                                 or self.capped(i, j, S, P1, Q1, QD1, s1, s2)):
+                            if Q1 & S:
+                                Q1 = shrink(Q1, QD1, S, s2)[0]
                             raise Invalid(self.why(t, pos, S, X, B, P1, Q1, s1, s2))
                     else:
                         if Q1 & S:
@@ -810,9 +812,11 @@ class _Replay:
 
     def capped(self, i: int, j: int, S: int, P: int, Q: int, D: int, s1: _Side,
                s2: _Side) -> int:
-        """The capped core of Q (packed, exact, with its D) for the members i, j of the
-        packed S (i = j: one member): the largest Q' ⊆ Q whose members v have, for
-        m = i, j, |N(v) ∩ Q' \\ c_m| + min(sl_m, |N(v) ∩ Q' ∩ c_m|) ≥ d_v − t_v + 1
+        """The capped core (packed, exact) for the members i, j of the packed S (i = j:
+        one member) of the state's Q = core(Q \\ S) (``s2``'s thresholds; Q closed, with
+        its D, as on the stack of :meth:`config`; S ∩ Q = ∅ for the exact Q): the largest
+        Q' ⊆ Q \\ S whose members v have, for m = i, j,
+        |N(v) ∩ Q' \\ c_m| + min(sl_m, |N(v) ∩ Q' ∩ c_m|) ≥ need_v = d_v − t_v + 1
         (t: ``s2``'s thresholds), c_m = N(m) ∩ P \\ S, sl_m = |c_m| − need_m,
         need_m = |N(m) \\ S| − t_m + 1 (t: ``s1``'s); 0 (empty) when an sl_m < 0.
 
@@ -820,55 +824,126 @@ class _Replay:
         holds m and ≥ need_m nodes of c_m, so |U2 ∩ c_m| ≤ sl_m, and each v ∈ U2 has
         ≥ d_v − t_v + 1 in-neighbours in U2, at most min(sl_m, |N(v) ∩ U2 ∩ c_m|) of
         them in c_m; the conditions only weaken as Q' shrinks, so peeling keeps U2.
-        (sl_m may be lowered to |c_m ∩ Q|: min(sl_m, e) is the same for every
-        e ≤ |c_m ∩ Q|.)
+        They include |N(v) ∩ Q'| ≥ need_v, so the peel of Q \\ S is the peel of its
+        core, the state's Q (one peel instead of two). (sl_m may be lowered to
+        |c_m ∩ Q|: min(sl_m, e) is the same for every e ≤ |c_m ∩ Q|.)
 
-        Packed (when sl_m + ``s2.most`` ≤ 2^(w−1), else :meth:`capped_slow`): a
-        member's D field is 2^(w−1) + δ_v, δ_v = min(t_v, n) − 1 − |N(v) \\ Q'|
-        (= |N(v) ∩ Q'| − (d_v − t_v + 1) when t_v ≤ n; else δ_v ≥ |N(v) ∩ Q'| and v is
-        never peeled, rightly), δ_v < most; E_m holds e_v = |N(v) ∩ Q' ∩ c_m| < n in
-        field v (the ``less`` rows of c_m ∩ Q', lowered for each removed node of c_m).
-        v is peeled when δ_v < 0 (D's guard bit cleared, as in :meth:`shrink`) or
-        δ_v − e_v + sl_m < 0: the guard bit of the field of D − E_m + sl_m, taken on
-        the members only, those with δ_v < 0 set to all ones (every field stays in
-        [1, 2^w): no borrow, no carry).
+        Packed (when sl_m + ``s2.most`` ≤ 2^(w−1), else :meth:`capped_slow`): D's field v
+        is 2^(w−1) + δ_v, δ_v = min(t_v, n) − 1 − |N(v) \\ U| (U: the set being peeled;
+        = |N(v) ∩ U| − need_v when t_v ≤ n, else δ_v ≥ |N(v) ∩ U| and v is never
+        peeled for it, rightly); F_m's field v is 2^(w−1) + δ_v − e_v,
+        e_v = |N(v) ∩ U ∩ c_m|: F_m = D − E_m at the start (E_m: the ``less`` rows of
+        c_m ∩ Q, :meth:`row_sum`), and a removed node's row is subtracted from D, and
+        from F_m when it is not in c_m. v ∈ U is peeled when δ_v < 0 or
+        δ_v − e_v + sl_m < 0: the guard bit of its field in D or in F_m + sl_m·[U].
+        No field borrows or carries: a member's δ_v ≥ −need_v ≥ 1 − n (t_v ≥ 1) and
+        δ_v − e_v = |N(v) ∩ U \\ c_m| − need_v ≥ 1 − n, while 2^(w−1) > n; δ_v < most,
+        so δ_v − e_v + sl_m < 2^(w−1); the field of a node outside U stays in
+        (0, 2^w): once all ones (:meth:`shrink`) or a member's, it loses at most one
+        per in-neighbour removed afterwards, and E_m's field counts only in-neighbours
+        still in Q.
 
         A nonempty Z ⊆ C meeting the conditions has, for each member v,
         d_v − t_v + 1 ≤ min(|Z| − 1, |Z \\ c_m| + sl_m), so m_v ≤
         min(|C|, |C \\ c_m| + sl_m + 1) (m_v as in :meth:`shrink`): the same cut as
-        there shows the capped core empty early. Work: one step per round, cut, node of
-        c_m ∩ Q and removed node."""
-        pin, half = self.pin, 1 << (self.w - 1)
-        c1 = pin[i] & P & ~S
-        sl1 = c1.bit_count() - (pin[i] & ~S).bit_count() + s1.t[i] - 1
+        there leaves a superset of the capped core (∅: it is empty; the cut nodes are
+        peeled with the next round's). Work: one step per round, cut, node of c_m ∩ Q
+        and removed node."""
+        pin, room, t1 = self.pin, (1 << (self.w - 1)) - s2.most, s1.t
+        need = pin[i] & ~S
+        c1 = need & P
+        q1 = c1 & Q
+        sl1 = min(c1.bit_count() - need.bit_count() + t1[i] - 1, q1.bit_count())
         if sl1 < 0:
             return 0
-        q1 = c1 & Q
-        sl1 = min(sl1, q1.bit_count())
         if i == j:
-            if sl1 + s2.most > half:
-                return self.capped_slow((c1, sl1, c1, sl1), Q, s2)
-            return self.capped_one(c1, sl1, self.row_sum(i, q1), Q, D, s2)
-        c2 = pin[j] & P & ~S
-        sl2 = c2.bit_count() - (pin[j] & ~S).bit_count() + s1.t[j] - 1
+            if sl1 <= room:
+                return self.capped_one(c1, sl1, D - self.row_sum(i, q1), Q, D, S & Q, s2)
+            return self.capped_wide(i, j, S, P, Q, D, s1, s2)
+        need = pin[j] & ~S
+        c2 = need & P
+        q2 = c2 & Q
+        sl2 = min(c2.bit_count() - need.bit_count() + t1[j] - 1, q2.bit_count())
         if sl2 < 0:
             return 0
-        q2 = c2 & Q
-        sl2 = min(sl2, q2.bit_count())
-        if max(sl1, sl2) + s2.most > half:
+        if sl1 <= room and sl2 <= room:
+            return self.capped_two((c1, sl1, D - self.row_sum(i, q1)),
+                                   (c2, sl2, D - self.row_sum(j, q2)), Q, D, S & Q, s2)
+        return self.capped_wide(i, j, S, P, Q, D, s1, s2)
+
+    def capped_wide(self, i: int, j: int, S: int, P: int, Q: int, D: int, s1: _Side,
+                    s2: _Side) -> int:
+        """:meth:`capped` when a lowered sl_m + ``s2.most`` > 2^(w−1) (both sl_m ≥ 0):
+        lowered again to |c_m ∩ core(Q \\ S)|, then packed or :meth:`capped_slow`."""
+        pin, t1 = self.pin, s1.t
+        if Q & S:
+            Q, D = self.shrink(Q, D, S, s2)
+        c1, c2 = pin[i] & P & ~S, pin[j] & P & ~S
+        sl1 = min(c1.bit_count() - (pin[i] & ~S).bit_count() + t1[i] - 1,
+                  (c1 & Q).bit_count())
+        sl2 = min(c2.bit_count() - (pin[j] & ~S).bit_count() + t1[j] - 1,
+                  (c2 & Q).bit_count())
+        if max(sl1, sl2) + s2.most > 1 << (self.w - 1):
             return self.capped_slow((c1, sl1, c2, sl2), Q, s2)
-        less, sh, ones, cut, keep = self.less, self.w - 1, self.ones, s2.cut, s2.keep
-        E1, E2, steps = self.row_sum(i, q1), self.row_sum(j, q2), 1
-        U = Q
-        while True:
-            steps += 1
-            std = U & ~D  # δ_v < 0
-            pos = (U & D) >> sh
-            M = (U >> sh) * ones
-            Dm = (D & M) | (std >> sh) * ones
-            todo = std | U & ~((Dm - (E1 & M) + sl1 * pos) & (Dm - (E2 & M) + sl2 * pos))
-            if not todo:
-                break
+        if i == j:
+            return self.capped_one(c1, sl1, D - self.row_sum(i, c1 & Q), Q, D, 0, s2)
+        return self.capped_two((c1, sl1, D - self.row_sum(i, c1 & Q)),
+                               (c2, sl2, D - self.row_sum(j, c2 & Q)), Q, D, 0, s2)
+
+    def capped_one(self, c: int, sl: int, F: int, U: int, D: int, todo: int,
+                   s2: _Side) -> int:
+        """:meth:`capped`'s packed peel for one member (c, sl and F = D − E), of U
+        without ``todo`` (a node failing the conditions in U fails them in U \\ todo)."""
+        less, sh, cut, keep = self.less, self.w - 1, s2.cut, s2.keep
+        out = ~c  # the nodes outside c: their rows are taken from F too
+        steps = 1
+        todo |= U & ~(D & (F + sl * (U >> sh)))
+        while todo:
+            U ^= todo
+            k = U.bit_count()
+            k2 = (U & out).bit_count() + sl + 1
+            if k2 < k:
+                k = k2
+            if U & cut[k]:
+                C = U
+                while C & cut[k]:
+                    C &= keep[k]
+                    k = C.bit_count()
+                    k2 = (C & out).bit_count() + sl + 1
+                    if k2 < k:
+                        k = k2
+                    steps += 1
+                if not C:
+                    U = 0
+                    break
+                todo |= U ^ C
+                U = C
+            steps += 1 + todo.bit_count()
+            rest = todo & out
+            todo &= c
+            while todo:
+                low = todo & -todo
+                todo ^= low
+                D -= less[low.bit_length()]
+            while rest:
+                low = rest & -rest
+                rest ^= low
+                row = less[low.bit_length()]
+                D -= row
+                F -= row
+            todo = U & ~(D & (F + sl * (U >> sh)))
+        self.work += steps * self.unit
+        return U
+
+    def capped_two(self, m1: tuple[int, int, int], m2: tuple[int, int, int], U: int, D: int,
+                   todo: int, s2: _Side) -> int:
+        """:meth:`capped`'s packed peel for two members, each (c, sl, F = D − E), of U
+        without ``todo``."""
+        less, sh, cut, keep = self.less, self.w - 1, s2.cut, s2.keep
+        (c1, sl1, F1), (c2, sl2, F2) = m1, m2
+        steps, M = 1, U >> sh
+        todo |= U & ~(D & (F1 + sl1 * M) & (F2 + sl2 * M))
+        while todo:
             U ^= todo
             k = U.bit_count()
             k1 = (U & ~c1).bit_count() + sl1 + 1
@@ -885,63 +960,41 @@ class _Replay:
                 if not C:
                     U = 0
                     break
-            D |= (todo >> sh) * ones
-            steps += todo.bit_count()
+                todo |= U ^ C
+                U = C
+            steps += 1 + todo.bit_count()
             while todo:
                 low = todo & -todo
                 todo ^= low
                 row = less[low.bit_length()]
                 D -= row
-                if c1 & low:
-                    E1 -= row
-                if c2 & low:
-                    E2 -= row
-        self.work += steps * self.unit
-        return U
-
-    def capped_one(self, c: int, sl: int, E: int, Q: int, D: int, s2: _Side) -> int:
-        """:meth:`capped` for one member (c, sl; E its e_v), its packed path."""
-        less, sh, ones, cut, keep = self.less, self.w - 1, self.ones, s2.cut, s2.keep
-        U, steps = Q, 1
-        while True:
-            steps += 1
-            std = U & ~D  # δ_v < 0
-            M = (U >> sh) * ones
-            todo = std | U & ~(((D & M) | (std >> sh) * ones) - (E & M)
-                               + sl * ((U & D) >> sh))
-            if not todo:
-                break
-            U ^= todo
-            k = U.bit_count()
-            k2 = (U & ~c).bit_count() + sl + 1
-            k = k if k < k2 else k2
-            if U & cut[k]:
-                C = U
-                while C & cut[k]:
-                    C &= keep[k]
-                    k = C.bit_count()
-                    k2 = (C & ~c).bit_count() + sl + 1
-                    k = k if k < k2 else k2
-                    steps += 1
-                if not C:
-                    U = 0
-                    break
-            D |= (todo >> sh) * ones
-            steps += todo.bit_count()
-            while todo:
-                low = todo & -todo
-                todo ^= low
-                row = less[low.bit_length()]
-                D -= row
-                if c & low:
-                    E -= row
+                if not c1 & low:
+                    F1 -= row
+                if not c2 & low:
+                    F2 -= row
+            M = U >> sh
+            todo = U & ~(D & (F1 + sl1 * M) & (F2 + sl2 * M))
         self.work += steps * self.unit
         return U
 
     def row_sum(self, i: int, q: int) -> int:
         """Σ of the ``less`` rows of the packed set q ⊆ N(i): field v holds the number
         of its members that send to v (< n: no carry); from ``rows[i]``, the sum over
-        N(i), when N(i) \\ q is the smaller (work: one step per row added or taken)."""
+        N(i), when N(i) \\ q is the smaller (work: one step per row added or taken).
+        Kept in ``sums`` (q → Σ; one step to look up, n·w bits each, at most
+        ROW_SUMS of them: emptied when full), as sibling leaves share most q."""
+        E = self.sums.get(q)
+        if E is not None:
+            self.work += self.unit
+            return E
+        if len(self.sums) >= ROW_SUMS:
+            self.sums.clear()
+        self.work += self.g.n * self.w // 64
+        self.sums[q] = E = self._row_sum(i, q)
+        return E
+
+    def _row_sum(self, i: int, q: int) -> int:
+        """:meth:`row_sum`, computed."""
         less, rest = self.less, self.pin[i] & ~q
         sign = q.bit_count() > rest.bit_count()
         E, m = (self.rows[i], rest) if sign else (0, q)
