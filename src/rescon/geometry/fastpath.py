@@ -247,14 +247,15 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     is solved (:func:`_one_per_point`). ``top``: the rows' maxima over V
     (:func:`_row_max`, being computed), else they are computed over the exact
     vertices' floats."""
-    S_set = np.unique(sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
-                                      count=sum(map(len, facets)))]).tolist()
+    sizes = np.fromiter(map(len, facets), dtype=np.int64, count=len(facets))
+    flat = sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
+                           count=int(sizes.sum()))]
+    S_set = np.unique(flat).tolist()
     H.exact_all(S_set)
     S = np.asarray(S_set, dtype=np.int64)
-    rows_of = sel.tolist()
-    Ts = _bases(H, [[rows_of[i] for i in f] for f in facets], k)
-    solved = _one_per_point(H, Ts, k).tolist() if pieces else list(range(len(Ts)))
-    X = _solve_rows(H, [Ts[p] for p in solved], k)
+    Ts = _basis_array(H, flat, sizes, k)  # (proposals, k): rows of H
+    solved = _one_per_point(H, Ts, k) if pieces else np.arange(len(Ts))
+    X = _solve_rows(H, Ts[solved], k)
     # x_0 = 0: k dependent rows (a zero-volume piece of a triangulated non-simple
     # vertex), the other proposals or the closure decide
     met = X[:, 0] != 0
@@ -268,7 +269,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     of_proposal, firsts = _distinct_points(W, Vx)
     W, Vx = W[firsts], Vx[firsts]
     verts = list(map(tuple, W.tolist()))
-    T_kept = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)[kept]
+    T_kept = Ts[kept]
     # per vertex: k independent rows tight at it (positions in S), its first proposal's
     basis = np.searchsorted(S, T_kept[firsts]).tolist()
     # (vertex, position in S) of the rows tight by construction; more are found below
@@ -523,19 +524,28 @@ def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
 
 
 def _bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
-    """For each proposal's rows T, k of them that floats suggest are independent: T
-    itself when it has k rows; else the rows a merged (non-simple) proposal is solved
-    from, by QR with column pivoting of their unit normals (at each step the row of
-    largest norm once the chosen ones are projected out), all proposals of one size at
-    once. Only these k are tight by construction; the others are decided exactly
-    later."""
-    out = list(Ts)
-    sizes: dict[int, list[int]] = {}
-    for p, T in enumerate(Ts):
-        if len(T) > k:
-            sizes.setdefault(len(T), []).append(p)
-    for ps in sizes.values():
-        R = H.af[np.array([Ts[p] for p in ps])]  # (m, t, k)
+    """:func:`_basis_array` of the lists of rows Ts, as lists."""
+    sizes = np.array([len(T) for T in Ts], dtype=np.int64)
+    flat = np.array([h for T in Ts for h in T], dtype=np.int64)
+    return _basis_array(H, flat, sizes, k).tolist()
+
+
+def _basis_array(H, flat: np.ndarray, sizes: np.ndarray, k: int) -> np.ndarray:
+    """For each proposal's rows T (``flat``: the proposals' rows one after another,
+    ``sizes``: how many each, all ≥ k), k of them that floats suggest are independent,
+    an int64 array (proposals, k): T itself when it has k rows; else the rows a merged
+    (non-simple) proposal is solved from, by QR with column pivoting of their unit
+    normals (at each step the row of largest norm once the chosen ones are projected
+    out), all proposals of one size at once. Only these k are tight by construction;
+    the others are decided exactly later."""
+    starts = np.cumsum(sizes) - sizes
+    out = np.empty((len(sizes), k), dtype=np.int64)
+    simple = sizes == k
+    out[simple] = flat[starts[simple][:, None] + np.arange(k)]
+    for t in np.unique(sizes[~simple]).tolist():
+        ps = np.flatnonzero(sizes == t)
+        T = flat[starts[ps][:, None] + np.arange(t)]  # (m, t)
+        R = H.af[T]  # (m, t, k)
         R = R / np.linalg.norm(R, axis=2)[:, :, None]
         m = np.arange(len(ps))
         chosen = np.empty((len(ps), k), dtype=np.int64)
@@ -545,8 +555,7 @@ def _bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
             q = R[m, c] / np.sqrt(norms[m, c])[:, None]
             R = R - (R @ q[:, :, None]) * q[:, None, :]
             R[m, c] = 0.0
-        for p, row in zip(ps, chosen.tolist(), strict=True):
-            out[p] = [Ts[p][i] for i in row]
+        out[ps] = np.take_along_axis(T, chosen, axis=1)
     return out
 
 
@@ -554,7 +563,7 @@ def _row_table(H, Ts: list[list[int]], k: int) -> tuple[np.ndarray, np.ndarray, 
     """The lists Ts of k rows as an int64 array B, the homogeneous rows E of the distinct
     rows in B (:func:`_homogeneous`, the row at infinity last) and the position in E of
     each entry of B."""
-    B = np.array(Ts, dtype=np.int64).reshape(len(Ts), k)
+    B = np.asarray(Ts, dtype=np.int64).reshape(len(Ts), k)
     used, at = np.unique(B, return_inverse=True)
     return B, at.reshape(B.shape), _homogeneous(H, used.tolist(), k)
 
@@ -567,7 +576,7 @@ def _one_per_point(H, Ts: list[list[int]], k: int) -> np.ndarray:
     refuses (module docstring)."""
     from ._certify_nb import KEY_PRIME, point_keys
 
-    if not Ts:
+    if not len(Ts):
         return np.zeros(0, dtype=np.int64)
     _, at, E = _row_table(H, Ts, k)
     residues = np.array([[v % KEY_PRIME for v in e] for e in E[:-1].tolist()], dtype=np.int64)
@@ -606,7 +615,7 @@ def _solve_rows(H, Ts: list[list[int]], k: int) -> np.ndarray:
     the vertex, and any nonzero x with E_T x = 0 spans it. Where det A_T = 0 the cross
     product of E_T has x_0 = ±det A_T = 0."""
     X = np.empty((len(Ts), k + 1), dtype=object)
-    if not Ts:
+    if not len(Ts):
         return X
     from ._certify_nb import nonsingular
 
