@@ -14,7 +14,7 @@ import pytest
 
 from rescon.geometry import fastpath
 from rescon.geometry.exact import nullspace_exact
-from rescon.geometry.polytope import _bits
+from rescon.geometry.polytope import _bits, tight_pairs
 from tests.test_kernel_d45 import _halfspaces
 from tests.test_kernel_d45_certify import _reference_vertex
 
@@ -96,6 +96,10 @@ def test_bitsets_equal_bit_by_bit_sums():
         for v, h in pairs:
             want[v] |= 1 << h
         assert fastpath._bitsets(vs, hs, n, width) == want
+        tight, (v_of, h_of) = fastpath._tight_sets(vs, hs, n, width)
+        want_v, want_h = tight_pairs(want)
+        assert tight == want
+        assert v_of.tolist() == want_v.tolist() and h_of.tolist() == want_h.tolist()
 
 
 def _brute_end(tight: list[int], v: int, Z: int) -> set[int]:

@@ -20,11 +20,11 @@ def _recorded(monkeypatch) -> list:
     seen = []
     real = fastpath._closed
 
-    def closed(tight, basis, normals, k, start_rays):
+    def closed(tight, basis, normals, k, start_rays, pairs=None):
         non_simple = [v for v, t in enumerate(tight) if t.bit_count() > k]
         starts = start_rays([basis[v] for v in non_simple])
         seen.append((tight, basis, normals, k, dict(zip(non_simple, starts, strict=True))))
-        return real(tight, basis, normals, k, start_rays)
+        return real(tight, basis, normals, k, start_rays, pairs)
 
     monkeypatch.setattr(fastpath, "_closed", closed)
     return seen

@@ -395,8 +395,9 @@ def test_the_double_description_refuses_a_dropped_neighbour(kind, d, n, F, monke
     seen = []
     real = fastpath._closed
 
-    def record(tight, basis, normals, k, start_rays):
-        seen.append((tight, basis, normals, k, real(tight, basis, normals, k, start_rays)))
+    def record(tight, basis, normals, k, start_rays, pairs=None):
+        seen.append((tight, basis, normals, k,
+                     real(tight, basis, normals, k, start_rays, pairs)))
         return seen[-1][-1]
 
     with monkeypatch.context() as mp:
@@ -405,8 +406,8 @@ def test_the_double_description_refuses_a_dropped_neighbour(kind, d, n, F, monke
     tight, basis, normals, k, N = seen[-1]
     checked = _closure.combinatorial_rays
 
-    def deferring(tight, normals, k):
-        ok, ends = checked(tight, normals, k)
+    def deferring(tight, normals, k, pairs=None):
+        ok, ends = checked(tight, normals, k, pairs)
         wide = np.array([t.bit_count() > k for t in tight], dtype=bool)
         return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
 

@@ -73,15 +73,16 @@ WORK = 200_000
 KEYED_ROWS = 10
 
 
-def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int
+def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
+                       pairs: tuple[np.ndarray, np.ndarray] | None = None
                        ) -> tuple[np.ndarray, list[list[int]]]:
     """For every vertex v (``tight``: its rows, of rank k), whether the check (module
     docstring) proves that the proposed vertices u with rank(T(v) ∩ T(u)) = k − 1 end
     all the extreme rays of its tangent cone, and those u, increasing (empty where it
     does not). At a simple vertex (k rows, independent) every k − 1 of them have rank
     k − 1: no modular rank is needed, and the check passes iff each of its k rays has
-    an end."""
-    v_of, h_of = tight_pairs(tight)  # by vertex, then row
+    an end. ``pairs``: :func:`.polytope.tight_pairs` of ``tight`` when known."""
+    v_of, h_of = tight_pairs(tight) if pairs is None else pairs  # by vertex, then row
     v_ptr = np.searchsorted(v_of, np.arange(len(tight) + 1)).astype(np.int64)
     by_row = np.argsort(h_of, kind="stable")  # by row, then vertex
     h_ptr = np.searchsorted(h_of[by_row], np.arange(len(normals) + 1)).astype(np.int64)

@@ -322,10 +322,11 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     in_S = S[at] == hs[on]
     tight_v.append(near_v[on][in_S])
     tight_h.append(at[in_S])
-    tight = _bitsets(np.concatenate(tight_v), np.concatenate(tight_h), len(verts), len(S))
+    tight, pairs = _tight_sets(np.concatenate(tight_v), np.concatenate(tight_h), len(verts),
+                               len(S))
     normals = [H.exact(h)[0] for h in S_set]
     edges = _closed(tight, basis, normals, k,
-                    lambda bases: _simplicial_rays(H, S_set, normals, bases, k))
+                    lambda bases: _simplicial_rays(H, S_set, normals, bases, k), pairs)
     if edges is None:
         return None
     P = ExactPolytope(k, unit=scale)
@@ -342,16 +343,31 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
 
 def _bitsets(vs: np.ndarray, hs: np.ndarray, n: int, width: int) -> list[int]:
     """For each of n vertices the bitset (a Python int) of the positions hs[i] < width
-    paired with it (vs[i]): a boolean table packed to bytes, one int per row."""
+    paired with it (vs[i]): :func:`_tight_sets`."""
+    return _tight_sets(vs, hs, n, width)[0]
+
+
+def _tight_sets(vs: np.ndarray, hs: np.ndarray, n: int, width: int
+                ) -> tuple[list[int], tuple[np.ndarray, np.ndarray]]:
+    """For each of n vertices the bitset (a Python int) of the positions hs[i] < width
+    paired with it (vs[i]): a boolean table packed to bytes, one int per row; and the
+    distinct pairs (vertex, position) ordered by vertex then position, read off the
+    packed table (what :func:`.polytope.tight_pairs` gives for the bitsets)."""
     nbytes = max((width + 7) // 8, 1)
     table = np.zeros((n, 8 * nbytes), dtype=np.bool_)
     table[vs, hs] = True
-    buf = np.packbits(table, axis=1, bitorder="little").tobytes()
-    return [int.from_bytes(buf[i:i + nbytes], "little") for i in range(0, n * nbytes, nbytes)]
+    packed = np.packbits(table, axis=1, bitorder="little").ravel()
+    buf = packed.tobytes()
+    tight = [int.from_bytes(buf[i:i + nbytes], "little") for i in range(0, n * nbytes, nbytes)]
+    at = np.flatnonzero(packed)  # vertex · nbytes + byte, increasing
+    bits = np.flatnonzero(np.unpackbits(packed[at], bitorder="little"))
+    at = at[bits >> 3]
+    return tight, (at // nbytes, at % nbytes * 8 + (bits & 7))
 
 
 def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
-            k: int, start_rays) -> list[list[int]] | None:
+            k: int, start_rays, pairs: tuple[np.ndarray, np.ndarray] | None = None
+            ) -> list[list[int]] | None:
     """The edges of P_S — for each vertex, its neighbours, increasing — if every extreme
     ray of every vertex's tangent cone leads to another vertex, else None. The rows Z
     tight along a ray have rank k − 1, so a vertex u ≠ v lies on the ray's line iff
@@ -362,10 +378,11 @@ def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, .
     settle has a ray that leads nowhere. A non-simple one's rays then come from
     :func:`_tangent_rays`, their ends through the (k − 1)-subsets of the tight sets
     (:class:`_RayIndex`). ``start_rays``: for a list of bases, their simplicial cones'
-    rays (:func:`_simplicial_rays`), where the double descriptions start."""
+    rays (:func:`_simplicial_rays`), where the double descriptions start. ``pairs``:
+    :func:`.polytope.tight_pairs` of ``tight`` when known."""
     from ._closure import combinatorial_rays
 
-    settled, edges = combinatorial_rays(tight, normals, k)
+    settled, edges = combinatorial_rays(tight, normals, k, pairs)
     rest = np.flatnonzero(~settled).tolist()
     if not rest:
         return edges
