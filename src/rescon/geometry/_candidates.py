@@ -676,37 +676,64 @@ def _chunk_top(A, b, h, centres, radii, norm, c, floor):
 
 
 @njit(cache=True, nogil=True)
-def _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, h0, h1, out):
+def _chunked_max_range(A, b, W, starts, centres, radii, groups, g_centres, g_radii, norms,
+                       floor, h0, h1, out):
     k = A.shape[1]
     for h in range(h0, h1):
         best = -np.inf
-        for c in range(len(starts) - 1):
-            top = _chunk_top(A, b, h, centres, radii, norms[h], c, floor)
-            if top < 0.0:  # the whole ball is below: its bound will do
+        for g in range(len(groups) - 1):
+            top = _chunk_top(A, b, h, g_centres, g_radii, norms[h], g, floor)
+            if top < 0.0:  # the whole group's ball is below: its bound will do
                 best = max(best, top)
                 continue
-            for v in range(starts[c], starts[c + 1]):
-                s = 0.0
-                for j in range(k):
-                    s += A[h, j] * W[v, j]
-                best = max(best, s - b[h])
+            for c in range(groups[g], groups[g + 1]):
+                top = _chunk_top(A, b, h, centres, radii, norms[h], c, floor)
+                if top < 0.0:  # the whole ball is below: its bound will do
+                    best = max(best, top)
+                    continue
+                for v in range(starts[c], starts[c + 1]):
+                    s = 0.0
+                    for j in range(k):
+                        s += A[h, j] * W[v, j]
+                    best = max(best, s - b[h])
         out[h] = best
 
 
 @njit(cache=True, parallel=True)
-def _chunked_max_parallel(A, b, W, starts, centres, radii, norms, floor, out):
+def _chunked_max_parallel(A, b, W, starts, centres, radii, groups, g_centres, g_radii,
+                          norms, floor, out):
     m = A.shape[0]
     for c in prange(64):
-        _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, m * c // 64,
-                           m * (c + 1) // 64, out)
+        _chunked_max_range(A, b, W, starts, centres, radii, groups, g_centres, g_radii,
+                           norms, floor, m * c // 64, m * (c + 1) // 64, out)
+
+
+#: row_top groups this many consecutive chunks (neighbours in the k-d tree) under one
+#: ball, tested first
+GROUP_CHUNKS = 8
+
+
+def ball_groups(W: np.ndarray, starts: np.ndarray, per: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Runs of ``per`` consecutive chunks (:func:`ball_chunks`; W: the points in chunk
+    order) as balls: (groups, centres, radii) — group g is chunks groups[g] to
+    groups[g + 1] − 1, its points within ``radii[g]`` (the float max of ‖v − centre‖,
+    as for the chunks) of ``centres[g]`` (their mean)."""
+    groups = np.append(np.arange(0, len(starts) - 1, per), len(starts) - 1)
+    first = starts[groups]
+    counts = np.diff(first)
+    centres = np.add.reduceat(W, first[:-1], axis=0) / counts[:, None]
+    gap = ((W - np.repeat(centres, counts, axis=0)) ** 2).sum(axis=1)
+    return groups, centres, np.sqrt(np.maximum.reduceat(gap, first[:-1]))
 
 
 def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float,
             parallel: bool = True) -> np.ndarray:
     """Per row h an upper bound on max_v a_h·v − b_h over the float points V, which is
-    the maximum itself (evaluated in floats) wherever that may be ≥ 0: chunks of V
-    (:func:`ball_chunks`) whose ball lies surely below the hyperplane contribute
-    their ball's bound, the others their points' values. ``floor``: the underflow
+    the maximum itself (evaluated in floats) wherever that may be ≥ 0: groups of
+    chunks (:func:`ball_groups`), then chunks of V (:func:`ball_chunks`) whose ball
+    lies surely below the hyperplane contribute their ball's bound, the others their
+    points' values. ``floor``: the underflow
     term of these products. ``parallel`` False: on the calling thread only, without
     the GIL (for a caller that works meanwhile)."""
     order, starts, centres, radii = ball_chunks(V)
@@ -715,11 +742,11 @@ def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float,
     b = np.ascontiguousarray(b)
     norms = np.sqrt((A**2).sum(axis=1))
     out = np.empty(A.shape[0])
+    balls = (starts, centres, radii, *ball_groups(W, starts, GROUP_CHUNKS), norms, floor)
     if parallel and A.shape[0] * (len(starts) - 1) >= 20_000:
-        _chunked_max_parallel(A, b, W, starts, centres, radii, norms, floor, out)
+        _chunked_max_parallel(A, b, W, *balls, out)
     else:
-        _chunked_max_range(A, b, W, starts, centres, radii, norms, floor, 0, A.shape[0],
-                           out)
+        _chunked_max_range(A, b, W, *balls, 0, A.shape[0], out)
     return out
 
 
