@@ -602,7 +602,8 @@ class _Replay:
     the table ``less`` (up to n·w bits per node with out-neighbours) and the stack
     (at most n + 1 levels, as each fixes one more node in S ∪ X, each with up to four
     packed sets of its own: S or X with the new node, and a re-peeled set with its D),
-    so memory stays below 64·MAX_SEARCH_WORK bits.
+    and each row sum stored by :meth:`row_sum` (n·w bits), so memory stays below
+    64·MAX_SEARCH_WORK bits.
     """
 
     def __init__(self, g: Graph, r: int, where: str) -> None:
