@@ -249,8 +249,8 @@ def test_the_double_description_where_the_check_defers(kind, d, n, F, monkeypatc
     real = _closure.combinatorial_rays
     deferred = []
 
-    def deferring(tight, normals, k):
-        ok, ends = real(tight, normals, k)
+    def deferring(tight, normals, k, pairs=None):
+        ok, ends = real(tight, normals, k, pairs)
         wide = np.array([t.bit_count() > k for t in tight], dtype=bool)
         deferred.append(int(wide.sum()))
         return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
