@@ -1290,6 +1290,86 @@ def _int_vector(v: Vec) -> list[int]:
     return _scaled([v], _den_lcm([v]))[0]
 
 
+#: the vertex test's exact filters (tests switch them off to compare verdicts)
+VERTEX_FILTERS = True
+_FILTER_TOL = 2.0 ** -48  # 32 u, u = 2^-53 the unit roundoff (proof in _surely_inside)
+_RANK_PRIME = (1 << 61) - 1
+
+
+def _float_rows(Fi: list[tuple[list[int], int]]) -> list[tuple[list[float], float, float]] | None:
+    """(fl(a) + [−fl(g)], fl(|a|_1), |fl(g)|) per facet a·x <= g, or None when some entry
+    has more than 600 bits (then the filter of :func:`_surely_inside` is not used)."""
+    out = []
+    for a, g in Fi:
+        if max(abs(t) for t in a + [g]).bit_length() > 600:
+            return None
+        af = [float(t) for t in a]
+        out.append((af + [-float(g)], math.fsum(map(abs, af)), abs(float(g))))
+    return out
+
+
+def _float_vertex(X: list[int], Dv: int) -> tuple[list[float], float] | None:
+    """(fl(X / Dv) + [1.0], max |fl(X_i / Dv)|) when every nonzero coordinate has magnitude in
+    [2^-600, 2^300] (int / int is correctly rounded); None otherwise."""
+    try:
+        vf = [x / Dv for x in X]
+    except OverflowError:
+        return None
+    vmax = 0.0
+    for x, t in zip(X, vf):
+        if x and not 2.0 ** -600 <= abs(t) <= 2.0 ** 300:
+            return None
+        vmax = max(vmax, abs(t))
+    return vf + [1.0], vmax
+
+
+def _surely_inside(rows: list[tuple[list[float], float, float]], vf: list[float],
+                   vmax: float) -> list[bool]:
+    """Per facet a·x <= g: True only when a·v < g holds for the exact v (strictly inside,
+    so neither violated nor tight); False means "decide exactly".
+
+    Proof (exact reals a, g, v; s = a·v − g; u = 2^-53).  The entries of a, g are 0 or
+    integers of magnitude in [1, 2^600] (:func:`_float_rows`), the coordinates of v are 0
+    (then X_i = 0 and fl(v_i) = 0) or of magnitude in [2^-600, 2^300]
+    (:func:`_float_vertex`): every float below is finite, and 0 or normal — a nonzero
+    product is >= 2^-600 in magnitude and a multiple of 2^-652, so is every sum of them
+    and of the integer fl(g), so the fsum below is 0 or >= 2^-652.  The conversions are
+    correctly rounded: fl(a_i) = a_i(1 + δ), fl(v_i) = v_i(1 + δ'), fl(g) = g(1 + δ''),
+    |δ| <= u; the product fl(fl(a_i)·fl(v_i)) = a_i v_i (1 + θ_i), |θ_i| <= (1 + u)³ − 1
+    < 4u; math.fsum returns the correctly rounded sum s' of these d floats and −fl(g)
+    (the product −fl(g)·1.0 is exact).  So
+    |s' − s| <= 4u·Σ|a_i v_i| + u·|g| + u·|s'| <= 4u·M, M = |a|_1·max|v_i| + |g| + |s'|.
+    For s' < 0 the float B = fl(fl(a1·vmax) + |fl(g)|) − s' (rounded; a1 = fsum |fl(a_i)|, vmax =
+    max |fl(v_i)|: all terms >= 0, six roundings in all) is >= (1 − u)^6·M > M / 2, so
+    s' < −TOL·B with TOL = 32u gives −s' > 16u·M > |s' − s|, hence s < 0.  (TOL·B is
+    exact: TOL is a power of 2 and B is normal.)"""
+    fsum, tol = math.fsum, -_FILTER_TOL
+    return [(s := fsum(map(mul, afg, vf))) < 0 and s < tol * (a1 * vmax + ag - s)
+            for afg, a1, ag in rows]
+
+
+def _rank_at_least_mod_p(rows: list[list[int]], d: int) -> bool:
+    """True only if the integer rows have rank >= d over Q: their rank modulo the prime
+    _RANK_PRIME is a lower bound (a d x d minor nonzero mod p is a nonzero integer).
+    Gaussian elimination over GF(p), stopped at rank d."""
+    p = _RANK_PRIME
+    piv: list[tuple[int, list[int]]] = []  # (pivot column c, row b with b[c] != 0)
+    for r in rows:
+        v = [x % p for x in r]
+        for c, b in piv:
+            f = v[c]
+            if f:  # bc·v − f·b: bc is invertible mod p, so the span is unchanged
+                bc = b[c]
+                v = [(bc * x - f * y) % p for x, y in zip(v, b)]
+        c = next((j for j, x in enumerate(v) if x), None)
+        if c is None:
+            continue
+        piv.append((c, v))
+        if len(piv) >= d:
+            return True
+    return False
+
+
 def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], int]],
                    V: list[Vec], d: int, ctx: Any) -> list[list[int]] | None:
     """Every v ∈ V satisfies the equalities and facets exactly and the constraints tight
@@ -1306,19 +1386,26 @@ def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], in
                   f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work {work} > "
                   f"{MAX_EVAL_WORK}")
         return None
+    rows_f = _float_rows(Fi) if VERTEX_FILTERS else None
     incidence: list[list[int]] = []
     for i, ((X, Dv), v) in enumerate(zip(SV, V)):
         for j, (a, f) in enumerate(Ei):
             if _dot(a, X) != f * Dv:
                 raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
         on: list[int] = []
+        fv = _float_vertex(X, Dv) if rows_f is not None else None
+        # facets proved strictly slack by the filter are neither violated nor tight
+        inside = _surely_inside(rows_f, *fv) if fv is not None else [False] * len(Fi)
         for j, (a, g) in enumerate(Fi):
+            if inside[j]:
+                continue
             s = _dot(a, X) - g * Dv
             if s > 0:
                 raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates facets[{j}]")
             if s == 0:
                 on.append(j)
-        r = _rank([a for a, _ in Ei] + [Fi[j][0] for j in on])
+        tight = [a for a, _ in Ei] + [Fi[j][0] for j in on]
+        r = d if VERTEX_FILTERS and _rank_at_least_mod_p(tight, d) else _rank(tight)
         if r < d:
             raise Invalid(f"vertices[{i}] = {_fmtv(v)} is not a vertex of P: the constraints "
                           f"tight at it have rank {r} < d = {d}")
