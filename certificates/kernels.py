@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 import re
 from bisect import bisect_left, bisect_right
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from fractions import Fraction
 from itertools import combinations
 from operator import mul
@@ -1278,7 +1278,13 @@ def _basis_with_rhs(E: list[tuple[list[int], int]], d: int) -> list[tuple[list[i
 def _check_dim(V: list[Vec], dim: int) -> None:
     """The affine dimension of V is ``dim``: the rank of the differences v - v_0, each
     row scaled by its own denominator (the rank does not change, and distinct vertex
-    denominators never multiply)."""
+    denominators never multiply).  dim = d: the rank is at most d, so a rank >= d modulo
+    a prime (a lower bound, :func:`_rank_at_least_mod_p`, fed the rows as it asks for
+    them) decides."""
+    d = len(V[0])
+    if VERTEX_FILTERS and dim == d and _rank_at_least_mod_p(
+            (_int_vector(tuple(a - b for a, b in zip(v, V[0]))) for v in V[1:]), d):
+        return
     rows = [_int_vector(tuple(a - b for a, b in zip(v, V[0]))) for v in V[1:]]
     k = len(_echelon(rows, stop=len(V[0]) + 1))
     if k != dim:
@@ -1348,7 +1354,7 @@ def _surely_inside(rows: list[tuple[list[float], float, float]], vf: list[float]
             for afg, a1, ag in rows]
 
 
-def _rank_at_least_mod_p(rows: list[list[int]], d: int) -> bool:
+def _rank_at_least_mod_p(rows: Iterable[list[int]], d: int) -> bool:
     """True only if the integer rows have rank >= d over Q: their rank modulo the prime
     _RANK_PRIME is a lower bound (a d x d minor nonzero mod p is a nonzero integer).
     Gaussian elimination over GF(p), stopped at rank d."""
