@@ -602,8 +602,8 @@ class _Replay:
     the table ``less`` (up to n·w bits per node with out-neighbours) and the stack
     (at most n + 1 levels, as each fixes one more node in S ∪ X, each with up to four
     packed sets of its own: S or X with the new node, and a re-peeled set with its D),
-    and each row sum stored by :meth:`row_sum` (n·w bits), so memory stays below
-    64·MAX_SEARCH_WORK bits.
+    and each row sum stored by :meth:`row_sum` (2·n·w bits, with its key), so memory
+    stays below 64·MAX_SEARCH_WORK bits.
     """
 
     def __init__(self, g: Graph, r: int, where: str) -> None:
@@ -985,17 +985,17 @@ class _Replay:
         """Σ of the ``less`` rows of the packed set q ⊆ N(i): field v holds the number
         of its members that send to v (< n: no carry); from ``rows[i]``, the sum over
         N(i), when N(i) \\ q is the smaller (work: one step per row added or taken).
-        Kept in ``sums`` (q → Σ; one step to look up, n·w bits each, at most
-        ROW_SUMS of them: emptied when full), as nearby leaves share most q (88 % of
-        the look-ups of the ER(30, 0.5) s* = 3 proof); :meth:`capped` looks up a single
-        member's itself, charged with its peel's first step."""
+        Kept in ``sums`` (q → Σ; one step to look up, 2·n·w bits each, the key q and
+        Σ, at most ROW_SUMS of them: emptied when full), as nearby leaves share most q
+        (88 % of the look-ups of the ER(30, 0.5) s* = 3 proof); :meth:`capped` looks up
+        a single member's itself, charged with its peel's first step."""
         E = self.sums.get(q)
         if E is not None:
             self.work += self.unit
             return E
         if len(self.sums) >= ROW_SUMS:
             self.sums.clear()
-        self.work += self.g.n * self.w // 64
+        self.work += 2 * self.g.n * self.w // 64
         self.sums[q] = E = self._row_sum(i, q)
         return E
 
