@@ -458,7 +458,12 @@ def _refute_by_axes(pts: list[Vec], F: int, tests: list[Vec], names: list[str]) 
     n = len(pts)
     for j in range(len(pts[0])):
         col = sorted(p[j] for p in pts)
+        lo, hi = col[min(F, n - 1)], col[max(n - 1 - F, 0)]
         for x, name in zip(tests, names):
+            # #{y_j <= x_j} <= F iff x_j < col[F]; #{y_j >= x_j} <= F iff x_j > col[n-1-F]
+            # (F < n); the counts themselves only for the message
+            if lo <= x[j] <= hi:
+                continue
             above = n - bisect_left(col, x[j])  # points with y_j >= x_j
             below = bisect_right(col, x[j])  # points with y_j <= x_j
             for count, rel in ((above, ">="), (below, "<=")):
@@ -563,7 +568,7 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
         return "halfspaces: not checked"
     p0 = P[0]
     basis = _echelon([_sub(p, p0) for p in P], stop=d)
-    for (x, e), name in zip(T, names):
+    for (x, e), name in zip(T if len(basis) < d else [], names):  # rank d: aff(X) = R^d
         if any(_reduce([t - e * c for t, c in zip(x, p0)], basis)):
             raise Invalid(f"{name} is not in the safe kernel: it is not in the affine hull "
                           f"of the points (dimension {len(basis)})")
@@ -1437,11 +1442,12 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
         raise Unchecked("size limit", f"vertices: {len(varr)} entries exceed the checker's "
                         f"limit of {MAX_CONSTRAINTS}")
     V = [_vec(v, f"vertices[{i}]", d) for i, v in enumerate(varr)]
-    pos: dict[Vec, int] = {}
+    pos: dict[tuple[int, ...], int] = {}  # keyed by the lowest terms (cheap to hash)
     for i, v in enumerate(V):
-        if v in pos:
-            raise Invalid(f"vertices[{i}] repeats vertices[{pos[v]}]")
-        pos[v] = i
+        key = tuple(x for t in v for x in (t.numerator, t.denominator))
+        if key in pos:
+            raise Invalid(f"vertices[{i}] repeats vertices[{pos[key]}]")
+        pos[key] = i
     E = _constraints(c["equalities"], "equalities", d)
     Fc = _constraints(c["facets"], "facets", d)
     m = _proof_method(c["proof"], "proof", {"halfspaces": (), "tverberg": ("vertex_parts",)})

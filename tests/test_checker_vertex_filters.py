@@ -194,3 +194,52 @@ def test_d5_unchecked_certificate_spends_few_exact_slacks(monkeypatch):
     full = check(copy.deepcopy(cert))
     assert full.verdict == "unchecked"
     assert any(u.startswith("adjacency: the edges at the 512 vertices") for u in full.unchecked)
+
+
+def _refute_by_axes_reference(pts, F, tests, names):
+    """The axis test as it was (both counts by bisection for every test point)."""
+    from bisect import bisect_left, bisect_right
+
+    n = len(pts)
+    for j in range(len(pts[0])):
+        col = sorted(p[j] for p in pts)
+        for x, name in zip(tests, names):
+            for count, rel in ((n - bisect_left(col, x[j]), ">="),
+                               (bisect_right(col, x[j]), "<=")):
+                if count <= F:
+                    return f"{name} {j} {rel} {count}"
+    return None
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_axis_test_by_order_statistics_matches_bisection(seed):
+    """_refute_by_axes compares x_j with the (F+1)-th smallest / largest coordinate and
+    counts only to word a refutation: same first failure (point, coordinate, side,
+    count) as counting every time, on integer clouds with ties, F = 0 .. n − 1."""
+    rng = random.Random(seed)
+    n, d = rng.randint(1, 9), rng.randint(1, 3)
+    pts = [tuple(Fraction(rng.randint(-3, 3)) for _ in range(d)) for _ in range(n)]
+    F = rng.randint(0, n - 1)
+    tests = [tuple(Fraction(rng.randint(-8, 8), 2) for _ in range(d)) for _ in range(5)]
+    names = [f"t{i}" for i in range(5)]
+    want = _refute_by_axes_reference(pts, F, tests, names)
+    try:
+        kernels._refute_by_axes(pts, F, tests, names)
+        got = None
+    except Exception as e:  # check.py's Invalid
+        m = __import__("re").search(r"(t\d) is .*y\[(\d)\] (>=|<=) .* holds only (\d+)", str(e))
+        got = " ".join(m.groups())
+    assert got == want
+
+
+def test_degenerate_cloud_still_refutes_a_point_off_its_affine_hull():
+    """The affine-hull test of (b) is skipped only when aff(X) = R^d: a flat cloud in
+    R^3 still refutes a point 1e-30 off its plane; a full-dimensional one accepts it."""
+    X = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [4, 4, 0], [2, 1, 0], [1, 3, 0]]
+    pts = [tuple(Fraction(t) for t in p) for p in X]
+    x = (Fraction(2), Fraction(2), Fraction(1, 10**30))
+    with pytest.raises(Exception, match="not in the affine hull of the points"):
+        kernels._in_kernel_halfspaces(pts, 1, [x], ["x"], None, "vertices")
+    pts[-1] = (Fraction(1), Fraction(3), Fraction(1))
+    with pytest.raises(Exception, match="strictly outside a halfspace"):
+        kernels._in_kernel_halfspaces(pts, 1, [x], ["x"], None, "vertices")
