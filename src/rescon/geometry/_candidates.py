@@ -664,14 +664,19 @@ def _select(key, order, lo, hi, mid):
 def _chunk_top(A, b, h, centres, radii, norm, c, floor):
     """An upper bound on a_h·v − b_h over the ball of chunk c (the exact value of
     a·centre − b + ‖a‖ r, plus 1e-6 of its terms' magnitudes — far above the
-    rounding of these few operations and of ‖a‖, r — and the underflow term)."""
+    rounding of these few operations and of ‖a‖, r — and the underflow term).
+    ‖a‖ and r are square roots of float sums of k squares, each square off by up to
+    2^-1075 where it underflows (offsets ≲ 1e-154: r came out 0 for a cluster of
+    points ~1e-170): as √(x + y) ≤ √x + √y, the true values lie within
+    e = √k · 2^-537 of the float ones, so (‖a‖ + e)(r + e) bounds the reach."""
     k = A.shape[1]
     s = 0.0
     mag = 0.0
     for j in range(k):
         s += A[h, j] * centres[c, j]
         mag += abs(A[h, j] * centres[c, j])
-    reach = norm * radii[c]
+    e = np.sqrt(k) * 2.0**-537
+    reach = (norm + e) * (radii[c] + e)
     return s - b[h] + reach + 1e-6 * (mag + abs(b[h]) + reach) + floor
 
 
