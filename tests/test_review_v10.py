@@ -234,6 +234,7 @@ def test_a_tiny_row_sum_store_changes_no_verdict_or_reason(monkeypatch, limit):
     assert seen == {"valid", "invalid"}
 
 
+@pytest.mark.slow
 def test_the_work_limit_fails_closed_on_capped_leaves(monkeypatch):
     """n = 22 (beyond the checker's own enumeration), s* ≥ 2, a charged tree with
     capped leaves: valid under the default limit; under limits cutting its replay
