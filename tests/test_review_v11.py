@@ -160,6 +160,98 @@ def test_each_engine_in_any_root_order_is_the_dp(seed):
                 assert got == truth, (favour, r, parts)
 
 
+def _brute_by_first(in_masks: list[int], n: int, r: int, order) -> list[int]:
+    """For each position j: the least cost over the pairs of :func:`_brute_s_star`
+    whose first node in ``order`` is order[j] (n when there is none)."""
+    pos = {int(v): j for j, v in enumerate(order)}
+    cost, open_ = [0] * (1 << n), [False] * (1 << n)
+    for S in range(1, 1 << n):
+        reached = sum(1 for i in range(n)
+                      if S >> i & 1 and bin(in_masks[i] & ~S).count("1") >= r)
+        cost[S], open_[S] = reached, reached < bin(S).count("1")
+    best = [n] * n
+    full = (1 << n) - 1
+    for S1 in range(1, 1 << n):
+        if not open_[S1]:
+            continue
+        rest = full & ~S1
+        S2 = rest
+        while S2:
+            if S2 > S1 and open_[S2]:
+                both = S1 | S2
+                j = min(pos[i] for i in range(n) if both >> i & 1)
+                best[j] = min(best[j], cost[S1] + cost[S2])
+            S2 = (S2 - 1) & rest
+    return best
+
+
+def _only(monkeypatch, engine: str) -> None:
+    """min_cost_pair's other engine never advances: ``engine`` answers."""
+
+    class Only(se.CostPartRun):
+        def advance(self, max_nodes: int) -> int:
+            if self.engine != engine:
+                self.seconds += 1e-3
+                return K.RUNNING
+            return super().advance(max_nodes)
+
+    monkeypatch.setattr(se, "CostPartRun", Only)
+
+
+@pytest.mark.parametrize("engine", se.COST_ENGINES)
+@pytest.mark.parametrize("seed", range(3))
+def test_roots_parts_are_exact_on_prefixes_and_bounded_below_elsewhere(seed, engine,
+                                                                        monkeypatch):
+    """n = 6-9, against every pair: min_cost_pair(..., roots=range(0, b)) is the least
+    cost over the pairs whose first node in search_order is at a position < b (a
+    pair's saturation, which the engines search instead, only adds nodes, so its first
+    node stays in the prefix), and roots=range(a, b) the cost of a pair whose first
+    node is at a position in [a, b), so at least the least of those — whichever engine
+    answers (each made to answer alone). A min over a partition equal to s* cannot tell
+    the engines' orders apart (optimal pairs are many, and on small graphs the sized
+    engine answers in its first slice: it held with the charged engine in its own order
+    on a part); these do."""
+    _only(monkeypatch, engine)
+    rng = np.random.default_rng(400 + seed)
+    for G in _families(50 + seed, 18, 6, 9):
+        ig = index_graph(G)
+        n = ig.n
+        order = se.search_order(ig)
+        for r in range(1, (n + 1) // 2 + 1):
+            by_first = _brute_by_first(list(ig.in_masks()), n, r, order)
+            ranges = [range(0, int(rng.integers(1, n + 1)))]
+            a = int(rng.integers(1, n))
+            ranges.append(range(a, int(rng.integers(a + 1, n + 1))))
+            for roots in ranges:
+                want = min(by_first[roots.start:roots.stop])
+                got = se.min_cost_pair(ig, r, n, roots=roots)
+                assert got.engine == engine
+                if roots.start == 0:
+                    assert got.best == want, (r, roots)
+                assert got.best >= want, (r, roots)
+                if got.pair is not None:
+                    S1, S2 = got.pair
+                    first = min(int(np.flatnonzero(order == i)[0]) for i in S1 | S2)
+                    assert first in roots
+
+
+def test_a_roots_part_need_not_bound_its_own_pairs():
+    """The docstring of min_cost_pair said a part's ``best`` "bounds only the pairs
+    whose first node lies in its roots"; it is not an upper bound on them: the engines
+    search maximal pairs only, and a pair's saturation may start in an earlier root.
+    Only the least over a partition of range(n) is s*(r)."""
+    G = next(iter(_families(51, 1, 6, 9)))
+    ig = index_graph(G)
+    n, order = ig.n, se.search_order(ig)
+    seen = False
+    for r in range(1, (n + 1) // 2 + 1):
+        by_first = _brute_by_first(list(ig.in_masks()), n, r, order)
+        for a in range(1, n):
+            got = se.min_cost_pair(ig, r, n, roots=range(a, n)).best
+            seen |= got > min(by_first[a:])
+    assert seen
+
+
 # ----------------------------------------------------------------------- cut and resumed
 
 
@@ -289,9 +381,11 @@ def tiny_parts(monkeypatch):
 @pytest.mark.slow
 def test_charged_engine_alone_on_the_cluster_in_its_order(cluster, tiny_parts):
     """The charged engine's parts alone on 2 workers (finish_cost_on_cluster with only
-    the charged run, started mid-root in its own order): the DP's s*, as serial."""
+    the charged run, started in its own order and stopped in a later root, so the
+    parts' B is a prefix of that order): the DP's s*, as serial."""
     from rescon.graphs import bounds as bd
 
+    sent, most = 0, 0
     with distributed.searches_on(scheduler=cluster):
         pool = distributed.active()
         for seed, (n, p) in enumerate([(12, 0.4), (13, 0.6), (14, 0.8), (12, 0.3)]):
@@ -300,12 +394,22 @@ def test_charged_engine_alone_on_the_cluster_in_its_order(cluster, tiny_parts):
             inputs = se._kernel_inputs(ig)
             for r in range(1, (n + 1) // 2 + 1):
                 truth = _dp(ig, r)
-                run = se.CostPartRun((*inputs[:3], se.charged_search_order(ig)), "charged",
-                                     r, 0, se.whole_cost_part(n), n)
-                if run.advance(7 + seed) != K.RUNNING:
+                order = se.charged_search_order(ig)
+                run = se.CostPartRun((*inputs[:3], order), "charged", r, -1,
+                                     se.whole_cost_part(n), n)
+                status = run.advance(7 + seed)
+                while status == K.RUNNING and run.run.state[K.CS_ROOT] < r + 2:
+                    status = run.advance(5)  # into a later root: its B is a prefix
+                if status != K.RUNNING:
                     continue
-                out = distributed.finish_cost_on_cluster(pool, [run], {"charged": 1.0},
-                                                         run.best, run.pair())
-                assert (out.status, out.best) == ("done", truth), (seed, r)
+                # the rest alone, serially and on the cluster, below n (not below the
+                # local incumbent, which would hide a part searched in the wrong order)
+                serial = _engine(ig, r, "charged", order, part=run.rest(), best=n).best
+                assert min(run.best, serial) == truth
+                out = distributed.finish_cost_on_cluster(pool, [run], {"charged": 1.0}, n,
+                                                         None)
+                assert (out.status, out.best) == ("done", serial), (seed, r)
                 if out.pair is not None:
-                    assert bd.pair_cost(ig, bd.Pair(*out.pair), r) == truth
+                    assert bd.pair_cost(ig, bd.Pair(*out.pair), r) <= serial
+                sent, most = sent + 1, max(most, out.nodes)
+    assert sent >= 10 and most > 600  # > 10 tasks of 60 states
