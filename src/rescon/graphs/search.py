@@ -536,9 +536,12 @@ def min_cost_pair(
     in a deepening search: the faster engine stays the faster on the same graph, and
     the other still has a quarter of the time, so a wrong guess costs at most 4×).
     n ≤ 64. ``on_progress`` and ``roots`` as in :func:`decide_r_robust` (a part's
-    ``best`` bounds only the pairs whose first node lies in its roots; s*(r) is the
-    least over the parts). The sized engine takes its roots in ``search_order``, the
-    charged one in :func:`charged_search_order` (each engine covers every pair in its
+    ``best`` is at least the least cost of the pairs whose first node lies in its
+    roots — its pair is one — but not always at most: the engines search maximal
+    pairs only, whose first node may come earlier; it is that least cost for roots =
+    range(0, b), and s*(r) is the least over a partition of range(n)). The sized
+    engine takes its roots in ``search_order``, the charged one in
+    :func:`charged_search_order` (each engine covers every pair in its
     own order, so either one finishing answers) — but both in ``search_order`` when
     ``roots`` is given, so that a part means the same pairs to both.
 
