@@ -224,6 +224,14 @@ def _bits(mask: int) -> list[int]:
     return out
 
 
+def _store_key(q: int) -> bytes:
+    """The key of the packed set q in a replay's row-sum store: its bytes. Python hashes
+    an int as q mod 2^61 − 1, so packed sets differing in fields p and p + 61 would hash
+    alike and a certificate could make every look-up probe the whole store; bytes hash
+    with SipHash, salted per process."""
+    return q.to_bytes((q.bit_length() + 7) // 8, "little")
+
+
 # --------------------------------------------------------------------------- #
 # graphs and the two set operations everything rests on
 # --------------------------------------------------------------------------- #
@@ -633,7 +641,7 @@ class _Replay:
         self.side = self.threshold_side([r] * n)
         self.pin: list[int] = []
         self.rows: list[int] = []
-        self.sums: dict[int, int] = {}
+        self.sums: dict[bytes, int] = {}
 
     def capped_tables(self) -> None:
         """The tables of the capped leaves (:meth:`capped`): ``pin[i]``, the packed N(i),
@@ -859,7 +867,7 @@ class _Replay:
             return 0
         if i == j:
             if sl1 <= room:
-                E = self.sums.get(q1)
+                E = self.sums.get(_store_key(q1))
                 if E is None:
                     E = self.row_sum(i, q1)
                 return self.capped_one(c1, sl1, D - E, Q, D, S & Q, s2)
@@ -985,18 +993,20 @@ class _Replay:
         """Σ of the ``less`` rows of the packed set q ⊆ N(i): field v holds the number
         of its members that send to v (< n: no carry); from ``rows[i]``, the sum over
         N(i), when N(i) \\ q is the smaller (work: one step per row added or taken).
-        Kept in ``sums`` (q → Σ; one step to look up, 2·n·w bits each, the key q and
-        Σ, at most ROW_SUMS of them: emptied when full), as nearby leaves share most q
+        Kept in ``sums`` (q's bytes → Σ, :func:`_store_key`; one step to look up,
+        2·n·w bits each, the key q and Σ, at most ROW_SUMS of them: emptied when full),
+        as nearby leaves share most q
         (88 % of the look-ups of the ER(30, 0.5) s* = 3 proof); :meth:`capped` looks up
         a single member's itself, charged with its peel's first step."""
-        E = self.sums.get(q)
+        key = _store_key(q)
+        E = self.sums.get(key)
         if E is not None:
             self.work += self.unit
             return E
         if len(self.sums) >= ROW_SUMS:
             self.sums.clear()
         self.work += 2 * self.g.n * self.w // 64
-        self.sums[q] = E = self._row_sum(i, q)
+        self.sums[key] = E = self._row_sum(i, q)
         return E
 
     def _row_sum(self, i: int, q: int) -> int:

@@ -322,12 +322,6 @@ def test_the_checker_before_the_one_pass_peel_gives_the_same_verdicts(tmp_path):
     assert compared > 300
 
 
-@pytest.mark.xfail(strict=True, reason="the row-sum store is keyed by the packed set q "
-                   "itself: Python's int hash is q mod 2^61 − 1, so fields p and p + 61 "
-                   "hash alike and a certificate with n >= 122 nodes can make its sets "
-                   "collide (dict probes ~ the store's size per look-up, charged one "
-                   "step); proposed: key by q.to_bytes(...) (SipHash, salted per "
-                   "process) in row_sum and capped's inline look-up")
 def test_the_row_sum_store_keys_do_not_collide_by_construction():
     """2000 packed subsets of N(0) that differ only in which node of each pair of
     fields (p, p + 61) they hold: their store keys have (nearly) distinct hashes, so a
