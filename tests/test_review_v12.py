@@ -229,3 +229,17 @@ def test_fast_path_on_hostile_clouds_is_the_clipping(name, d, n, F, monkeypatch)
     K = _same_as_clipping(X, F, monkeypatch)
     assert taken and taken[0] is not None
     assert K.exact_vertices
+
+
+def test_row_top_is_an_upper_bound_where_a_point_overflows():
+    """A row whose value at a point is inf − inf in floats (products ~2e308 of both
+    signs; exactly 2e308 − 2e308 + 1 = 1): the NaN was dropped by max, the row bounded
+    by −inf (alone) or by a smaller point's −1 (failed before row_top's guard: +inf
+    for every row where k·max|A|·max|V| + max|b| ≥ 1e307). Outside the fast path's
+    window (|coordinates| ≤ 2^32), where a NaN vertex also makes its row bound NaN."""
+    A, b = np.array([[2.0, -2.0]]), np.array([-1.0])
+    for V in (np.array([[1e308, 1e308]]), np.array([[1e308, 1e308], [0.0, 1.0]])):
+        assert _exact_tops(A, b, V) == [1]
+        with np.errstate(over="ignore"):
+            for parallel in (True, False):
+                assert row_top(A, b, V, 0.0, parallel)[0] >= 0

@@ -740,7 +740,14 @@ def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float,
     lies surely below the hyperplane contribute their ball's bound, the others their
     points' values. ``floor``: the underflow
     term of these products. ``parallel`` False: on the calling thread only, without
-    the GIL (for a caller that works meanwhile)."""
+    the GIL (for a caller that works meanwhile). Where k · max|A| · max|V| + max|b|
+    is not below 1e307 (or not finite) a value may overflow — inf − inf is NaN, which
+    max drops — and every row gets +inf instead (the fast path's data, |v| ≤ 2^32,
+    never come near)."""
+    big = (A.shape[1] * float(np.abs(A).max(initial=0.0)) * float(np.abs(V).max(initial=0.0))
+           + float(np.abs(b).max(initial=0.0)))
+    if len(V) and not big < 1e307:
+        return np.full(A.shape[0], np.inf)
     order, starts, centres, radii = ball_chunks(V)
     W = np.ascontiguousarray(V[order])
     A = np.ascontiguousarray(A)
