@@ -587,8 +587,9 @@ def ball_chunks(V: np.ndarray, leaf: int = 32
     """The rows of V grouped into chunks of ≤ ``leaf`` nearby points (a k-d split at the
     median of the widest coordinate, :func:`_kd_split`): (order, starts, centres,
     radii) — chunk c is V[order[starts[c]:starts[c+1]]], within ``radii[c]`` (the
-    float max of ‖v − centre‖, a few ulps from the exact one) of ``centres[c]`` (its
-    mean)."""
+    float max of ‖v − centre‖: a few ulps from the exact one where the squares do not
+    underflow, else up to √k·2^-537 below it — :func:`_chunk_top` allows for both) of
+    ``centres[c]`` (its mean)."""
     order = np.arange(len(V))
     cuts = np.empty(len(V) + 1, dtype=np.int64)
     count = _kd_split(np.ascontiguousarray(V, dtype=np.float64), leaf, order, cuts)
