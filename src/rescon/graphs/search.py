@@ -475,8 +475,10 @@ class CostPartRun:
         return float(self.run.progress[0])
 
     def pair(self) -> tuple[frozenset[int], frozenset[int]] | None:
-        """The last pair this run found (cost ``best`` right after it found it), None
-        while it found none cheaper than the incumbent it started with."""
+        """The last pair this run found (cost at most ``best`` right after it found it:
+        the charged engine may count a charged node the pair in fact leaves unreached;
+        callers recompute the cost), None while it found none cheaper than the incumbent
+        it started with."""
         if self.best >= self.upper:
             return None
         return _bits(self.run.ubuf[self.K.CB_W1]), _bits(self.run.ubuf[self.K.CB_W2])
