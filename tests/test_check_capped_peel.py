@@ -14,10 +14,8 @@ import numpy as np
 import pytest
 
 from rescon.graphs._charged_kernels import capped_core
-from rescon.graphs.charged import charged_tree
-from rescon.graphs.indexed import index_graph
-from tests.test_checker import C, digraph, in_masks, rand_edges, rho_and_s
-from tests.test_cost_tree_capped import _cert, _states
+from tests.test_checker import C, in_masks, rand_edges
+from tests.test_cost_tree_capped import _cert, _states, random_charged_trees
 
 pytestmark = pytest.mark.usefixtures("fresh_facts")
 
@@ -85,15 +83,7 @@ def test_emptying_the_row_sums_changes_no_verdict(monkeypatch):
     for limit in (C.ROW_SUMS, 2):
         monkeypatch.setattr(C, "ROW_SUMS", limit)
         out = []
-        for seed in range(12):
-            rng = random.Random(seed)
-            n = rng.randint(6, 8)
-            ig = index_graph(digraph(n, rand_edges(rng, n, rng.choice([0.5, 0.7, 0.9]))))
-            r, s_star = rho_and_s(n, in_masks(n, ig.edges()))
-            if not r:
-                continue
-            s = min(s_star, 3)
-            tree = list(charged_tree(ig, r, s))
+        for ig, _n, r, s, tree in random_charged_trees(range(12)):
             out.append(C.check(_cert(ig, r, s, tree)).verdict)
             k = next((k for k, t in enumerate(tree) if t >= 0), None)
             if k is not None:

@@ -160,20 +160,25 @@ def _cert(ig, r, s, tree, order=None):
                               "charged_tree": list(tree)}}
 
 
+def random_charged_trees(seeds):
+    """(ig, n, r, s, tree) per seed whose random digraph (n = 6–8, p 0.5–0.9) has ρ ≥ 1:
+    the charged tree recorded at r = ρ, s = min(s*, 3)."""
+    for seed in seeds:
+        rng = random.Random(seed)
+        n = rng.randint(6, 8)
+        ig = index_graph(digraph(n, rand_edges(rng, n, rng.choice([0.5, 0.7, 0.9]))))
+        r, s_star = rho_and_s(n, in_masks(n, ig.edges()))
+        if r:
+            s = min(s_star, 3)
+            yield ig, n, r, s, list(charged_tree(ig, r, s))
+
+
 def test_tampered_capped_leaves_are_invalid():
     """Recorded trees with capped leaves: each such leaf with its members swapped
     (i > j), naming a node outside S or moved onto a branch is invalid; a branch turned
     into any capped leaf is invalid (the recorder took every capped leaf that held)."""
     tampered = 0
-    for seed in range(40):
-        rng = random.Random(seed)
-        n = rng.randint(6, 8)
-        ig = index_graph(digraph(n, rand_edges(rng, n, rng.choice([0.5, 0.7, 0.9]))))
-        r, s_star = rho_and_s(n, in_masks(n, ig.edges()))
-        if not r:
-            continue
-        s = min(s_star, 3)
-        tree = list(charged_tree(ig, r, s))
+    for ig, n, r, s, tree in random_charged_trees(range(40)):
         assert C.check(_cert(ig, r, s, tree)).verdict == "valid"
         capped = [k for k, t in enumerate(tree) if t <= -5]
         for k in capped[:3]:
