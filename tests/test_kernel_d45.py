@@ -18,6 +18,13 @@ from rescon.geometry.halfspaces import valid_halfspaces
 from rescon.geometry.polytope import ExactPolytope, clip_to_fixpoint
 
 
+def bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
+    """fastpath._basis_array of the lists of rows Ts, as lists."""
+    sizes = np.array([len(T) for T in Ts], dtype=np.int64)
+    flat = np.array([h for T in Ts for h in T], dtype=np.int64)
+    return fastpath._basis_array(H, flat, sizes, k).tolist()
+
+
 def _halfspaces(X, F):
     P = exact_points(np.asarray(X, float))
     hull = affine_hull(P)
@@ -79,8 +86,8 @@ def test_fast_path_refuses_a_missing_non_simple_vertex():
     P = fastpath._certify(H, 4, unit, first, facets)
     vi = next(i for i, t in enumerate(P.tight) if bin(t).count("1") > 4)
     target = _primitive_verts(P)[vi]
-    bases = fastpath._bases(H, [[int(first[i]) for i in f] for f in facets], 4)
-    keep = [f for f, v in zip(facets, fastpath._solve_all(H, bases, 4), strict=True)
+    chosen = bases(H, [[int(first[i]) for i in f] for f in facets], 4)
+    keep = [f for f, v in zip(facets, fastpath._solve_all(H, chosen, 4), strict=True)
             if v != target]
     assert len(keep) < len(facets)
     assert fastpath._certify(H, 4, unit, first, keep) is None
@@ -155,7 +162,7 @@ def test_extra_rows_of_a_merged_proposal_are_decided_exactly():
     stranger = next(i for i in range(len(first))
                     if i not in facets[simple] and not any(
                         i in f for f, v in zip(facets, fastpath._solve_all(
-                            H, fastpath._bases(H, [[int(first[j]) for j in f]
+                            H, bases(H, [[int(first[j]) for j in f]
                                                    for f in facets], 4), 4),
                         strict=True) if v == vertex))
     lied = [list(f) for f in facets]

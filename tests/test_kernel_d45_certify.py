@@ -17,7 +17,7 @@ from rescon.geometry import fastpath
 from rescon.geometry import kernel as km
 from rescon.geometry.exact import nullspace_exact
 from rescon.geometry.halfspaces import _int_det
-from tests.test_kernel_d45 import _both_paths, _halfspaces, _primitive_verts
+from tests.test_kernel_d45 import _both_paths, _halfspaces, _primitive_verts, bases
 from tests.test_kernels_d45_fast import _cloud, _public
 
 
@@ -201,7 +201,7 @@ def test_bases_pick_independent_rows_of_each_proposal():
         Ts = [[0, 1, 2, *rng.choice(np.arange(3, 40), size=int(rng.integers(k - 1, k + 5)),
                                     replace=False).tolist()] for _ in range(60)]
         Ts += [rng.choice(40, size=k, replace=False).tolist() for _ in range(5)]
-        got = fastpath._bases(H, Ts, k)
+        got = bases(H, Ts, k)
         for T, B in zip(Ts, got, strict=True):
             assert len(set(B)) == k and set(B) <= set(T)
             assert len(T) > k or B == T

@@ -341,12 +341,6 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     return P
 
 
-def _bitsets(vs: np.ndarray, hs: np.ndarray, n: int, width: int) -> list[int]:
-    """For each of n vertices the bitset (a Python int) of the positions hs[i] < width
-    paired with it (vs[i]): :func:`_tight_sets`."""
-    return _tight_sets(vs, hs, n, width)[0]
-
-
 def _tight_sets(vs: np.ndarray, hs: np.ndarray, n: int, width: int
                 ) -> tuple[list[int], tuple[np.ndarray, np.ndarray]]:
     """For each of n vertices the bitset (a Python int) of the positions hs[i] < width
@@ -538,13 +532,6 @@ def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
         return None
     V = np.array(verts, dtype=np.int64)[vs]
     return (A.astype(np.int64) * V[:, 1:]).sum(axis=1) - b.astype(np.int64) * V[:, 0]
-
-
-def _bases(H, Ts: list[list[int]], k: int) -> list[list[int]]:
-    """:func:`_basis_array` of the lists of rows Ts, as lists."""
-    sizes = np.array([len(T) for T in Ts], dtype=np.int64)
-    flat = np.array([h for T in Ts for h in T], dtype=np.int64)
-    return _basis_array(H, flat, sizes, k).tolist()
 
 
 def _basis_array(H, flat: np.ndarray, sizes: np.ndarray, k: int) -> np.ndarray:
