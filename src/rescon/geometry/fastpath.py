@@ -336,6 +336,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
         P.b.append(b)
     P.verts = verts
     P.tight = tight
+    P.pairs = pairs
     P.edges = edges
     P._fv = Vx
     return P

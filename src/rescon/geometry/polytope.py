@@ -60,10 +60,12 @@ def tight_pairs(tight: list[int]) -> tuple[np.ndarray, np.ndarray]:
     return at // width, at % width * 8 + (bits & 7)
 
 
-def members_of(tight: list[int]) -> dict[int, list[int]]:
+def members_of(tight: list[int], pairs: tuple[np.ndarray, np.ndarray] | None = None
+               ) -> dict[int, list[int]]:
     """Row → the vertices whose bitset ``tight`` holds it, increasing (rows in
-    increasing order, only those set somewhere)."""
-    vs, hs = tight_pairs(tight)
+    increasing order, only those set somewhere). ``pairs``: :func:`tight_pairs` of
+    ``tight`` when known."""
+    vs, hs = tight_pairs(tight) if pairs is None else pairs
     if not len(hs):
         return {}
     hs, vs = np.divmod(np.sort(hs * len(tight) + vs), len(tight))  # by row, then vertex
@@ -95,6 +97,9 @@ class ExactPolytope:
     _fv: np.ndarray | None = field(default=None, repr=False)  # float vertices (cache)
     work: int = 0  # estimated steps spent clipping so far (:mod:`._budget`)
     edges: list[list[int]] | None = None  # per vertex its neighbours, when known (fast path)
+    #: :func:`tight_pairs` of ``tight``, when its builder has them (fast path); a clip
+    #: that changes ``tight`` drops them
+    pairs: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def box(cls, lo: list[int], hi: list[int], unit: int = 1) -> ExactPolytope:
@@ -176,7 +181,7 @@ class ExactPolytope:
             self.farkas = self._farkas(a, b, self.slack(a, b))
             self.a.append(a)
             self.b.append(b)
-            self.verts, self.tight, self._fv = [], [], None
+            self.verts, self.tight, self._fv, self.pairs = [], [], None, None
             return True
 
         def s_of(i: int) -> int:
@@ -212,7 +217,7 @@ class ExactPolytope:
         fv = self._float_array()
         self.verts = [self.verts[i] for i in keep] + new_v
         self.tight = [self.tight[i] | (bit if sign[i] == 0 else 0) for i in keep] + new_t
-        self.edges = None
+        self.edges = self.pairs = None
         self._fv = np.vstack([fv[keep], np.array(new_f, dtype=np.float64).reshape(-1, self.k)])
         self.a.append(a)
         self.b.append(b)
@@ -304,8 +309,8 @@ class ExactPolytope:
 
     def incidence(self) -> dict[int, list[int]]:
         """constraint → the vertices tight on it (only constraints tight somewhere):
-        :func:`members_of`."""
-        return members_of(self.tight)
+        :func:`members_of` (of ``pairs`` when known)."""
+        return members_of(self.tight, self.pairs)
 
 
 #: a prime below 2^31: a product of two residues fits an int64

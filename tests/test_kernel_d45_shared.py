@@ -1,0 +1,78 @@
+"""Work the d = 4-5 fast path shares instead of redoing (issue 13 §3): the k-subsets
+kept between calls of one size, and the fast path's tight pairs read by the incidence
+— each against the computation it replaces."""
+
+from __future__ import annotations
+
+import itertools
+from math import comb
+
+import numpy as np
+import pytest
+
+from rescon.geometry import _candidates
+from rescon.geometry.polytope import members_of, tight_pairs
+from tests.test_kernel_d45 import _both_paths, _halfspaces
+from tests.test_kernel_d45_around2 import _rows
+
+
+@pytest.mark.parametrize(("n", "k"), [(7, 1), (9, 3), (12, 4), (10, 5)])
+def test_kept_subsets_are_every_k_subset_in_order_and_read_only(n, k):
+    count = comb(n, k)
+    S = _candidates.lex_subsets(n, k, count)
+    assert S.tolist() == [list(c) for c in itertools.combinations(range(n), k)]
+    assert np.array_equal(S, _candidates.k_subsets(n, k, count))
+    assert _candidates.lex_subsets(n, k, count) is S  # kept for the next call
+    with pytest.raises(ValueError, match="read-only"):
+        S[0, 0] = 1
+
+
+def _clouds():
+    rng = np.random.default_rng(5)
+    yield rng.normal(size=(24, 4)), 3
+    yield rng.integers(-3, 4, size=(22, 4)).astype(float), 2  # ties, coplanar points
+    yield rng.normal(size=(16, 5)), 1
+    yield 1.0 + 1e-13 * rng.normal(size=(20, 4)), 2  # converged states
+
+
+@pytest.mark.parametrize("case", range(4))
+def test_valid_halfspaces_from_kept_subsets_equal_freshly_enumerated(case, monkeypatch):
+    X, F = list(_clouds())[case]
+    kept = [_rows(_halfspaces(X, F)[0]) for _ in range(2)]  # the second call reuses
+    calls = []
+
+    def fresh_subsets(n, k, count):
+        calls.append((n, k))
+        return _candidates.k_subsets(n, k, count)  # a new, writable array
+
+    monkeypatch.setattr(_candidates, "lex_subsets", fresh_subsets)
+    assert kept[0] == kept[1] == _rows(_halfspaces(X, F)[0]) and kept[0]
+    assert calls  # the compiled scan ran (not the small-input numpy one)
+
+
+@pytest.mark.parametrize("case", range(3))  # the converged cloud needs the centring
+def test_fast_path_pairs_are_the_tight_pairs_and_give_the_same_incidence(case):
+    X, F = list(_clouds())[case]
+    fast, box, _, _, _ = _both_paths(X, F)
+    assert fast is not None
+    vs, hs = tight_pairs(fast.tight)
+    assert np.array_equal(fast.pairs[0], vs) and np.array_equal(fast.pairs[1], hs)
+    assert fast.incidence() == members_of(fast.tight)
+    assert box.pairs is None  # the clipping path has none
+
+
+def test_a_clip_drops_the_pairs():
+    X, F = list(_clouds())[0]
+    fast, *_ = _both_paths(X, F)
+    V = fast.float_vertices()
+    j = int(np.argmax(V[:, 0]))
+    w, y0, *_ = fast.verts[j]
+    # y_0 ≤ the float vertex's coordinate floored: cuts the vertex j off
+    assert fast.clip((1,) + (0,) * (fast.k - 1), y0 // w - 1)
+    assert fast.pairs is None
+    assert fast.incidence() == members_of(fast.tight)
+    # a clip that empties the polytope drops them too
+    fast2, *_ = _both_paths(X, F)
+    lo = min(v[1] // v[0] for v in fast2.verts)
+    assert fast2.clip((1,) + (0,) * (fast2.k - 1), lo - 10**6)
+    assert fast2.pairs is None and fast2.incidence() == {}
