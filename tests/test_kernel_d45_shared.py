@@ -13,7 +13,7 @@ import pytest
 from rescon.geometry import _candidates
 from rescon.geometry.polytope import members_of, tight_pairs
 from tests.test_kernel_d45 import _both_paths, _halfspaces
-from tests.test_kernel_d45_around2 import _rows
+from tests.test_kernel_d45_around2 import KINDS, _points, _rows
 
 
 @pytest.mark.parametrize(("n", "k"), [(7, 1), (9, 3), (12, 4), (10, 5)])
@@ -76,3 +76,32 @@ def test_a_clip_drops_the_pairs():
     lo = min(v[1] // v[0] for v in fast2.verts)
     assert fast2.clip((1,) + (0,) * (fast2.k - 1), lo - 10**6)
     assert fast2.pairs is None and fast2.incidence() == {}
+
+
+@pytest.mark.parametrize("workers", [2, 3])
+@pytest.mark.parametrize(("k", "m"), [(3, 40), (4, 22), (5, 17)])
+@pytest.mark.parametrize("kind", KINDS)
+def test_threaded_scan_equals_the_parallel_loop(kind, k, m, workers):
+    """:func:`_candidates.classify` on threads taking ranges as they come gives the
+    arrays of numba's parallel loop (and of one thread), the exact-float case (c_err =
+    0: ties, degenerate subsets) and the rounding-bound one (c_err > 0) alike."""
+    Y = _points(kind, k, m, workers)
+    W = np.random.default_rng([m, workers]).integers(1, 3, size=m)
+    S = _candidates.lex_subsets(m, k, comb(m, k))
+    assert len(S) >= _candidates.PARALLEL_MIN_SUBSETS  # the threaded branch runs
+    for c_err, F in [(0.0, 1), (1e-12, 2)]:
+        want = _candidates.classify_subsets(Y, W, S, c_err, F, 1e-300)
+        for got in (_candidates.classify(Y, W, S, c_err, F, 1e-300, workers),
+                    _candidates.classify(Y, W, S, c_err, F, 1e-300, 1)):
+            assert all(np.array_equal(a, b) for a, b in zip(want, got, strict=True))
+
+
+def test_a_failing_range_raises_from_the_threaded_scan(monkeypatch):
+    def broken(*args):
+        raise RuntimeError("range failed")
+
+    monkeypatch.setattr(_candidates, "_classify_range", broken)
+    Y = _points("normal", 4, 22, 0)
+    S = _candidates.lex_subsets(22, 4, comb(22, 4))
+    with pytest.raises(RuntimeError, match="range failed"):
+        _candidates.classify(Y, np.ones(22, dtype=np.int64), S, 1e-12, 1, 0.0, 2)
