@@ -105,3 +105,46 @@ def test_a_failing_range_raises_from_the_threaded_scan(monkeypatch):
     S = _candidates.lex_subsets(22, 4, comb(22, 4))
     with pytest.raises(RuntimeError, match="range failed"):
         _candidates.classify(Y, np.ones(22, dtype=np.int64), S, 1e-12, 1, 0.0, 2)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_near_pairs_on_threads_equal_one_thread_and_brute_force(seed, monkeypatch):
+    """Enough rows × chunks for the threaded passes (rows with more near points than
+    NEAR_KEPT among them, scanned again): the pairs of one thread, and every slack's."""
+    from rescon.geometry._candidates import NEAR_KEPT, near_pairs
+
+    rng = np.random.default_rng(seed)
+    k, nv, m = 4, 900, 1000
+    V = rng.uniform(-1.0, 1.0, size=(nv, k))
+    V[: 2 * NEAR_KEPT, 0] = 2.0  # on the hyperplane x_0 = 2 of row 0
+    A = rng.normal(size=(m, k))
+    A[0] = [1, 0, 0, 0]
+    b = (A @ V.T).max(axis=1) + rng.uniform(0.0, 1.0, m)
+    b[0] = 2.0
+    b[1::3] = (A[1::3] @ V.T).max(axis=1)  # rows touching their highest point
+    A_abs, b_abs = np.abs(A) * 1.01, np.abs(b) * 1.01
+    c_err, c = 1e-12, 32 * 2.0**-53
+    M = np.abs(V).max()
+    coarse = c_err * (A_abs.sum(axis=1) * M + b_abs) + c * (np.abs(A).sum(axis=1) * M
+                                                            + np.abs(b))
+    S = A @ V.T - b[:, None]
+    bound = c_err * (A_abs @ np.abs(V).T + b_abs[:, None]) + c * (
+        np.abs(A) @ np.abs(V).T + np.abs(b)[:, None])
+    want = sorted(zip(*np.nonzero((np.abs(S) <= coarse[:, None]) & ~(np.abs(S) > bound)),
+                      strict=True))
+    ran = []
+    threaded = _candidates.on_threads
+
+    def spy(scan, total, chunks, workers=None):
+        ran.append(chunks)
+        threaded(scan, total, chunks, workers)
+
+    monkeypatch.setattr(_candidates, "on_threads", spy)
+    got_r, got_v = near_pairs(A, b, A_abs, b_abs, V, coarse, c_err, c, 0.0)
+    assert ran == [64, 64]  # both passes on threads
+    monkeypatch.setattr(_candidates, "on_threads",
+                        lambda scan, total, chunks, workers=None: threaded(scan, total, 1))
+    one_r, one_v = near_pairs(A, b, A_abs, b_abs, V, coarse, c_err, c, 0.0)
+    assert got_r.tolist() == one_r.tolist() and got_v.tolist() == one_v.tolist()
+    assert sorted(zip(got_r.tolist(), got_v.tolist(), strict=True)) == [
+        (int(r), int(v)) for r, v in want]

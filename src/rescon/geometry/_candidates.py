@@ -242,25 +242,34 @@ def classify(Y, W, subsets, c_err, F, floor=0.0, workers=None):
     M = float(np.abs(Y).max()) if Y.size else 0.0
     YT = np.ascontiguousarray(Y.T)
     none = np.empty((0, k))
+    chunks = CLASSIFY_CHUNKS if count >= PARALLEL_MIN_SUBSETS else 1
+
+    def scan(lo: int, hi: int) -> None:
+        _classify_range(Y, YT, W, subsets, c_err, F, floor, M, lo, hi, *out, none, none)
+
+    on_threads(scan, count, chunks, workers)
+    return out
+
+
+def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> None:
+    """scan(lo, hi) over ``chunks`` consecutive ranges covering range(total), on
+    ``workers`` threads (default: numba's thread count) each taking the next range
+    when it finishes one — for compiled scans without the GIL whose ranges write
+    disjoint outputs. On the calling thread alone for one chunk or one worker. A
+    range's exception is raised here."""
     if workers is None:
         import numba
 
         workers = numba.get_num_threads()
-    chunks = CLASSIFY_CHUNKS if count >= PARALLEL_MIN_SUBSETS and workers > 1 else 1
-
-    def scan(c: int) -> None:
-        _classify_range(Y, YT, W, subsets, c_err, F, floor, M, count * c // chunks,
-                        count * (c + 1) // chunks, *out, none, none)
-
-    if chunks == 1:
-        scan(0)
-        return out
+    if chunks <= 1 or workers <= 1:
+        scan(0, total)
+        return
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        for done in [pool.submit(scan, c) for c in range(chunks)]:
-            done.result()  # re-raises a worker's exception
-    return out
+        for done in [pool.submit(scan, total * c // chunks, total * (c + 1) // chunks)
+                     for c in range(chunks)]:
+            done.result()
 
 
 @njit(cache=True)
@@ -851,15 +860,6 @@ def _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_
             offsets[h] = at
 
 
-@njit(cache=True, parallel=True)
-def _near_parallel(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
-                   floor, fill, offsets, out_r, out_v, first):
-    m = A.shape[0]
-    for t in prange(64):
-        _near_range(A, b, A_abs, b_abs, W, starts, centres, radii, norms, coarse, c_err, c,
-                    floor, m * t // 64, m * (t + 1) // 64, fill, offsets, out_r, out_v, first)
-
-
 def near_pairs(A, b, A_abs, b_abs, V, coarse, c_err: float, c: float, floor: float
                ) -> tuple[np.ndarray, np.ndarray] | None:
     """The pairs (row, point of V) whose float slack s = a·v − b lies within its
@@ -898,8 +898,9 @@ NEAR_KEPT = 96
 
 def _near_run(common: tuple, parallel: bool, fill: bool, offsets, out_r, out_v, first
               ) -> None:
-    """One pass of :func:`near_pairs` over every row (threads for large inputs)."""
-    if parallel:
-        _near_parallel(*common, fill, offsets, out_r, out_v, first)
-    else:
-        _near_range(*common, 0, len(offsets), fill, offsets, out_r, out_v, first)
+    """One pass of :func:`near_pairs` over every row (for large inputs on threads taking
+    64 ranges of rows as they come: :func:`on_threads`)."""
+    def scan(lo: int, hi: int) -> None:
+        _near_range(*common, lo, hi, fill, offsets, out_r, out_v, first)
+
+    on_threads(scan, len(offsets), 64 if parallel else 1)
