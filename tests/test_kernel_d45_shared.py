@@ -148,3 +148,27 @@ def test_near_pairs_on_threads_equal_one_thread_and_brute_force(seed, monkeypatc
     assert got_r.tolist() == one_r.tolist() and got_v.tolist() == one_v.tolist()
     assert sorted(zip(got_r.tolist(), got_v.tolist(), strict=True)) == [
         (int(r), int(v)) for r, v in want]
+
+
+def test_row_top_on_threads_equals_one_thread(monkeypatch):
+    """Enough rows × chunks for the threaded pass: the bounds of the calling thread
+    alone, bit for bit, and never below the true maxima."""
+    from rescon.geometry._candidates import row_top
+
+    rng = np.random.default_rng(3)
+    V = rng.normal(size=(1200, 4))
+    A = rng.normal(size=(900, 4))
+    b = (A @ V.T).max(axis=1) + rng.uniform(-0.1, 0.5, 900)
+    ran = []
+    threaded = _candidates.on_threads
+
+    def spy(scan, total, chunks, workers=None):
+        ran.append(chunks)
+        threaded(scan, total, chunks, workers)
+
+    monkeypatch.setattr(_candidates, "on_threads", spy)
+    got = row_top(A, b, V, 0.0)
+    one = row_top(A, b, V, 0.0, parallel=False)
+    assert ran == [64, 1]
+    assert np.array_equal(got, one)
+    assert (got >= (A @ V.T - b[:, None]).max(axis=1) - 1e-12).all()

@@ -754,15 +754,6 @@ def _chunked_max_range(A, b, W, starts, centres, radii, groups, g_centres, g_rad
         out[h] = best
 
 
-@njit(cache=True, parallel=True)
-def _chunked_max_parallel(A, b, W, starts, centres, radii, groups, g_centres, g_radii,
-                          norms, floor, out):
-    m = A.shape[0]
-    for c in prange(64):
-        _chunked_max_range(A, b, W, starts, centres, radii, groups, g_centres, g_radii,
-                           norms, floor, m * c // 64, m * (c + 1) // 64, out)
-
-
 #: row_top groups this many consecutive chunks (neighbours in the k-d tree) under one
 #: ball, tested first
 GROUP_CHUNKS = 8
@@ -789,8 +780,9 @@ def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float,
     chunks (:func:`ball_groups`), then chunks of V (:func:`ball_chunks`) whose ball
     lies surely below the hyperplane contribute their ball's bound, the others their
     points' values. ``floor``: the underflow
-    term of these products. ``parallel`` False: on the calling thread only, without
-    the GIL (for a caller that works meanwhile). Where k · max|A| · max|V| + max|b|
+    term of these products. ``parallel``: for large inputs on threads taking 64 ranges
+    of rows as they come (:func:`on_threads`); False: on the calling thread only,
+    without the GIL (for a caller that works meanwhile). Where k · max|A| · max|V| + max|b|
     is not below 1e307 (or not finite) a value may overflow — inf − inf is NaN, which
     max drops — and every row gets +inf instead (the fast path's data, |v| ≤ 2^32,
     never come near)."""
@@ -805,10 +797,11 @@ def row_top(A: np.ndarray, b: np.ndarray, V: np.ndarray, floor: float,
     norms = np.sqrt((A**2).sum(axis=1))
     out = np.empty(A.shape[0])
     balls = (starts, centres, radii, *ball_groups(W, starts, GROUP_CHUNKS), norms, floor)
-    if parallel and A.shape[0] * (len(starts) - 1) >= 20_000:
-        _chunked_max_parallel(A, b, W, *balls, out)
-    else:
-        _chunked_max_range(A, b, W, *balls, 0, A.shape[0], out)
+    def scan(lo: int, hi: int) -> None:
+        _chunked_max_range(A, b, W, *balls, lo, hi, out)
+
+    on_threads(scan, A.shape[0], 64 if parallel and A.shape[0] * (len(starts) - 1) >= 20_000
+               else 1)
     return out
 
 
