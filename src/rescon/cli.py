@@ -61,10 +61,10 @@ def _progress(args: argparse.Namespace) -> bool | None:
 
 
 def _emit(result: dict[str, Any], as_json: bool, lines: list[str]) -> None:
-    if as_json:
-        print(json.dumps(result))
-    else:
-        print("\n".join(lines))
+    try:
+        print(json.dumps(result) if as_json else "\n".join(lines), flush=True)
+    except BrokenPipeError:
+        raise _StdoutClosed from None
 
 
 
@@ -537,12 +537,68 @@ def _one_line(text: str) -> str:
     return " ".join(text.split()) or "(no message)"
 
 
+def _numba_cache() -> None:
+    """Give numba a cache directory when it would find none, before any rescon kernel
+    is imported: with the package in a read-only place and no writable user cache
+    (a container run as another user with HOME=/, say) numba refuses every
+    ``cache=True`` function at import with a RuntimeError. Asks numba's own cache
+    locators, in its order, about a file of the package; when none can cache there,
+    sets ``NUMBA_CACHE_DIR`` (the config and the environment, for worker processes)
+    to ``rescon-numba-<uid>`` in the temporary directory — used only when it is a
+    directory of this user that no one else may write (numba's cache holds pickles),
+    else a fresh private one. A user's own ``NUMBA_CACHE_DIR`` is kept; any surprise
+    from numba's internals leaves numba to its own behaviour."""
+    import os
+
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    try:
+        import stat
+        import tempfile
+
+        from numba.core import caching, config
+
+        probe = str(Path(__file__).parent / "graphs" / "_kernels.py")
+        if any(cls.from_function(_numba_cache, probe) is not None
+               for cls in caching.CacheImpl._locator_classes):
+            return
+        path = None
+        if hasattr(os, "getuid"):
+            path = os.path.join(tempfile.gettempdir(), f"rescon-numba-{os.getuid()}")
+            try:
+                os.mkdir(path, 0o700)
+            except FileExistsError:
+                pass
+            st = os.lstat(path)
+            if (not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid()
+                    or st.st_mode & 0o022):
+                path = None
+        path = path or tempfile.mkdtemp(prefix="rescon-numba-")
+        config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"] = path
+    except Exception:  # noqa: BLE001 (a numba without these internals: its own behaviour)
+        return
+
+
+class _StdoutClosed(Exception):
+    """stdout was closed under us (``rescon ... | head``): not an error to report."""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rescon`` console script; returns the exit status."""
     args = _parser().parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
+    if func is not _cmd_check:  # the checker is standard library only
+        _numba_cache()
     try:
         return func(args)
+    except _StdoutClosed:  # like a program killed by SIGPIPE, silently
+        import os
+
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return 141
     except (RESCONError, OSError) as exc:
         print(f"rescon: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2
