@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Hashable
+from fractions import Fraction
 from dataclasses import dataclass
 
 import networkx as nx
@@ -273,7 +274,9 @@ def solve_exact(M, rhs):
     None if inconsistent or the columns are dependent. Independent of rescon: the
     review tests' brute-force oracles (hull membership, Tukey depth) use it."""
     rows, cols = len(M), len(M[0])
-    A = [list(M[i]) + [rhs[i]] for i in range(rows)]
+    # Fractions throughout: an int pivot row (the 1s of a convex combination) divided
+    # by itself gave floats, and the answer was rounded or overflowed
+    A = [[Fraction(v) for v in M[i]] + [Fraction(rhs[i])] for i in range(rows)]
     for c in range(cols):
         p = next((i for i in range(c, rows) if A[i][c]), None)
         if p is None:

@@ -275,19 +275,28 @@ class ValidityMonitor:
         rest = np.flatnonzero(~self._initial_rows(states))
         rest = rest[~self.surely_inside(states[rest])]
         if rest.size and self._edges is not None:
-            S, bound = self._slacks(states[rest])
             dist, err = self.edge_distances(states[rest])
-            fast = (S > bound).any(axis=1) & np.isfinite(err)
+            fast = self._surely_outside(states[rest]) & np.isfinite(err)
             out[rest[fast]] = dist[fast]
             rest = rest[~fast]
         if rest.size and self._triangles is not None:
-            S, bound = self._slacks(states[rest])
             dist, err = self.triangle_distances(states[rest])
-            fast = (S > bound).any(axis=1) & (dist > err)
+            fast = self._surely_outside(states[rest]) & (dist > err)
             out[rest[fast]] = dist[fast]
             rest = rest[~fast]
         for i in rest:
             out[i] = self.distance(states[i])
+        return out
+
+    def _surely_outside(self, states: np.ndarray) -> np.ndarray:
+        """Rows of ``states`` that a facet's float filter proves outside the hull
+        (:meth:`surely_inside`'s bound), in blocks of at most BLOCK slacks: O(BLOCK)
+        memory, not (rows × facets) — 3.2 GB for 10 000 states outside a 10 000-gon."""
+        out = np.zeros(len(states), dtype=bool)
+        block = max(1, BLOCK // len(self._rows[1]))
+        for s in range(0, len(states), block):
+            S, bound = self._slacks(states[s:s + block])
+            out[s:s + block] = (S > bound).any(axis=1)
         return out
 
     def _in_fan(self, X: np.ndarray) -> np.ndarray:
