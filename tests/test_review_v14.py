@@ -172,3 +172,13 @@ def test_cli_redundancy_without_cvxpy_names_the_extra(tmp_path, monkeypatch, cap
     assert main(["redundancy", str(costs), "--r", "1", "--json"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "cvxpy" in err and "install" in err
+
+
+def test_pyproject_license_is_an_spdx_string():
+    """Failed before: ``license = {text = "MIT"}``, which setuptools (84 here) warns is
+    deprecated and will refuse after 2027-02-18; the SPDX string needs setuptools ≥ 77."""
+    import tomllib
+
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert meta["project"]["license"] == "MIT"
+    assert "setuptools>=77" in meta["build-system"]["requires"]
