@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Hashable
-from fractions import Fraction
 from dataclasses import dataclass
+from fractions import Fraction
 
 import networkx as nx
 import pytest

@@ -385,8 +385,9 @@ class ValidityMonitor:
         The bound is inf beyond 1e±100 (squares may under- or overflow)."""
         A, B, C = self._triangles
         rows = []
-        for s in range(0, len(X), 256):
-            rows.append(_closest_on_triangles(X[s:s + 256], A, B, C))
+        block = max(1, BLOCK // 16 // len(A))  # ~20 (rows, triangles, 3) temporaries
+        for s in range(0, len(X), block):
+            rows.append(_closest_on_triangles(X[s:s + block], A, B, C))
         Y = np.concatenate(rows) if rows else np.empty((0, 3))
         with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
             n = X - Y
@@ -394,7 +395,10 @@ class ValidityMonitor:
             V = self.hull.vertices
             M = np.maximum(np.abs(X).max(axis=1), np.abs(V).max())
             n1 = np.abs(n).sum(axis=1)
-            low = ((X * n).sum(axis=1) - (n @ V.T).max(axis=1) - 8 * UNIT_ROUNDOFF * n1 * M)
+            vb = max(1, BLOCK // len(V))  # max_v n·v in blocks: no (rows × vertices)
+            top = np.concatenate([(n[s:s + vb] @ V.T).max(axis=1)
+                                  for s in range(0, len(n), vb)] or [np.empty(0)])
+            low = (X * n).sum(axis=1) - top - 8 * UNIT_ROUNDOFF * n1 * M
             low = low / (dist * (1 + 4 * UNIT_ROUNDOFF)) * (1 - 4 * UNIT_ROUNDOFF)
             high = dist * (1 + 4 * UNIT_ROUNDOFF) + 64 * UNIT_ROUNDOFF * M
             err = np.maximum(high - dist, dist - low) * (1 + 4 * UNIT_ROUNDOFF)
