@@ -18,18 +18,18 @@ from rescon.cli import main
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 
-# numba's cache locators refuse every directory outside the temporary directory: a
+# every directory outside the temporary directory is read-only for numba's cache: a
 # package installed read-only and a HOME without a writable cache (a container run as
-# another user with HOME=/)
+# another user with HOME=/). numba (and the CLI's guard) test a directory by creating a
+# temporary file in it, so refusing that outside the temporary directory simulates it.
 _NO_CACHE = textwrap.dedent("""
     import sys, tempfile
-    from numba.core import caching
-    _ensure = caching._CacheLocator.ensure_cache_path
-    def _deny(self):
-        if not self.get_cache_path().startswith(tempfile.gettempdir()):
-            raise OSError("read-only")
-        return _ensure(self)
-    caching._CacheLocator.ensure_cache_path = _deny
+    _temporary_file = tempfile.TemporaryFile
+    def _deny(*args, dir=None, **kw):
+        if dir is not None and not str(dir).startswith(tempfile.gettempdir()):
+            raise PermissionError(13, "Permission denied (simulated read-only)", dir)
+        return _temporary_file(*args, dir=dir, **kw)
+    tempfile.TemporaryFile = _deny
 """)
 
 

@@ -549,16 +549,23 @@ def _numba_cache() -> None:
     else a fresh private one. A user's own ``NUMBA_CACHE_DIR`` is kept; any surprise
     from numba's internals leaves numba to its own behaviour."""
     import os
+    import tempfile
 
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
+    probe = str(Path(__file__).parent / "graphs" / "_kernels.py")
+    try:  # numba's first choice (the package's __pycache__), tried as numba does,
+        # without importing numba (a small kernel from the CLI loads none)
+        os.makedirs(os.path.join(os.path.dirname(probe), "__pycache__"), exist_ok=True)
+        tempfile.TemporaryFile(dir=os.path.join(os.path.dirname(probe), "__pycache__")).close()
+        return
+    except OSError:
+        pass
     try:
         import stat
-        import tempfile
 
         from numba.core import caching, config
 
-        probe = str(Path(__file__).parent / "graphs" / "_kernels.py")
         if any(cls.from_function(_numba_cache, probe) is not None
                for cls in caching.CacheImpl._locator_classes):
             return
