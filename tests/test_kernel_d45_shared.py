@@ -172,3 +172,21 @@ def test_row_top_on_threads_equals_one_thread(monkeypatch):
     assert ran == [64, 1]
     assert np.array_equal(got, one)
     assert (got >= (A @ V.T - b[:, None]).max(axis=1) - 1e-12).all()
+
+
+def test_cofactors_on_threads_equal_one_thread(monkeypatch):
+    Y = _points("normal", 4, 30, 1)
+    S = _candidates.lex_subsets(30, 4, comb(30, 4))
+    assert len(S) >= _candidates.COFACTOR_THREADS_MIN
+    threaded = _candidates.on_threads
+    got = _candidates.cofactors(Y, S)
+    monkeypatch.setattr(_candidates, "on_threads",
+                        lambda scan, total, chunks, workers=None: threaded(scan, total, 1))
+    one = _candidates.cofactors(Y, S)
+    assert all(np.array_equal(a, b) for a, b in zip(got, one, strict=True))
+    rows = [3, 17, len(S) - 1]  # against the numpy twin too
+    from rescon.geometry import _scan_np
+
+    for a, b in zip(_candidates.cofactors(Y, S[rows]), _scan_np.cofactors(Y, S[rows]),
+                    strict=True):
+        assert np.array_equal(a, b)

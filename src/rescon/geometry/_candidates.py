@@ -253,10 +253,12 @@ def classify(Y, W, subsets, c_err, F, floor=0.0, workers=None):
 
 def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> None:
     """scan(lo, hi) over ``chunks`` consecutive ranges covering range(total), on
-    ``workers`` threads (default: numba's thread count) each taking the next range
-    when it finishes one — for compiled scans without the GIL whose ranges write
-    disjoint outputs. On the calling thread alone for one chunk or one worker. A
-    range's exception is raised here."""
+    ``workers`` threads (default: numba's thread count; the calling thread is one of
+    them) each taking the next range when it finishes one — for compiled scans without
+    the GIL whose ranges write disjoint outputs. The caller sleeps only in the final
+    joins (no wake-up per range: on a loaded machine each costs a time slice). On the
+    calling thread alone for one chunk or one worker. A range's exception is raised
+    here (the first one, after every thread has stopped)."""
     if workers is None:
         import numba
 
@@ -264,26 +266,52 @@ def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> Non
     if chunks <= 1 or workers <= 1:
         scan(0, total)
         return
-    from concurrent.futures import ThreadPoolExecutor
+    import threading
 
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        for done in [pool.submit(scan, total * c // chunks, total * (c + 1) // chunks)
-                     for c in range(chunks)]:
-            done.result()
+    # next() on a list iterator is atomic under the GIL: each range is taken once
+    ranges = iter([(total * c // chunks, total * (c + 1) // chunks) for c in range(chunks)])
+    errors: list[BaseException] = []
+
+    def work() -> None:
+        try:
+            for lo, hi in ranges:
+                scan(lo, hi)
+        except BaseException as exc:  # re-raised by the caller below
+            errors.append(exc)
+
+    helpers = [threading.Thread(target=work, daemon=True) for _ in range(workers - 1)]
+    for t in helpers:
+        t.start()
+    work()
+    for t in helpers:
+        t.join()
+    if errors:
+        raise errors[0]
 
 
-@njit(cache=True)
+#: from this many subsets on, :func:`cofactors` runs on threads (8 ranges)
+COFACTOR_THREADS_MIN = 20_000
+
+
 def cofactors(Y, subsets):
     """The cofactors C and their permanents |C| of the subsets (rows), (count, k) each,
     exactly as the scan (:func:`classify_subsets`) computes them — only for the
     subsets the caller keeps (the scan stores none: tables of C(n, k) rows cost more
-    to allocate than to fill)."""
+    to allocate than to fill). Many subsets: ranges of them on threads
+    (:func:`on_threads`; each row is computed alone, so the split changes nothing)."""
     count, k = subsets.shape
     cof = np.empty((count, k))
     cof_abs = np.empty((count, k))
     none = np.zeros(0, dtype=np.int64)
-    _classify_range(Y, Y, none, subsets, 0.0, 0, 0.0, 0.0, 0, count, none, none, none,
-                    np.zeros(0, dtype=np.bool_), cof, cof_abs)
+    flags = np.zeros(0, dtype=np.bool_)
+    Y = np.ascontiguousarray(Y, dtype=np.float64)
+    subsets = np.ascontiguousarray(subsets)
+
+    def scan(lo: int, hi: int) -> None:
+        _classify_range(Y, Y, none, subsets, 0.0, 0, 0.0, 0.0, lo, hi, none, none, none,
+                        flags, cof, cof_abs)
+
+    on_threads(scan, count, 8 if count >= COFACTOR_THREADS_MIN else 1)
     return cof, cof_abs
 
 
