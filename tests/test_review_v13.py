@@ -169,3 +169,46 @@ def test_long_converging_runs_monitors_exact(d, scale, steps):
         for i, x in enumerate(xb):
             assert (_distance(x0[B], x) == 0) == (tr.metrics["validity_per_agent"][k][i] == 0)
         assert _close(tr.metrics["diameter"][k], _exact_diameter(np.unique(xb, axis=0)), 0.0)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_diameter_of_huge_states_beside_subnormal_ones_compares_few_pairs(monkeypatch, seed):
+    """States ~1e150–1e300 (1e150 is Scenario's limit) beside a state with a subnormal
+    entry: scaling by 2^-e would round that entry, so every pair of distinct states
+    was compared by hypot (7 CPU-s and 123 MB per step at N = 10 000). The ends are
+    now chosen on the rounded rows and compared on the given ones: the same float as
+    all pairs, ≤ 64·n pairs; exact on small sets (incl. rows differing only there)."""
+    from rescon.consensus import metrics
+
+    rng = np.random.default_rng(seed)
+    d = 2 + seed % 2
+    n = 3000
+    X = rng.standard_normal((n, d)) * (1e150 if seed < 3 else 1e300)
+    X[seed] = [5e-324] + [0.0] * (d - 1)
+    X[n // 2 + seed, -1] = 2.5e-322
+    seen = []
+    real = metrics._pairwise_max
+    monkeypatch.setattr(metrics, "_pairwise_max",
+                        lambda P, Y, *a, **k: seen.append(len(P) * len(Y)) or real(P, Y, *a, **k))
+    D = diameter(X)
+    assert sum(seen) <= 64 * n, seen
+    U = np.unique(X, axis=0)
+    assert D == real(U, U, hypot=True)
+    small = X[rng.integers(0, n, 5)]
+    assert _close(diameter(small), _exact_diameter(small), 0.0)
+    tiny = np.array([[1e300, 5e-324, 0.0], [1e300, 0.0, 0.0], [1e300, 0.0, 1e-320]])[:, :d]
+    assert _close(diameter(tiny), _exact_diameter(tiny), 0.0)
+
+
+def test_state_just_outside_a_thin_polygon_is_not_at_distance_zero():
+    """Five rounded points of a line (a thin polygon, not flat) and a state 3.8e-22
+    outside it that a facet proves outside: the float edge distance was 0, reported as
+    is — 'distance 0 exactly when inside' broken (hidden by the shared oracle's float
+    λ, :func:`test_solve_exact_stays_exact_with_an_int_pivot_row`)."""
+    t = np.array([-2.0, -1.0, 1.0, -1.0, 3.0])
+    X0 = np.c_[t, t * -2 / 3] * 1e-5
+    x = np.array([0.0, -6.776263578034403e-22])
+    want = _distance(X0, x)
+    assert want > 0
+    got = ValidityMonitor(X0).distances(np.vstack([X0[:4], x]))[-1]
+    assert got > 0 and _close(got, want, 3e-5)

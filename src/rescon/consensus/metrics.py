@@ -93,24 +93,40 @@ def diameter(states: np.ndarray) -> float:
     if len(X) < 2:
         return _pairwise_max(X, X)
     scale = 0
+    rounded = None
     if np.isfinite(X).all():
         scale = int(np.frexp(np.abs(X).max())[1])
         if not np.array_equal(np.ldexp(np.ldexp(X, -scale), scale), X):
-            scale = 0  # subnormal entries would lose bits
+            rounded = np.ldexp(X, -scale)  # subnormal entries lose bits: see below
+            scale = 0
         X = np.ldexp(X, -scale)
-        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-            r = np.sqrt(((X - X.mean(axis=0)) ** 2).sum(axis=1))
-            far = np.sqrt(((X - X[np.argmax(r)]) ** 2).sum(axis=1)).max()
-            if 1e-100 < r.max() < 1e100 and far > 1e-100:
-                keep = r + r.max() >= far * (1 - 4 * (X.shape[1] + 2) * UNIT_ROUNDOFF)
-                K = np.unique(X[keep], axis=0)  # states at a few values: all ends
-                if X.shape[1] == 2 and len(K) > ANGULAR_MIN:
-                    p, q = K[list(_caliper_pair(K))]
-                    L = float(np.sqrt(((p - q) ** 2).sum()))
-                    return math.ldexp(_antipodal_max(K, (p + q) / 2, L), scale)
-                return math.ldexp(_pairwise_max(K, X), scale)
+        keep = _diameter_ends(X)
+        if keep is not None:
+            K = np.unique(X[keep], axis=0)  # states at a few values: all ends
+            if X.shape[1] == 2 and len(K) > ANGULAR_MIN:
+                p, q = K[list(_caliper_pair(K))]
+                L = float(np.sqrt(((p - q) ** 2).sum()))
+                return math.ldexp(_antipodal_max(K, (p + q) / 2, L), scale)
+            return math.ldexp(_pairwise_max(K, X), scale)
     distinct = np.unique(X, axis=0)
-    return math.ldexp(_pairwise_max(distinct, distinct, hypot=True), scale)
+    keep = None if rounded is None else _diameter_ends(rounded)
+    ends = distinct if keep is None else np.unique(X[keep], axis=0)
+    return math.ldexp(_pairwise_max(ends, distinct, hypot=True), scale)
+
+
+def _diameter_ends(X: np.ndarray) -> np.ndarray | None:
+    """The rows of X (finite, max |x| < 1) that can end a diameter (:func:`diameter`:
+    ‖p − c‖ + R ≥ L(1 − 4(d + 2)u)), or None when R or L is not in (1e-100, 1e100).
+    Rows given rounded (each entry within 2^-1075: states at 1e300 beside subnormal
+    ones, scaled by 2^-e) keep every end: the rounding moves each distance by at most
+    2√d·2^-1075, far below the slack 4(d + 2)u·L ≥ 1e-115 — the ends are then compared
+    on the rows as given, by hypot, not every pair (7 s at N = 10 000)."""
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        r = np.sqrt(((X - X.mean(axis=0)) ** 2).sum(axis=1))
+        far = np.sqrt(((X - X[np.argmax(r)]) ** 2).sum(axis=1)).max()
+        if 1e-100 < r.max() < 1e100 and far > 1e-100:
+            return r + r.max() >= far * (1 - 4 * (X.shape[1] + 2) * UNIT_ROUNDOFF)
+    return None
 
 
 #: kept rows beyond which the plane's diameter compares near-antipodal pairs only
@@ -276,7 +292,8 @@ class ValidityMonitor:
         rest = rest[~self.surely_inside(states[rest])]
         if rest.size and self._edges is not None:
             dist, err = self.edge_distances(states[rest])
-            fast = self._surely_outside(states[rest]) & np.isfinite(err)
+            # dist > 0: a state just outside a thin polygon may get a float distance 0
+            fast = self._surely_outside(states[rest]) & np.isfinite(err) & (dist > 0)
             out[rest[fast]] = dist[fast]
             rest = rest[~fast]
         if rest.size and self._triangles is not None:
