@@ -537,55 +537,6 @@ def _one_line(text: str) -> str:
     return " ".join(text.split()) or "(no message)"
 
 
-def _numba_cache() -> None:
-    """Give numba a cache directory when it would find none, before any rescon kernel
-    is imported: with the package in a read-only place and no writable user cache
-    (a container run as another user with HOME=/, say) numba refuses every
-    ``cache=True`` function at import with a RuntimeError. Asks numba's own cache
-    locators, in its order, about a file of the package; when none can cache there,
-    sets ``NUMBA_CACHE_DIR`` (the config and the environment, for worker processes)
-    to ``rescon-numba-<uid>`` in the temporary directory — used only when it is a
-    directory of this user that no one else may write (numba's cache holds pickles),
-    else a fresh private one. A user's own ``NUMBA_CACHE_DIR`` is kept; any surprise
-    from numba's internals leaves numba to its own behaviour."""
-    import os
-    import tempfile
-
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return
-    probe = str(Path(__file__).parent / "graphs" / "_kernels.py")
-    try:  # numba's first choice (the package's __pycache__), tried as numba does,
-        # without importing numba (a small kernel from the CLI loads none)
-        os.makedirs(os.path.join(os.path.dirname(probe), "__pycache__"), exist_ok=True)
-        tempfile.TemporaryFile(dir=os.path.join(os.path.dirname(probe), "__pycache__")).close()
-        return
-    except OSError:
-        pass
-    try:
-        import stat
-
-        from numba.core import caching, config
-
-        if any(cls.from_function(_numba_cache, probe) is not None
-               for cls in caching.CacheImpl._locator_classes):
-            return
-        path = None
-        if hasattr(os, "getuid"):
-            path = os.path.join(tempfile.gettempdir(), f"rescon-numba-{os.getuid()}")
-            try:
-                os.mkdir(path, 0o700)
-            except FileExistsError:
-                pass
-            st = os.lstat(path)
-            if (not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid()
-                    or st.st_mode & 0o022):
-                path = None
-        path = path or tempfile.mkdtemp(prefix="rescon-numba-")
-        config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"] = path
-    except Exception:  # noqa: BLE001 (a numba without these internals: its own behaviour)
-        return
-
-
 class _StdoutClosed(Exception):
     """stdout was closed under us (``rescon ... | head``): not an error to report."""
 
@@ -594,8 +545,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rescon`` console script; returns the exit status."""
     args = _parser().parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
-    if func is not _cmd_check:  # the checker is standard library only
-        _numba_cache()
     try:
         return func(args)
     except _StdoutClosed:  # like a program killed by SIGPIPE, silently
