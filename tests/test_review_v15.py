@@ -1,0 +1,431 @@
+"""Review V15: a hostile review of the d = 4–5 kernel's threaded passes
+(:func:`rescon.geometry._candidates.on_threads` under the scan, the near pairs and
+row_top), the k-subsets kept between calls (:func:`._candidates.lex_subsets`) and the
+fast path's tight pairs carried by its polytope (``ExactPolytope.pairs``).
+
+Every answer is checked against the exact clipping (the fast path switched off:
+tests/test_review_v2._clipped, as benchmarks/kernel_d45_bench._exact_clip), bit for
+bit: exact vertices, constraints and certificate JSON. The threaded passes run here
+under a hostile scheduler too — ranges of another, uneven split (empty ones among
+them), in a shuffled order, on more threads than cores, each after a random pause —
+as their docstrings claim any split and any order give the same arrays."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import gc
+import json
+import os
+import random
+import subprocess
+import sys
+import threading
+import time
+import weakref
+from concurrent.futures import ThreadPoolExecutor
+from math import comb
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numba import njit
+
+import rescon
+from benchmarks.kernel_clouds import make_cloud
+from rescon.geometry import _candidates
+from rescon.geometry.polytope import members_of, tight_pairs
+from tests.test_kernel_attack import _spied
+from tests.test_kernel_d45 import _both_paths
+from tests.test_review_v2 import _clipped
+
+ROOT = Path(__file__).resolve().parents[1]
+REAL_ON_THREADS = _candidates.on_threads
+
+
+# --------------------------------------------------------------------------- #
+# on_threads itself
+# --------------------------------------------------------------------------- #
+
+def _recorded(total: int, chunks: int, workers: int, seed: int) -> list[tuple[int, int]]:
+    """The ranges on_threads hands out, each after a random pause (thread timing)."""
+    rng = random.Random(seed)
+    pauses = [rng.random() * 2e-4 for _ in range(max(chunks, 1))]
+    seen: list[tuple[int, int, str]] = []
+    lock = threading.Lock()
+
+    def scan(lo: int, hi: int) -> None:
+        time.sleep(pauses[len(seen) % len(pauses)])
+        with lock:
+            seen.append((lo, hi, threading.current_thread().name))
+
+    REAL_ON_THREADS(scan, total, chunks, workers)
+    return [(lo, hi) for lo, hi, _ in seen]
+
+
+@pytest.mark.parametrize("workers", [1, 2, 3, 7])
+@pytest.mark.parametrize("chunks", [0, 1, 2, 3, 7, 32, 64, 100])
+@pytest.mark.parametrize("total", [0, 1, 2, 31, 33, 1000, 5003])
+def test_on_threads_covers_every_row_once(total, chunks, workers):
+    """Every row in exactly one range, every range once — chunks not dividing the rows,
+    more chunks than rows (empty ranges), 0 or 1 rows, more workers than chunks."""
+    got = _recorded(total, chunks, workers, total * 1000 + chunks * 10 + workers)
+    want_calls = chunks if chunks > 1 and workers > 1 else 1
+    assert len(got) == want_calls
+    got.sort()
+    assert got[0][0] == 0 and got[-1][1] == total
+    assert all(a[1] == b[0] for a, b in zip(got, got[1:]))  # contiguous, no overlap
+    assert all(lo <= hi for lo, hi in got)
+
+
+@njit(nogil=True, cache=False)
+def _fill(out, seed, lo, hi):
+    for i in range(lo, hi):
+        x = (i * 2654435761 + seed) % 1000003
+        out[i] = x * 1e-3 - np.sqrt(x)
+
+
+def test_compiled_ranges_write_disjoint_slots_under_contention():
+    """A nogil compiled pass on 4 threads (2 cores, other processes): the array of one
+    thread, bit for bit, over many runs (a slot written twice or skipped shows)."""
+    n = 1_000_003
+    want = np.empty(n)
+    _fill(want, 7, 0, n)
+    for run in range(30):
+        out = np.full(n, np.nan)
+        REAL_ON_THREADS(lambda lo, hi, out=out: _fill(out, 7, lo, hi), n, 64, 4)
+        assert np.array_equal(out, want), run
+
+
+def _no_new_threads(before: set[int]) -> bool:
+    for _ in range(200):
+        if not {t.ident for t in threading.enumerate()} - before:
+            return True
+        time.sleep(0.01)
+    return False
+
+
+@pytest.mark.parametrize("where", ["caller", "helper"])
+@pytest.mark.parametrize("exc", [RuntimeError, KeyboardInterrupt, SystemExit, MemoryError])
+def test_a_range_exception_propagates_and_leaves_no_thread(exc, where):
+    """Raised by on_threads itself (not swallowed, no partial return, no hang), after
+    which none of its threads is left running — whichever thread the range ran on."""
+    before = {t.ident for t in threading.enumerate()}
+    main = threading.get_ident()
+
+    def scan(lo, hi):
+        time.sleep(1e-4)
+        on_caller = threading.get_ident() == main
+        if lo >= 500 and on_caller == (where == "caller"):
+            raise exc("range failed")
+
+    with pytest.raises(exc, match="range failed"):
+        REAL_ON_THREADS(scan, 1000, 64, 3)
+    assert _no_new_threads(before)
+
+
+@pytest.mark.xfail(strict=True, reason="on_threads: after a range raises, the other "
+                   "threads still take every remaining range (wasted work; a Ctrl-C or "
+                   "MemoryError waits for the whole pass)")
+def test_no_range_starts_after_a_failure():
+    """One range fails at once, the others take 2 ms each: the failure should stop the
+    pass within a range or two per thread, not after all 64."""
+    started = []
+
+    def scan(lo, hi):
+        started.append(lo)
+        if lo == 0:
+            raise RuntimeError("range failed")
+        time.sleep(2e-3)
+
+    with pytest.raises(RuntimeError):
+        REAL_ON_THREADS(scan, 6400, 64, 2)
+    assert len(started) <= 8, len(started)
+
+
+def test_numba_thread_count_one_runs_on_the_caller_alone():
+    """numba.set_num_threads(1) (as NUMBA_NUM_THREADS=1): every range on the calling
+    thread, no thread started."""
+    import numba
+
+    saved = numba.get_num_threads()
+    threads = set()
+    numba.set_num_threads(1)
+    try:
+        REAL_ON_THREADS(lambda lo, hi: threads.add(threading.get_ident()), 100, 64)
+    finally:
+        numba.set_num_threads(saved)
+    assert threads == {threading.get_ident()}
+
+
+# --------------------------------------------------------------------------- #
+# the kernel under a hostile scheduler, against the exact clipping
+# --------------------------------------------------------------------------- #
+
+def _hostile(seed: int):
+    """An on_threads that splits the rows its own way (a prime number of uneven ranges,
+    some empty), runs them in a shuffled order on 5 threads after random pauses — for
+    every pass, the single-chunk ones included."""
+    rng = random.Random(seed)
+    lock = threading.Lock()
+
+    def on_threads(scan, total, chunks, workers=None):
+        cuts = sorted({0, total, *(rng.randrange(total + 1) for _ in range(12))})
+        ranges = list(zip(cuts, cuts[1:])) + [(total // 2, total // 2)]
+        rng.shuffle(ranges)
+        pauses = [rng.random() * 1e-4 for _ in ranges]
+        todo = iter(list(zip(ranges, pauses)))
+        errors = []
+
+        def work():
+            try:
+                while True:
+                    with lock:
+                        item = next(todo, None)
+                    if item is None:
+                        return
+                    time.sleep(item[1])
+                    scan(*item[0])
+            except BaseException as e:  # noqa: BLE001 (re-raised below)
+                errors.append(e)
+
+        ts = [threading.Thread(target=work) for _ in range(5)]
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join()
+        if errors:
+            raise errors[0]
+
+    return on_threads
+
+
+def _public(K) -> tuple:
+    return (K.exact_vertices, K._exact.constraints,
+            json.dumps(K.certificate, sort_keys=True))
+
+
+#: hostile clouds in d = 4–5 (tests/test_kernel_attack, benchmarks/kernel_clouds), each
+#: at scale 1 and at 2^±990 (exact: the kernel scales with them)
+CLOUDS = [("attack", 4, 18, 3), ("converged", 4, 22, 2), ("duplicates", 4, 45, 2),
+          ("grid", 4, 24, 2), ("flat", 5, 16, 1), ("gaussian", 5, 14, 1),
+          ("attack", 5, 12, 2), ("sphere", 4, 22, 3), ("gaussian", 4, 26, 3)]
+
+
+#: larger ones, whose passes take the threaded branches (chunks > 1) of the scan, the
+#: near pairs, row_top and the cofactors: 2–5 s of exact clipping each
+LARGER = [("gaussian", 4, 40, 6), ("gaussian", 5, 18, 2), ("gaussian", 4, 50, 9),
+          ("attack", 5, 20, 3)]
+
+
+def _cases():
+    for i, cloud in enumerate(CLOUDS + LARGER):
+        for scale in (1.0, 2.0**990, 2.0**-990):
+            if cloud in LARGER and scale != 1.0 and i != len(CLOUDS):
+                continue
+            slow = cloud in LARGER or (cloud[1] == 5 and scale != 1.0)
+            yield pytest.param(cloud, scale, i * 7 + int(np.log2(scale)) % 5,
+                               marks=[pytest.mark.slow] if slow else [],
+                               id="-".join(map(str, cloud)) + f"-2^{int(np.log2(scale))}")
+
+
+@pytest.mark.parametrize(("cloud", "scale", "seed"), list(_cases()))
+def test_hostile_schedule_is_the_exact_clipping(cloud, scale, seed, monkeypatch):
+    fam, d, n, F = cloud
+    X = make_cloud(fam, d, n, F).X * scale
+    E = _clipped(X, F)
+    monkeypatch.setattr(_candidates, "on_threads", _hostile(seed))
+    K, _, P = _spied(X, F)
+    assert P is not None  # the fast path certified it
+    assert _public(K) == _public(E)
+    # its pairs are still those of its bitsets (the centring moved it in place)
+    vs, hs = tight_pairs(P.tight)
+    assert np.array_equal(P.pairs[0], vs) and np.array_equal(P.pairs[1], hs)
+
+
+def test_threaded_branches_run_on_the_larger_clouds(monkeypatch):
+    """The LARGER clouds reach every threaded branch (chunks > 1): the scan, the near
+    pairs, row_top and the cofactors — so the hostile schedule replaced real splits."""
+    seen = []
+
+    def spy(scan, total, chunks, workers=None):
+        seen.append((scan.__qualname__.split(".")[0], chunks))
+        REAL_ON_THREADS(scan, total, chunks, workers)
+
+    monkeypatch.setattr(_candidates, "on_threads", spy)
+    for fam, d, n, F in [("gaussian", 4, 50, 9), ("gaussian", 5, 18, 2)]:
+        rescon.safe_kernel(make_cloud(fam, d, n, F).X, F)
+    threaded = {name for name, chunks in seen if chunks > 1}
+    assert threaded == {"classify", "_near_run", "row_top", "cofactors"}, seen
+
+
+@pytest.mark.parametrize("scale", [1.0, pytest.param(2.0**990, marks=pytest.mark.slow)])
+def test_concurrent_kernels_from_user_threads(scale):
+    """Several safe_kernel calls at once from a ThreadPoolExecutor (each starting its own
+    range threads, sharing the kept k-subsets): the serial answers, bit for bit, and no
+    thread left behind."""
+    cases = [("gaussian", 4, 26, 3), ("gaussian", 5, 14, 1), ("converged", 4, 22, 2),
+             ("sphere", 4, 22, 3)]
+    inputs = [(make_cloud(*c).X * scale, c[3]) for c in cases] * 2
+    want = [_public(rescon.safe_kernel(X, F)) for X, F in inputs]
+    before = {t.ident for t in threading.enumerate()}
+    with ThreadPoolExecutor(4) as pool:
+        got = list(pool.map(lambda a: _public(rescon.safe_kernel(*a)), inputs))
+    assert got == want
+    assert _no_new_threads(before)
+
+
+def test_dask_threads_scheduler():
+    """Inside Dask's threaded scheduler (worker threads calling on_threads)."""
+    dask = pytest.importorskip("dask")
+    cases = [("gaussian", 4, 26, 3), ("sphere", 4, 22, 3), ("gaussian", 5, 14, 1)]
+    inputs = [(make_cloud(*c).X, c[3]) for c in cases]
+    tasks = [dask.delayed(lambda X, F: _public(rescon.safe_kernel(X, F)))(X, F)
+             for X, F in inputs]
+    got = dask.compute(*tasks, scheduler="threads", num_workers=3)
+    assert list(got) == [_public(rescon.safe_kernel(X, F)) for X, F in inputs]
+
+
+@pytest.mark.slow
+def test_numba_num_threads_one_in_a_fresh_process():
+    """NUMBA_NUM_THREADS=1 (numba's layer with one thread; on_threads on the caller
+    alone): the certificate JSON of this process's threaded run."""
+    code = ("import json, rescon; from benchmarks.kernel_clouds import make_cloud\n"
+            "out = []\n"
+            "for c in [('gaussian', 4, 26, 3), ('gaussian', 5, 14, 1)]:\n"
+            "    K = rescon.safe_kernel(make_cloud(*c).X, c[3])\n"
+            "    out.append(json.dumps(K.certificate, sort_keys=True))\n"
+            "import numba; out.append(numba.get_num_threads())\n"
+            "print(json.dumps(out))\n")
+    env = dict(os.environ, NUMBA_NUM_THREADS="1",
+               PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT)]))
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, cwd=ROOT, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    got = json.loads(run.stdout)
+    assert got[-1] == 1
+    want = [json.dumps(rescon.safe_kernel(make_cloud(*c).X, c[3]).certificate, sort_keys=True)
+            for c in [("gaussian", 4, 26, 3), ("gaussian", 5, 14, 1)]]
+    assert got[:-1] == want
+
+
+# --------------------------------------------------------------------------- #
+# lex_subsets: the kept k-subsets
+# --------------------------------------------------------------------------- #
+
+def test_kept_subsets_concurrent_first_calls_agree():
+    """Many threads asking for one (n, k) at once: every answer the lexicographic
+    enumeration, read-only (lru_cache may build it twice: harmless)."""
+    _candidates.lex_subsets.cache_clear()
+    try:
+        with ThreadPoolExecutor(8) as pool:
+            got = list(pool.map(lambda _: _candidates.lex_subsets(30, 4, comb(30, 4)),
+                                range(16)))
+        want = _candidates.k_subsets(30, 4, comb(30, 4))
+        assert all(np.array_equal(S, want) and not S.flags.writeable for S in got)
+    finally:
+        _candidates.lex_subsets.cache_clear()
+
+
+def test_kept_subsets_are_bounded_in_number():
+    _candidates.lex_subsets.cache_clear()
+    try:
+        for n in range(8, 40):
+            for k in (2, 3, 4):
+                _candidates.lex_subsets(n, k, comb(n, k))
+        assert _candidates.lex_subsets.cache_info().currsize <= 2
+    finally:
+        _candidates.lex_subsets.cache_clear()
+
+
+@pytest.mark.xfail(strict=True, reason="lex_subsets: the kept array owns its memory, so "
+                   "any caller can setflags(write=True) and corrupt every later kernel "
+                   "of that size")
+def test_kept_subsets_cannot_be_made_writable():
+    _candidates.lex_subsets.cache_clear()
+    try:
+        S = _candidates.lex_subsets(12, 4, comb(12, 4))
+        with pytest.raises(ValueError):
+            S.setflags(write=True)
+    finally:
+        _candidates.lex_subsets.cache_clear()  # never leave a writable table behind
+
+
+@pytest.mark.xfail(strict=True, reason="lex_subsets keeps tables of any size after the "
+                   "kernel returns: up to 2 x C(91, 5) x 5 x 8 B = 3.7 GB (k = 5 at the "
+                   "work budget), 2 x 0.82 GB at k = 4")
+def test_large_subset_tables_are_not_kept():
+    """C(44, 5) rows (43 MB, ~10x the d = 4, n = 50 table the cache was made for) are
+    freed once the caller drops them."""
+    _candidates.lex_subsets.cache_clear()
+    try:
+        S = _candidates.lex_subsets(44, 5, comb(44, 5))
+        assert S.nbytes > 40e6
+        ref = weakref.ref(S)
+        del S
+        gc.collect()
+        assert ref() is None
+    finally:
+        _candidates.lex_subsets.cache_clear()
+
+
+# --------------------------------------------------------------------------- #
+# ExactPolytope.pairs
+# --------------------------------------------------------------------------- #
+
+def _fast(case: int):
+    rng = np.random.default_rng(5)
+    X = [rng.normal(size=(24, 4)), rng.normal(size=(16, 5))][case]
+    fast, box, *_ = _both_paths(X, [3, 1][case])
+    assert fast is not None and fast.pairs is not None
+    return fast, box
+
+
+def _pairs_ok(P) -> bool:
+    return P.incidence() == members_of(P.tight)
+
+
+@pytest.mark.parametrize("case", [0, 1])
+def test_a_copy_clipped_leaves_the_original_pairs_right(case):
+    P, _ = _fast(case)
+    for Q in (copy.copy(P), copy.deepcopy(P)):
+        j = int(np.argmax(Q.float_vertices()[:, 0]))
+        w, y0, *_ = Q.verts[j]
+        assert Q.clip((1,) + (0,) * (Q.k - 1), y0 // w - 1)
+        assert Q.pairs is None and _pairs_ok(Q)
+        assert P.pairs is not None and _pairs_ok(P)
+
+
+@pytest.mark.parametrize("case", [0, 1])
+def test_a_clip_cutting_nothing_keeps_right_pairs(case):
+    """A clip no vertex violates (some tight on it) records nothing: the pairs stay
+    those of the unchanged bitsets."""
+    P, _ = _fast(case)
+    w, y0, *_ = P.verts[int(np.argmax(P.float_vertices()[:, 0]))]
+    top = max(-(-v[1] // v[0]) for v in P.verts)  # ceil: no vertex above
+    assert not P.clip((1,) + (0,) * (P.k - 1), top)
+    assert P.pairs is not None and _pairs_ok(P)
+
+
+@pytest.mark.parametrize("case", [0, 1])
+def test_the_fast_polytope_has_the_exact_clipping_incidence(case):
+    """incidence() from the carried pairs gives the clipping's facets (the maximal
+    vertex sets of the rows), vertices named by their exact coordinates."""
+    P, box = _fast(case)
+
+    def facets(Q):
+        verts = Q.fraction_vertices()
+        sets = {frozenset(verts[v] for v in vs) for vs in Q.incidence().values()}
+        return {s for s in sets if not any(s < t for t in sets)}
+
+    assert facets(P) == facets(box)
+    assert all(len(f) >= P.k for f in facets(P))
+
+
+@pytest.mark.xfail(strict=True, reason="ExactPolytope.pairs is an init field: "
+                   "dataclasses.replace(P, tight=...) carries the old pairs to incidence() "
+                   "(no internal path does this today)")
+def test_replace_with_new_bitsets_does_not_keep_stale_pairs():
+    P, _ = _fast(0)
+    Q = dataclasses.replace(P, tight=[t | 1 << (len(P.a) - 1) for t in P.tight])
+    assert _pairs_ok(Q)
