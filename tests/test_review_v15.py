@@ -429,3 +429,28 @@ def test_replace_with_new_bitsets_does_not_keep_stale_pairs():
     P, _ = _fast(0)
     Q = dataclasses.replace(P, tight=[t | 1 << (len(P.a) - 1) for t in P.tight])
     assert _pairs_ok(Q)
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize(("k", "m"), [(4, 22), (5, 17)])
+@pytest.mark.parametrize("kind", ["normal", "coplanar", "repeated", "integers", "subnormal",
+                                  "huge", "nearsame", "adversary"])
+def test_scan_arrays_under_any_split_equal_the_parallel_loop(kind, k, m, seed,
+                                                             monkeypatch):
+    """The scan's arrays (pruned lower bounds included) when its ranges start anywhere
+    — inside a prefix's run, on its last subset, empty — in any order: numba's own
+    loop's, bit for bit."""
+    from tests.test_kernel_d45_around2 import _points
+
+    Y = _points(kind, k, m, seed)
+    W = np.random.default_rng([m, seed]).integers(1, 3, size=m)
+    S = _candidates.k_subsets(m, k, comb(m, k))
+    monkeypatch.setattr(_candidates, "on_threads", _hostile(100 + seed))
+    for c_err, F in [(0.0, 1), (1e-12, 2)]:
+        want = _candidates.classify_subsets(Y, W, S, c_err, F, 1e-300)
+        got = _candidates.classify(Y, W, S, c_err, F, 1e-300, 3)
+        assert all(np.array_equal(a, b) for a, b in zip(want, got, strict=True))
+    rows = np.random.default_rng(seed).choice(len(S), 300, replace=False)
+    for a, b in zip(_candidates.cofactors(Y, S[rows]), _candidates.cofactors(Y, S),
+                    strict=True):
+        assert np.array_equal(a, b[rows], equal_nan=True)  # huge: NaN cofactors
