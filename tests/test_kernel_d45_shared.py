@@ -1,10 +1,9 @@
-"""Work the d = 4-5 fast path shares instead of redoing (issue 13 §3): the k-subsets
-kept between calls of one size, and the fast path's tight pairs read by the incidence
-— each against the computation it replaces."""
+"""Work the d = 4-5 fast path shares instead of redoing (issue 13 §3): the fast path's
+tight pairs read by the incidence, and its compiled passes on threads taking ranges as
+they come — each against the computation it replaces."""
 
 from __future__ import annotations
 
-import itertools
 from math import comb
 
 import numpy as np
@@ -12,19 +11,8 @@ import pytest
 
 from rescon.geometry import _candidates
 from rescon.geometry.polytope import members_of, tight_pairs
-from tests.test_kernel_d45 import _both_paths, _halfspaces
-from tests.test_kernel_d45_around2 import KINDS, _points, _rows
-
-
-@pytest.mark.parametrize(("n", "k"), [(7, 1), (9, 3), (12, 4), (10, 5)])
-def test_kept_subsets_are_every_k_subset_in_order_and_read_only(n, k):
-    count = comb(n, k)
-    S = _candidates.lex_subsets(n, k, count)
-    assert S.tolist() == [list(c) for c in itertools.combinations(range(n), k)]
-    assert np.array_equal(S, _candidates.k_subsets(n, k, count))
-    assert _candidates.lex_subsets(n, k, count) is S  # kept for the next call
-    with pytest.raises(ValueError, match="read-only"):
-        S[0, 0] = 1
+from tests.test_kernel_d45 import _both_paths
+from tests.test_kernel_d45_around2 import KINDS, _points
 
 
 def _clouds():
@@ -33,21 +21,6 @@ def _clouds():
     yield rng.integers(-3, 4, size=(22, 4)).astype(float), 2  # ties, coplanar points
     yield rng.normal(size=(16, 5)), 1
     yield 1.0 + 1e-13 * rng.normal(size=(20, 4)), 2  # converged states
-
-
-@pytest.mark.parametrize("case", range(4))
-def test_valid_halfspaces_from_kept_subsets_equal_freshly_enumerated(case, monkeypatch):
-    X, F = list(_clouds())[case]
-    kept = [_rows(_halfspaces(X, F)[0]) for _ in range(2)]  # the second call reuses
-    calls = []
-
-    def fresh_subsets(n, k, count):
-        calls.append((n, k))
-        return _candidates.k_subsets(n, k, count)  # a new, writable array
-
-    monkeypatch.setattr(_candidates, "lex_subsets", fresh_subsets)
-    assert kept[0] == kept[1] == _rows(_halfspaces(X, F)[0]) and kept[0]
-    assert calls  # the compiled scan ran (not the small-input numpy one)
 
 
 @pytest.mark.parametrize("case", range(3))  # the converged cloud needs the centring
@@ -87,7 +60,7 @@ def test_threaded_scan_equals_the_parallel_loop(kind, k, m, workers):
     0: ties, degenerate subsets) and the rounding-bound one (c_err > 0) alike."""
     Y = _points(kind, k, m, workers)
     W = np.random.default_rng([m, workers]).integers(1, 3, size=m)
-    S = _candidates.lex_subsets(m, k, comb(m, k))
+    S = _candidates.k_subsets(m, k, comb(m, k))
     assert len(S) >= _candidates.PARALLEL_MIN_SUBSETS  # the threaded branch runs
     for c_err, F in [(0.0, 1), (1e-12, 2)]:
         want = _candidates.classify_subsets(Y, W, S, c_err, F, 1e-300)
@@ -102,7 +75,7 @@ def test_a_failing_range_raises_from_the_threaded_scan(monkeypatch):
 
     monkeypatch.setattr(_candidates, "_classify_range", broken)
     Y = _points("normal", 4, 22, 0)
-    S = _candidates.lex_subsets(22, 4, comb(22, 4))
+    S = _candidates.k_subsets(22, 4, comb(22, 4))
     with pytest.raises(RuntimeError, match="range failed"):
         _candidates.classify(Y, np.ones(22, dtype=np.int64), S, 1e-12, 1, 0.0, 2)
 
@@ -176,7 +149,7 @@ def test_row_top_on_threads_equals_one_thread(monkeypatch):
 
 def test_cofactors_on_threads_equal_one_thread(monkeypatch):
     Y = _points("normal", 4, 30, 1)
-    S = _candidates.lex_subsets(30, 4, comb(30, 4))
+    S = _candidates.k_subsets(30, 4, comb(30, 4))
     assert len(S) >= _candidates.COFACTOR_THREADS_MIN
     threaded = _candidates.on_threads
     got = _candidates.cofactors(Y, S)
@@ -190,3 +163,34 @@ def test_cofactors_on_threads_equal_one_thread(monkeypatch):
     for a, b in zip(_candidates.cofactors(Y, S[rows]), _scan_np.cofactors(Y, S[rows]),
                     strict=True):
         assert np.array_equal(a, b)
+
+
+def test_a_copy_of_a_fast_polytope_has_no_pairs():
+    """``pairs`` is not an init field: ``dataclasses.replace`` with new bitsets cannot
+    carry the old pairs to the incidence (V15's finding, failed before)."""
+    import dataclasses
+
+    X, F = list(_clouds())[0]
+    fast, *_ = _both_paths(X, F)
+    Q = dataclasses.replace(fast, tight=[t | 1 << (len(fast.a) - 1) for t in fast.tight])
+    assert Q.pairs is None and Q.incidence() == members_of(Q.tight)
+
+
+def test_no_range_starts_after_a_failure():
+    """A failing range stops the pass: the other threads start no further range
+    (V15's finding: they took every remaining one, failed before)."""
+    import threading
+    import time
+
+    started, lock = [], threading.Lock()
+
+    def scan(lo, hi):
+        with lock:
+            started.append(lo)
+        if lo == 0:
+            raise RuntimeError("range failed")
+        time.sleep(0.002)
+
+    with pytest.raises(RuntimeError, match="range failed"):
+        _candidates.on_threads(scan, 64, 64, workers=2)
+    assert len(started) <= 4

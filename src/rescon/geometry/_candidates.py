@@ -17,8 +17,6 @@ float arithmetic is exact (small integers), and s = 0 means "on the hyperplane".
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 from numba import njit, prange
 
@@ -258,7 +256,7 @@ def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> Non
     the GIL whose ranges write disjoint outputs. The caller sleeps only in the final
     joins (no wake-up per range: on a loaded machine each costs a time slice). On the
     calling thread alone for one chunk or one worker. A range's exception is raised
-    here (the first one, after every thread has stopped)."""
+    here (the first one, after every thread has stopped; no range starts after it)."""
     if workers is None:
         import numba
 
@@ -275,6 +273,8 @@ def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> Non
     def work() -> None:
         try:
             for lo, hi in ranges:
+                if errors:  # another range failed: start no more
+                    return
                 scan(lo, hi)
         except BaseException as exc:  # re-raised by the caller below
             errors.append(exc)
@@ -313,16 +313,6 @@ def cofactors(Y, subsets):
 
     on_threads(scan, count, 8 if count >= COFACTOR_THREADS_MIN else 1)
     return cof, cof_abs
-
-
-@functools.lru_cache(maxsize=2)
-def lex_subsets(n: int, k: int, count: int) -> np.ndarray:
-    """:func:`k_subsets`, read-only and kept for the next call with the same (n, k,
-    count): repeated kernels of one size (a consensus run's rounds) enumerate the
-    same C(n, k) rows (C(50, 4): 3.7 MB, ~1.6 CPU-ms to fill)."""
-    out = k_subsets(n, k, count)
-    out.setflags(write=False)
-    return out
 
 
 @njit(cache=True)

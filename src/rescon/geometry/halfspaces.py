@@ -242,8 +242,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     if small:
         from ._scan_np import classify, cofactors, in_range, k_subsets
     else:
-        from ._candidates import ANGLE_ERR, classify, cofactors
-        from ._candidates import lex_subsets as k_subsets
+        from ._candidates import ANGLE_ERR, classify, cofactors, k_subsets
         from ._expansions import in_range
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     # k = 1: the sign of a float difference is exact — of exact floats

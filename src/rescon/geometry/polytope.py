@@ -97,9 +97,11 @@ class ExactPolytope:
     _fv: np.ndarray | None = field(default=None, repr=False)  # float vertices (cache)
     work: int = 0  # estimated steps spent clipping so far (:mod:`._budget`)
     edges: list[list[int]] | None = None  # per vertex its neighbours, when known (fast path)
-    #: :func:`tight_pairs` of ``tight``, when its builder has them (fast path); a clip
-    #: that changes ``tight`` drops them
-    pairs: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False, compare=False)
+    #: :func:`tight_pairs` of ``tight``, set by its builder when it has them (fast path);
+    #: a clip that changes ``tight`` drops them, and a copy (``dataclasses.replace``)
+    #: starts without them
+    pairs: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False,
+                                                        compare=False)
 
     @classmethod
     def box(cls, lo: list[int], hi: list[int], unit: int = 1) -> ExactPolytope:
