@@ -51,6 +51,27 @@ def test_a_clip_drops_the_pairs():
     assert fast2.pairs is None and fast2.incidence() == {}
 
 
+#: the threaded pass itself (the tests below replace it by spies and one-thread twins)
+ON_THREADS = _candidates.on_threads
+
+
+def _one_thread(scan, total, chunks, workers=None):
+    ON_THREADS(scan, total, 1)
+
+
+@pytest.fixture
+def thread_passes(monkeypatch):
+    """The chunk counts of the threaded passes a test makes (they still run)."""
+    ran = []
+
+    def spy(scan, total, chunks, workers=None):
+        ran.append(chunks)
+        ON_THREADS(scan, total, chunks, workers)
+
+    monkeypatch.setattr(_candidates, "on_threads", spy)
+    return ran
+
+
 @pytest.mark.parametrize("workers", [2, 3])
 @pytest.mark.parametrize(("k", "m"), [(3, 40), (4, 22), (5, 17)])
 @pytest.mark.parametrize("kind", KINDS)
@@ -81,7 +102,8 @@ def test_a_failing_range_raises_from_the_threaded_scan(monkeypatch):
 
 
 @pytest.mark.parametrize("seed", range(2))
-def test_near_pairs_on_threads_equal_one_thread_and_brute_force(seed, monkeypatch):
+def test_near_pairs_on_threads_equal_one_thread_and_brute_force(seed, monkeypatch,
+                                                                 thread_passes):
     """Enough rows × chunks for the threaded passes (rows with more near points than
     NEAR_KEPT among them, scanned again): the pairs of one thread, and every slack's."""
     from rescon.geometry._candidates import NEAR_KEPT, near_pairs
@@ -105,25 +127,16 @@ def test_near_pairs_on_threads_equal_one_thread_and_brute_force(seed, monkeypatc
         np.abs(A) @ np.abs(V).T + np.abs(b)[:, None])
     want = sorted(zip(*np.nonzero((np.abs(S) <= coarse[:, None]) & ~(np.abs(S) > bound)),
                       strict=True))
-    ran = []
-    threaded = _candidates.on_threads
-
-    def spy(scan, total, chunks, workers=None):
-        ran.append(chunks)
-        threaded(scan, total, chunks, workers)
-
-    monkeypatch.setattr(_candidates, "on_threads", spy)
     got_r, got_v = near_pairs(A, b, A_abs, b_abs, V, coarse, c_err, c, 0.0)
-    assert ran == [64, 64]  # both passes on threads
-    monkeypatch.setattr(_candidates, "on_threads",
-                        lambda scan, total, chunks, workers=None: threaded(scan, total, 1))
+    assert thread_passes == [64, 64]  # both passes on threads
+    monkeypatch.setattr(_candidates, "on_threads", _one_thread)
     one_r, one_v = near_pairs(A, b, A_abs, b_abs, V, coarse, c_err, c, 0.0)
     assert got_r.tolist() == one_r.tolist() and got_v.tolist() == one_v.tolist()
     assert sorted(zip(got_r.tolist(), got_v.tolist(), strict=True)) == [
         (int(r), int(v)) for r, v in want]
 
 
-def test_row_top_on_threads_equals_one_thread(monkeypatch):
+def test_row_top_on_threads_equals_one_thread(thread_passes):
     """Enough rows × chunks for the threaded pass: the bounds of the calling thread
     alone, bit for bit, and never below the true maxima."""
     from rescon.geometry._candidates import row_top
@@ -132,17 +145,9 @@ def test_row_top_on_threads_equals_one_thread(monkeypatch):
     V = rng.normal(size=(1200, 4))
     A = rng.normal(size=(900, 4))
     b = (A @ V.T).max(axis=1) + rng.uniform(-0.1, 0.5, 900)
-    ran = []
-    threaded = _candidates.on_threads
-
-    def spy(scan, total, chunks, workers=None):
-        ran.append(chunks)
-        threaded(scan, total, chunks, workers)
-
-    monkeypatch.setattr(_candidates, "on_threads", spy)
     got = row_top(A, b, V, 0.0)
     one = row_top(A, b, V, 0.0, parallel=False)
-    assert ran == [64, 1]
+    assert thread_passes == [64, 1]
     assert np.array_equal(got, one)
     assert (got >= (A @ V.T - b[:, None]).max(axis=1) - 1e-12).all()
 
@@ -151,10 +156,8 @@ def test_cofactors_on_threads_equal_one_thread(monkeypatch):
     Y = _points("normal", 4, 30, 1)
     S = _candidates.k_subsets(30, 4, comb(30, 4))
     assert len(S) >= _candidates.COFACTOR_THREADS_MIN
-    threaded = _candidates.on_threads
     got = _candidates.cofactors(Y, S)
-    monkeypatch.setattr(_candidates, "on_threads",
-                        lambda scan, total, chunks, workers=None: threaded(scan, total, 1))
+    monkeypatch.setattr(_candidates, "on_threads", _one_thread)
     one = _candidates.cofactors(Y, S)
     assert all(np.array_equal(a, b) for a, b in zip(got, one, strict=True))
     rows = [3, 17, len(S) - 1]  # against the numpy twin too
