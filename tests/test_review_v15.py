@@ -495,3 +495,35 @@ def test_forked_workers_after_a_kernel():
                          env=env, cwd=ROOT, timeout=300)
     assert run.returncode == 0 and "OpenMP" not in run.stderr, run.stderr[-2000:]
     assert run.stdout.strip().startswith("[")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT")
+def test_ctrl_c_during_a_threaded_kernel():
+    """SIGINT while a d = 5, n = 60 kernel's threaded passes run: KeyboardInterrupt
+    within seconds, no range thread left, and the next kernel is right."""
+    import signal
+
+    code = ("import numpy as np, rescon, threading\n"
+            "rescon.safe_kernel(np.random.default_rng(0).normal(size=(20, 5)), 2)\n"
+            "print('ready', flush=True)\n"
+            "try:\n"
+            "    rescon.safe_kernel(np.random.default_rng(0).normal(size=(60, 5)), 12)\n"
+            "except KeyboardInterrupt:\n"
+            "    print('interrupted', len(threading.enumerate()), flush=True)\n"
+            "Y = np.random.default_rng(1).normal(size=(24, 4))\n"
+            "print(len(rescon.safe_kernel(Y, 3).vertices), flush=True)\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=env, cwd=ROOT)
+    try:
+        assert p.stdout.readline().strip() == "ready"
+        time.sleep(1.0)
+        p.send_signal(signal.SIGINT)
+        t = time.perf_counter()
+        out, err = p.communicate(timeout=120)
+    finally:
+        p.kill()
+    assert time.perf_counter() - t < 30 and p.returncode == 0, err[-2000:]
+    want = len(rescon.safe_kernel(np.random.default_rng(1).normal(size=(24, 4)), 3).vertices)
+    assert out.split("\n")[:2] == ["interrupted 1", str(want)]
