@@ -1,7 +1,8 @@
 """Review V15: a hostile review of the d = 4–5 kernel's threaded passes
-(:func:`rescon.geometry._candidates.on_threads` under the scan, the near pairs and
-row_top), the k-subsets kept between calls (:func:`._candidates.lex_subsets`) and the
-fast path's tight pairs carried by its polytope (``ExactPolytope.pairs``).
+(:func:`rescon.geometry._candidates.on_threads` under the scan, the near pairs, row_top
+and the cofactors), the k-subsets kept between calls (``_candidates.lex_subsets``,
+dropped after this review) and the fast path's tight pairs carried by its polytope
+(``ExactPolytope.pairs``).
 
 Every answer is checked against the exact clipping (the fast path switched off:
 tests/test_review_v2._clipped, as benchmarks/kernel_d45_bench._exact_clip), bit for
@@ -14,7 +15,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import gc
 import json
 import os
 import random
@@ -22,7 +22,6 @@ import subprocess
 import sys
 import threading
 import time
-import weakref
 from concurrent.futures import ThreadPoolExecutor
 from math import comb
 from pathlib import Path
@@ -124,12 +123,10 @@ def test_a_range_exception_propagates_and_leaves_no_thread(exc, where):
     assert _no_new_threads(before)
 
 
-@pytest.mark.xfail(strict=True, reason="on_threads: after a range raises, the other "
-                   "threads still take every remaining range (wasted work; a Ctrl-C or "
-                   "MemoryError waits for the whole pass)")
 def test_no_range_starts_after_a_failure():
-    """One range fails at once, the others take 2 ms each: the failure should stop the
-    pass within a range or two per thread, not after all 64."""
+    """One range fails at once, the others take 2 ms each: the failure stops the pass
+    within a range or two per thread, not after all 64 (failed before 310d2d8: every
+    remaining range ran — wasted work, a Ctrl-C or MemoryError waited for the pass)."""
     started = []
 
     def scan(lo, hi):
@@ -262,7 +259,7 @@ def test_threaded_branches_run_on_the_larger_clouds(monkeypatch):
 @pytest.mark.parametrize("scale", [1.0, pytest.param(2.0**990, marks=pytest.mark.slow)])
 def test_concurrent_kernels_from_user_threads(scale):
     """Several safe_kernel calls at once from a ThreadPoolExecutor (each starting its own
-    range threads, sharing the kept k-subsets): the serial answers, bit for bit, and no
+    range threads): the serial answers, bit for bit, and no
     thread left behind."""
     cases = [("gaussian", 4, 26, 3), ("gaussian", 5, 14, 1), ("converged", 4, 22, 2),
              ("sphere", 4, 22, 3)]
@@ -310,63 +307,13 @@ def test_numba_num_threads_one_in_a_fresh_process():
 
 
 # --------------------------------------------------------------------------- #
-# lex_subsets: the kept k-subsets
+# the kept k-subsets (lex_subsets, 1cb2aef): dropped in 310d2d8 after this review —
+# any caller could setflags(write=True) on the shared table (it owned its memory), and
+# it kept up to 2 × C(91, 5) × 5 × 8 B = 3.7 GB after the kernel returned
 # --------------------------------------------------------------------------- #
 
-def test_kept_subsets_concurrent_first_calls_agree():
-    """Many threads asking for one (n, k) at once: every answer the lexicographic
-    enumeration, read-only (lru_cache may build it twice: harmless)."""
-    _candidates.lex_subsets.cache_clear()
-    try:
-        with ThreadPoolExecutor(8) as pool:
-            got = list(pool.map(lambda _: _candidates.lex_subsets(30, 4, comb(30, 4)),
-                                range(16)))
-        want = _candidates.k_subsets(30, 4, comb(30, 4))
-        assert all(np.array_equal(S, want) and not S.flags.writeable for S in got)
-    finally:
-        _candidates.lex_subsets.cache_clear()
-
-
-def test_kept_subsets_are_bounded_in_number():
-    _candidates.lex_subsets.cache_clear()
-    try:
-        for n in range(8, 40):
-            for k in (2, 3, 4):
-                _candidates.lex_subsets(n, k, comb(n, k))
-        assert _candidates.lex_subsets.cache_info().currsize <= 2
-    finally:
-        _candidates.lex_subsets.cache_clear()
-
-
-@pytest.mark.xfail(strict=True, reason="lex_subsets: the kept array owns its memory, so "
-                   "any caller can setflags(write=True) and corrupt every later kernel "
-                   "of that size")
-def test_kept_subsets_cannot_be_made_writable():
-    _candidates.lex_subsets.cache_clear()
-    try:
-        S = _candidates.lex_subsets(12, 4, comb(12, 4))
-        with pytest.raises(ValueError):
-            S.setflags(write=True)
-    finally:
-        _candidates.lex_subsets.cache_clear()  # never leave a writable table behind
-
-
-@pytest.mark.xfail(strict=True, reason="lex_subsets keeps tables of any size after the "
-                   "kernel returns: up to 2 x C(91, 5) x 5 x 8 B = 3.7 GB (k = 5 at the "
-                   "work budget), 2 x 0.82 GB at k = 4")
-def test_large_subset_tables_are_not_kept():
-    """C(44, 5) rows (43 MB, ~10x the d = 4, n = 50 table the cache was made for) are
-    freed once the caller drops them."""
-    _candidates.lex_subsets.cache_clear()
-    try:
-        S = _candidates.lex_subsets(44, 5, comb(44, 5))
-        assert S.nbytes > 40e6
-        ref = weakref.ref(S)
-        del S
-        gc.collect()
-        assert ref() is None
-    finally:
-        _candidates.lex_subsets.cache_clear()
+def test_no_kept_subsets():
+    assert not hasattr(_candidates, "lex_subsets")
 
 
 # --------------------------------------------------------------------------- #
@@ -422,10 +369,9 @@ def test_the_fast_polytope_has_the_exact_clipping_incidence(case):
     assert all(len(f) >= P.k for f in facets(P))
 
 
-@pytest.mark.xfail(strict=True, reason="ExactPolytope.pairs is an init field: "
-                   "dataclasses.replace(P, tight=...) carries the old pairs to incidence() "
-                   "(no internal path does this today)")
 def test_replace_with_new_bitsets_does_not_keep_stale_pairs():
+    """Failed before 310d2d8 (pairs an init field: dataclasses.replace(P, tight=...)
+    carried the old pairs to incidence(); no internal path did this)."""
     P, _ = _fast(0)
     Q = dataclasses.replace(P, tight=[t | 1 << (len(P.a) - 1) for t in P.tight])
     assert _pairs_ok(Q)
