@@ -473,3 +473,37 @@ def test_ctrl_c_during_a_threaded_kernel():
     assert time.perf_counter() - t < 30 and p.returncode == 0, err[-2000:]
     want = len(rescon.safe_kernel(np.random.default_rng(1).normal(size=(24, 4)), 3).vertices)
     assert out.split("\n")[:2] == ["interrupted 1", str(want)]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_near_pairs_and_row_top_under_any_split(seed, monkeypatch):
+    """Both near-pair passes (rows with more than NEAR_KEPT near points scanned again)
+    and row_top under the hostile schedule: the one-thread arrays, in the same order."""
+    from rescon.geometry._candidates import NEAR_KEPT, near_pairs, row_top
+
+    rng = np.random.default_rng([seed, 15])
+    k, nv, m = 5, 700, 400
+    V = rng.uniform(-2.0, 2.0, size=(nv, k))
+    V[: 3 * NEAR_KEPT, 0] = 3.0  # on row 0's hyperplane x_0 = 3: the second pass runs
+    A = rng.normal(size=(m, k))
+    A[0] = [1.0, 0, 0, 0, 0]
+    b = (A @ V.T).max(axis=1) + rng.uniform(0.0, 0.3, m)
+    b[0] = 3.0
+    b[2::5] = (A[2::5] @ V.T).max(axis=1)
+    A_abs, b_abs = np.abs(A) * 1.01, np.abs(b) * 1.01
+    c_err, c = 1e-12, 36 * 2.0**-53
+    coarse = c_err * (A_abs.sum(axis=1) * np.abs(V).max() + b_abs) + c * (
+        np.abs(A).sum(axis=1) * np.abs(V).max() + np.abs(b))
+
+    def both():
+        return (near_pairs(A, b, A_abs, b_abs, V, coarse, c_err, c, 0.0),
+                row_top(A, b, V, 0.0))
+
+    monkeypatch.setattr(_candidates, "on_threads",
+                        lambda scan, total, chunks, workers=None: scan(0, total))
+    (one_r, one_v), one_top = both()
+    assert (np.bincount(one_r) > NEAR_KEPT).any()
+    monkeypatch.setattr(_candidates, "on_threads", _hostile(200 + seed))
+    (r, v), top = both()
+    assert r.tolist() == one_r.tolist() and v.tolist() == one_v.tolist()
+    assert np.array_equal(top, one_top)
