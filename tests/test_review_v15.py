@@ -507,3 +507,27 @@ def test_near_pairs_and_row_top_under_any_split(seed, monkeypatch):
     (r, v), top = both()
     assert r.tolist() == one_r.tolist() and v.tolist() == one_v.tolist()
     assert np.array_equal(top, one_top)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform != "linux", reason="fork")
+@pytest.mark.xfail(strict=True, reason="d = 2 with >= 150 points still runs numba's prange "
+                   "(sweep_pairs_2d; also _expansions._side_counts_parallel): GNU OpenMP in "
+                   "the parent, and each forked child that reaches it dies ('fork() called "
+                   "from a process already using GNU OpenMP'), the pool hangs")
+def test_forked_workers_after_a_plane_kernel():
+    code = ("import multiprocessing as mp, numpy as np, rescon\n"
+            "def run(seed):\n"
+            "    X = np.random.default_rng(seed).normal(size=(300, 2))\n"
+            "    return len(rescon.safe_kernel(X, 20).vertices)\n"
+            "if __name__ == '__main__':\n"
+            "    run(0)\n"
+            "    with mp.get_context('fork').Pool(2) as p:\n"
+            "        print(p.map(run, [1, 2]))\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    try:
+        run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             env=env, cwd=ROOT, timeout=40)
+    except subprocess.TimeoutExpired:
+        pytest.fail("the fork pool hung")
+    assert run.returncode == 0 and "OpenMP" not in run.stderr, run.stderr[-2000:]
