@@ -81,8 +81,8 @@ def test_pruned_scan_counts_are_exact_lower_bounds_of_every_subset(kind, k, m, F
     Yi = _integers(Y)
     subsets = _scan_np.k_subsets(m, k)
     c_err, floor = _scan_args(Y, kind == "integers")
-    got = _candidates.classify_subsets(Y, W.astype(np.int64), subsets, c_err, F, floor)
-    one = _candidates.classify(Y, W.astype(np.int64), subsets, c_err, F, floor)
+    got = _candidates.classify(Y, W.astype(np.int64), subsets, c_err, F, floor, 2)
+    one = _candidates.classify(Y, W.astype(np.int64), subsets, c_err, F, floor, 1)
     twin = _scan_np.classify(Y, W, subsets, c_err, F, floor)
     for a, b in zip(got, one, strict=True):  # threads and one thread: the same
         assert np.array_equal(a, b)

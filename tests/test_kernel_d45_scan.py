@@ -130,7 +130,7 @@ def _full_sides(counts, F):
 @pytest.mark.parametrize("k,m,kind", [(4, 25, "normal"), (4, 22, "ties"), (5, 16, "normal"),
                                       (5, 15, "repeated"), (6, 12, "tiny")])
 def test_parallel_scan_equals_the_numpy_twin_exactly(k, m, kind):
-    """Above PARALLEL_MIN_SUBSETS the scan runs in 64 chunks on threads (each chunk
+    """Above PARALLEL_MIN_SUBSETS the scan runs in CLASSIFY_CHUNKS ranges on threads (each range
     builds its own prefix minors); for k ≥ 4 its counts and flags are identical to the
     numpy twin's — and to one thread's; so are the cofactors of any subsets, as the
     scan computes them."""
@@ -138,8 +138,8 @@ def test_parallel_scan_equals_the_numpy_twin_exactly(k, m, kind):
     W = np.random.default_rng(m).integers(1, 4, size=m)
     subsets = _scan_np.k_subsets(m, k)
     c_err, floor = _scan_args(Y, kind == "ties")
-    threads = _full_sides(_candidates.classify_subsets(Y, W.astype(np.int64), subsets,
-                                                       c_err, 2, floor), 2)
+    threads = _full_sides(_candidates.classify(Y, W.astype(np.int64), subsets,
+                                               c_err, 2, floor, 2), 2)
     twin = _full_sides(_scan_np.classify(Y, W, subsets, c_err, 2, floor), 2)
     one = _full_sides(_candidates.classify(Y, W.astype(np.int64),
                                            subsets[:_candidates.PARALLEL_MIN_SUBSETS - 1],

@@ -381,19 +381,21 @@ def test_replace_with_new_bitsets_does_not_keep_stale_pairs():
 @pytest.mark.parametrize(("k", "m"), [(4, 22), (5, 17)])
 @pytest.mark.parametrize("kind", ["normal", "coplanar", "repeated", "integers", "subnormal",
                                   "huge", "nearsame", "adversary"])
-def test_scan_arrays_under_any_split_equal_the_parallel_loop(kind, k, m, seed,
+def test_scan_arrays_under_any_split_equal_the_unsplit_scan(kind, k, m, seed,
                                                              monkeypatch):
     """The scan's arrays (pruned lower bounds included) when its ranges start anywhere
-    — inside a prefix's run, on its last subset, empty — in any order: numba's own
-    loop's, bit for bit."""
+    — inside a prefix's run, on its last subset, empty — in any order: the unsplit
+    scan's, bit for bit."""
     from tests.test_kernel_d45_around2 import _points
 
     Y = _points(kind, k, m, seed)
     W = np.random.default_rng([m, seed]).integers(1, 3, size=m)
     S = _candidates.k_subsets(m, k, comb(m, k))
+    cases = [(0.0, 1), (1e-12, 2)]
+    # one range on the calling thread: the scan unsplit
+    wants = [_candidates.classify(Y, W, S, c_err, F, 1e-300, 1) for c_err, F in cases]
     monkeypatch.setattr(_candidates, "on_threads", _hostile(100 + seed))
-    for c_err, F in [(0.0, 1), (1e-12, 2)]:
-        want = _candidates.classify_subsets(Y, W, S, c_err, F, 1e-300)
+    for (c_err, F), want in zip(cases, wants, strict=True):
         got = _candidates.classify(Y, W, S, c_err, F, 1e-300, 3)
         assert all(np.array_equal(a, b) for a, b in zip(want, got, strict=True))
     rows = np.random.default_rng(seed).choice(len(S), 300, replace=False)
@@ -402,10 +404,6 @@ def test_scan_arrays_under_any_split_equal_the_parallel_loop(kind, k, m, seed,
         assert np.array_equal(a, b[rows], equal_nan=True)  # huge: NaN cofactors
 
 
-@pytest.mark.xfail(strict=True, reason="on_threads starts workers − 1 threads whatever the "
-                   "number of ranges: on a 64-core machine 63 threads for cofactors' 8 "
-                   "ranges (measured here: 8.9 ms wall, 5.0 CPU-ms per call vs 6.8 / 0.8 "
-                   "with 8 workers, load ~2.6)")
 def test_no_more_threads_than_ranges():
     started = []
     real_start = threading.Thread.start
@@ -511,11 +509,10 @@ def test_near_pairs_and_row_top_under_any_split(seed, monkeypatch):
 
 @pytest.mark.slow
 @pytest.mark.skipif(sys.platform != "linux", reason="fork")
-@pytest.mark.xfail(strict=True, reason="d = 2 with >= 150 points still runs numba's prange "
-                   "(sweep_pairs_2d; also _expansions._side_counts_parallel): GNU OpenMP in "
-                   "the parent, and each forked child that reaches it dies ('fork() called "
-                   "from a process already using GNU OpenMP'), the pool hangs")
 def test_forked_workers_after_a_plane_kernel():
+    """Failed before (numba's prange in the plane sweep and the exact side counts: GNU
+    OpenMP in the parent, each forked child died and the pool hung); every compiled pass
+    now runs on Python threads (:func:`._candidates.on_threads`)."""
     code = ("import multiprocessing as mp, numpy as np, rescon\n"
             "def run(seed):\n"
             "    X = np.random.default_rng(seed).normal(size=(300, 2))\n"
@@ -531,3 +528,24 @@ def test_forked_workers_after_a_plane_kernel():
     except subprocess.TimeoutExpired:
         pytest.fail("the fork pool hung")
     assert run.returncode == 0 and "OpenMP" not in run.stderr, run.stderr[-2000:]
+
+
+@pytest.mark.slow
+def test_concurrent_kernels_under_the_workqueue_layer():
+    """Kernels from 4 user threads at once under numba's ``workqueue`` threading layer
+    (not thread-safe: it aborts the process when parallel regions run concurrently):
+    the same exact vertices as serially. Failed before — the plane sweep and the exact
+    side counts still ran numba ``prange`` loops ("Concurrent access has been
+    detected", the process aborted); every compiled pass now runs on Python threads."""
+    code = ("import numpy as np, rescon\n"
+            "from concurrent.futures import ThreadPoolExecutor\n"
+            "cases = [(np.random.default_rng(s).normal(size=(n, d)), F) for s, (n, d, F)\n"
+            "         in enumerate([(300, 2, 20), (100, 3, 10), (30, 4, 3), (400, 2, 40)] * 3)]\n"
+            "with ThreadPoolExecutor(4) as ex:\n"
+            "    par = list(ex.map(lambda c: rescon.safe_kernel(*c).exact_vertices, cases))\n"
+            "print(par == [rescon.safe_kernel(X, F).exact_vertices for X, F in cases])\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"), NUMBA_THREADING_LAYER="workqueue")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, cwd=ROOT, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.strip() == "True"

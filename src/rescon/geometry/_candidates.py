@@ -18,7 +18,7 @@ float arithmetic is exact (small integers), and s = 0 means "on the hyperplane".
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .._rounding import UNIT_ROUNDOFF
 
@@ -142,7 +142,7 @@ def _prefix_octants(Y, YT, idx, k, R, mdet, mper, c_err, floor, M, C, Cabs, S, T
     is strictly off the line and nothing is counted on a side). Each coordinate of P
     is an orientation whose last difference row is a unit vector, computed as the scan
     computes s(q), so within its coarse bound e = c_err · 2M · Σ_j |C|_j + floor (M =
-    max |coordinate|; the scan's own, :func:`classify_subsets`); a point counts in an
+    max |coordinate|; the scan's own, :func:`classify`); a point counts in an
     open octant only when every comparison clears the bounds: |x̃| > e, |ỹ| > e, and
     fl(|x̃| − |ỹ|) beyond ±2e (rounding is monotone, so fl(u) > 2e implies u > 2e)."""
     n = Y.shape[0]
@@ -226,11 +226,26 @@ CLASSIFY_CHUNKS = 32
 
 
 def classify(Y, W, subsets, c_err, F, floor=0.0, workers=None):
-    """:func:`classify_subsets`: on one thread for small inputs, else on ``workers``
-    threads (default: numba's thread count) that each take the next of CLASSIFY_CHUNKS
-    ranges of subsets as they finish one (:func:`_classify_range`, compiled without the
-    GIL). Each subset's counts depend on it alone (a range recomputes its first
-    prefix's minors), so any split gives the same arrays. Taken as they come, the
+    """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
+    on the + side, surely on the − side and uncertain, and whether its cofactors C
+    (:func:`cofactors`) are surely zero (degenerate subset; only decided when
+    c_err = 0).
+
+    A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
+    (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
+    the precise one (both plus ``floor``, 0 when c_err = 0). For k ≤ 3 the scan of a
+    subset stops once both sides surely hold more than F points (it can then bound no
+    valid halfspace), so counts above F are not exact; for k ≥ 4 every point is
+    counted (:func:`_scan_all`), except for the subsets whose both sides the octants of
+    their prefix already show to hold more than F points (:func:`_prefix_octants`,
+    for prefixes shared by ≥ PRUNE_MIN_RUN subsets): F + 1 on each side, a lower
+    bound, and none uncertain.
+
+    On one thread for small inputs, else on ``workers`` threads (default: numba's
+    thread count) that each take the next of CLASSIFY_CHUNKS ranges of subsets as they
+    finish one (:func:`_classify_range`, compiled without the GIL). Each subset's
+    counts depend on it alone (a range recomputes its first prefix's minors), so any
+    split gives the same arrays. Taken as they come, the
     ranges keep both cores busy when another process holds one part of the time —
     numba's own parallel loop gives each thread a fixed half and waits for the slower
     (measured, cube(4, 50, 9) at load ~3.7: 60 → 40–48 ms wall, 40 → 31–35 CPU-ms)."""
@@ -261,7 +276,8 @@ def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> Non
         import numba
 
         workers = numba.get_num_threads()
-    if chunks <= 1 or workers <= 1:
+    workers = min(workers, chunks)  # no thread without a range to take
+    if workers <= 1:
         scan(0, total)
         return
     import threading
@@ -295,7 +311,7 @@ COFACTOR_THREADS_MIN = 20_000
 
 def cofactors(Y, subsets):
     """The cofactors C and their permanents |C| of the subsets (rows), (count, k) each,
-    exactly as the scan (:func:`classify_subsets`) computes them — only for the
+    exactly as the scan (:func:`classify`) computes them — only for the
     subsets the caller keeps (the scan stores none: tables of C(n, k) rows cost more
     to allocate than to fill). Many subsets: ranges of them on threads
     (:func:`on_threads`; each row is computed alone, so the split changes nothing)."""
@@ -458,7 +474,7 @@ def _member(idx, q):
 @njit(cache=True, nogil=True)
 def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
                     plus, minus, unc, degenerate, cof, cof_abs):
-    """classify_subsets for rows t0 ≤ t < t1 (written into the output arrays) — or,
+    """classify for rows t0 ≤ t < t1 (written into the output arrays) — or,
     when ``cof`` has rows, only the subsets' cofactors and permanents, into cof and
     cof_abs (:func:`cofactors`: the same code computes them)."""
     n, k = Y.shape
@@ -545,48 +561,12 @@ def _classify_range(Y, YT, W, subsets, c_err, F, floor, M, t0, t1,
         unc[t] = nu
 
 
-@njit(cache=True, parallel=True)
-def classify_subsets(Y, W, subsets, c_err, F, floor=0.0):
-    """For every k-subset (rows of ``subsets``): the weighted numbers of points surely
-    on the + side, surely on the − side and uncertain, and whether its cofactors C
-    (:func:`cofactors`) are surely zero (degenerate subset; only decided when
-    c_err = 0).
-
-    A point is first tested against the subset's coarse bound c_err · 2M · Σ|C|_j
-    (M = max |coordinate|, so |q − p_0|_j ≤ 2M), and only near the hyperplane against
-    the precise one (both plus ``floor``, 0 when c_err = 0). For k ≤ 3 the scan of a
-    subset stops once both sides surely hold more than F points (it can then bound no
-    valid halfspace), so counts above F are not exact; for k ≥ 4 every point is
-    counted (:func:`_scan_all`), except for the subsets whose both sides the octants of
-    their prefix already show to hold more than F points (:func:`_prefix_octants`,
-    for prefixes shared by ≥ PRUNE_MIN_RUN subsets): F + 1 on each side, a lower
-    bound, and none uncertain."""
-    n, k = Y.shape
-    count = subsets.shape[0]
-    plus = np.zeros(count, dtype=np.int64)
-    minus = np.zeros(count, dtype=np.int64)
-    unc = np.zeros(count, dtype=np.int64)
-    degenerate = np.zeros(count, dtype=np.bool_)
-    M = 0.0
-    for q in range(n):
-        for j in range(k):
-            M = max(M, abs(Y[q, j]))
-    YT = np.ascontiguousarray(Y.T)
-    chunks = 64
-    for c in prange(chunks):
-        _classify_range(Y, YT, W, subsets, c_err, F, floor, M, count * c // chunks,
-                        count * (c + 1) // chunks, plus, minus, unc, degenerate,
-                        np.empty((0, k)), np.empty((0, k)))
-    return plus, minus, unc, degenerate
-
-
 #: angle error bound of atan2 on a correctly rounded difference vector (radians):
 #: the difference has relative error ≤ ε per component (≤ √2 ε in direction), atan2
 #: a few ulps of π; 64 ε is a wide margin.
 ANGLE_ERR = 64.0 * UNIT_ROUNDOFF * np.pi
 
 
-@njit(cache=True, parallel=True)
 def sweep_pairs_2d(Y, W, subsets):
     """Side counts of the lines through every pair (rows of ``subsets``, i < j) of
     distinct points in the plane by an angular sweep around each point, O(n² log n).
@@ -595,7 +575,8 @@ def sweep_pairs_2d(Y, W, subsets):
     normal (−Δy, Δx)). A point whose angle around i is within 2·ANGLE_ERR of the
     line's two directions is counted as uncertain (decided exactly later); the others
     are certainly on their side, since each float angle is within ANGLE_ERR of the
-    true one."""
+    true one. The points i are swept in ranges on threads (:func:`on_threads`: each
+    writes only the rows of its own pairs (i, ·), so any split gives the same arrays)."""
     n = Y.shape[0]
     count = subsets.shape[0]
     plus = np.zeros(count, dtype=np.int64)
@@ -603,11 +584,23 @@ def sweep_pairs_2d(Y, W, subsets):
     unc = np.zeros(count, dtype=np.int64)
     # row offset of the pairs (i, ·): pairs are in lexicographic order
     start = np.zeros(n + 1, dtype=np.int64)
-    for i in range(n):
-        start[i + 1] = start[i] + (n - 1 - i)
+    start[1:] = np.cumsum(np.arange(n - 1, -1, -1))
+
+    def scan(lo: int, hi: int) -> None:
+        _sweep_points(Y, W, start, lo, hi, plus, minus, unc)
+
+    on_threads(scan, max(n - 1, 0), 64 if count >= PARALLEL_MIN_SUBSETS else 1)
+    return plus, minus, unc, np.zeros(count, dtype=np.bool_)
+
+
+@njit(cache=True, nogil=True)
+def _sweep_points(Y, W, start, i0, i1, plus, minus, unc):
+    """:func:`sweep_pairs_2d` around the points i0 ≤ i < i1 (the rows of their pairs
+    (i, j), j > i)."""
+    n = Y.shape[0]
     two_pi = 2.0 * np.pi
     tol = 2.0 * ANGLE_ERR
-    for i in prange(n - 1):
+    for i in range(i0, i1):
         m = n - 1
         ang = np.empty(m)
         wts = np.empty(m, dtype=np.int64)
@@ -645,8 +638,6 @@ def sweep_pairs_2d(Y, W, subsets):
             minus[row] = right
             # everything else but j itself is uncertain
             unc[row] = total - left - right - W[j]
-    degenerate = np.zeros(count, dtype=np.bool_)
-    return plus, minus, unc, degenerate
 
 
 def ball_chunks(V: np.ndarray, leaf: int = 32

@@ -19,7 +19,7 @@ inputs can make a sign wrong.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 from numba.extending import register_jitable
 
 from .._rounding import MIN_NORMAL
@@ -338,16 +338,7 @@ def _side_counts_range(Y, W, subsets, F, t0, t1, plus, minus, degenerate):
                 break
 
 
-@njit(cache=True, parallel=True)
-def _side_counts_parallel(Y, W, subsets, F, plus, minus, degenerate):
-    count = subsets.shape[0]
-    chunks = 64
-    for c in prange(chunks):
-        _side_counts_range(Y, W, subsets, F, count * c // chunks, count * (c + 1) // chunks,
-                           plus, minus, degenerate)
-
-
-#: from this many subsets on, the exact side counts run on all threads
+#: from this many subsets on, the exact side counts run on threads
 PARALLEL_MIN_SUBSETS = 200
 
 
@@ -356,8 +347,11 @@ def side_counts(Y, W, subsets, F, plus, minus, degenerate):
     or line (k = 2) through each subset (+: the side of the cofactor normal), and
     whether the subset is affinely dependent. A subset's scan stops once both sides
     hold more than F (it bounds no valid halfspace), so counts above F are lower
-    bounds; counts ≤ F are exact."""
-    if len(subsets) >= PARALLEL_MIN_SUBSETS:
-        _side_counts_parallel(Y, W, subsets, F, plus, minus, degenerate)
-    else:
-        _side_counts_range(Y, W, subsets, F, 0, len(subsets), plus, minus, degenerate)
+    bounds; counts ≤ F are exact. Many subsets: ranges of them on threads
+    (:func:`._candidates.on_threads`; each subset's counts are its own)."""
+    from ._candidates import on_threads
+
+    def scan(lo: int, hi: int) -> None:
+        _side_counts_range(Y, W, subsets, F, lo, hi, plus, minus, degenerate)
+
+    on_threads(scan, len(subsets), 64 if len(subsets) >= PARALLEL_MIN_SUBSETS else 1)

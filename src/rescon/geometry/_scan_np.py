@@ -96,7 +96,7 @@ def _expand_last(row: np.ndarray, r: int, cols, minors: dict
 def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F: int,
              floor: float = 0.0) -> tuple[np.ndarray, ...]:
     """(plus, minus, unc, degenerate) for every k-subset, as
-    :func:`rescon.geometry._candidates.classify_subsets` defines them.
+    :func:`rescon.geometry._candidates.classify` defines them.
 
     A point q off the subset is surely on the + side when s(q) > bound, on the − side
     when s(q) < −bound, else uncertain (c_err > 0) or on the hyperplane (c_err = 0,
