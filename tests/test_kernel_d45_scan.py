@@ -191,3 +191,22 @@ def test_kernels_equal_the_exact_clipping(kind, d, n, F, monkeypatch):
     assert fast.exact_vertices == slow.exact_vertices
     assert fast._exact.constraints == slow._exact.constraints
     assert fast.certificate == slow.certificate
+
+
+@pytest.mark.parametrize("block", [1, 7, 4096])
+@pytest.mark.parametrize(("k", "m"), [(2, 12), (3, 11), (4, 9), (5, 8)])
+@pytest.mark.parametrize("kind", ["normal", "ties", "repeated", "tiny"])
+def test_exact_side_counts_in_integers_equal_the_brute_force(kind, k, m, block,
+                                                              monkeypatch):
+    """The integer path of ``halfspaces._exact_side_counts`` (every point at once per
+    block of subsets, object arrays) against one Bareiss determinant per point: the
+    counts and dependence flags of every subset, in blocks of any size."""
+    monkeypatch.setattr(halfspaces, "EXACT_BLOCK", block * m)
+    Y = _points(kind, k, m, 7)
+    Yi = _integers(Y)
+    W = np.random.default_rng(m).integers(1, 4, size=m)
+    subsets = _scan_np.k_subsets(m, k)
+    plus, minus, dep = halfspaces._exact_side_counts(Y, Yi, W, subsets, m, False)
+    want = [_exact_counts(Yi, W, s) for s in subsets.tolist()]
+    assert [list(t) for t in zip(plus.tolist(), minus.tolist(), dep.tolist())] == [
+        list(t) for t in want]

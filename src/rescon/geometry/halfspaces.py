@@ -309,7 +309,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         af_abs = af_abs * (1.1 * c_err / c_new)
         c_err = c_new
         if len(ill):
-            af[ill] = (_exact_normals3(Y, through[ill], small) if k == 3
+            af[ill] = (_exact_normals3(Y, Yi, through[ill], small) if k == 3
                        else _rounded_cofactors(Y, Yi, through[ill])) * sign[ill, None]
             af_abs[ill] = np.abs(af[ill]) * (1.0 + 4 * _EPS) + (k > 3) * MIN_NORMAL
     bf = np.einsum("ij,ij->i", af, p0)
@@ -332,25 +332,19 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     return hs
 
 
-def _exact_normals3(Y: np.ndarray, triples: np.ndarray, small: bool) -> np.ndarray:
+def _exact_normals3(Y: np.ndarray, Yi: list[tuple[int, ...]], triples: np.ndarray,
+                    small: bool) -> np.ndarray:
     """The normals (p_j − p_i) × (p_k − p_i) of the triples (i, j, k) of rows of Y, each
     component its exact value rounded: by numba expansions (within 3 ulps), or for
-    small inputs in Fractions (correctly rounded; Y's entries are exact binary
-    fractions)."""
+    small inputs correctly rounded from the integer normal (:func:`_rounded_cofactors`:
+    for k = 3 the cofactor normal is this cross product; Y = Yi / unit exactly)."""
     if not small:
         from ._expansions import normals3
 
         out = np.empty((len(triples), 3))
         normals3(np.ascontiguousarray(Y, dtype=np.float64), triples, out)
         return out
-    rows = []
-    for i, j, k in triples.tolist():
-        p, u, w = ([Fraction(v) for v in Y[r]] for r in (i, j, k))
-        a = [x - y for x, y in zip(u, p, strict=True)]
-        b = [x - y for x, y in zip(w, p, strict=True)]
-        rows.append([float(a[1] * b[2] - a[2] * b[1]), float(a[2] * b[0] - a[0] * b[2]),
-                     float(a[0] * b[1] - a[1] * b[0])])
-    return np.array(rows, dtype=np.float64).reshape(-1, 3)
+    return _rounded_cofactors(Y, Yi, triples)
 
 
 def _rounded_cofactors(Y: np.ndarray, Yi: list[tuple[int, ...]], subsets: np.ndarray
@@ -393,6 +387,10 @@ def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
     return np.sort(order[starts])
 
 
+#: (subset, point) pairs per block of :func:`_exact_side_counts`' integer path
+EXACT_BLOCK = 4096
+
+
 def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Exact weighted numbers of points strictly on the + and − side of the hyperplane
@@ -409,28 +407,19 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
         side_counts(np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64),
                     np.ascontiguousarray(subsets), F, plus, minus, dependent)
         return plus, minus, dependent
-    for t, subset in enumerate(subsets):
-        n_plus, n_minus = _exact_counts(Yi, W, subset)
-        dependent[t] = n_plus is None
-        plus[t], minus[t] = (0, 0) if n_plus is None else (n_plus, n_minus)
+    # in integers: s(q) = C·(q − p_0) for every point q at once (object arrays, in
+    # blocks of ≤ EXACT_BLOCK (subset, point) pairs); a member q of the subset lies on
+    # its hyperplane (s = 0), so it counts on neither side
+    P = np.array(Yi, dtype=object).reshape(len(Yi), k)
+    Wi = np.asarray(W, dtype=np.int64)
+    block = max(1, EXACT_BLOCK // max(1, len(Yi)))
+    for s0 in range(0, len(subsets), block):
+        sub = subsets[s0:s0 + block]
+        N = np.array([exact_normal(Yi, t) for t in sub.tolist()], dtype=object
+                     ).reshape(len(sub), k)
+        S = ((P[None, :, :] - P[sub[:, 0]][:, None, :]) * N[:, None, :]).sum(axis=2)
+        plus[s0:s0 + len(sub)] = np.asarray(S > 0, dtype=np.bool_) @ Wi
+        minus[s0:s0 + len(sub)] = np.asarray(S < 0, dtype=np.bool_) @ Wi
+        dependent[s0:s0 + len(sub)] = ~np.asarray(N != 0, dtype=np.bool_).any(axis=1)
+    plus[dependent] = minus[dependent] = 0
     return plus, minus, dependent
-
-
-def _exact_counts(Yi, W, subset) -> tuple[int | None, int]:
-    """Exact weighted numbers of points strictly on the + and − side of the
-    hyperplane through ``subset`` ((None, 0) if the subset is affinely dependent)."""
-    normal = exact_normal(Yi, subset)
-    if not any(normal):
-        return None, 0
-    p0 = Yi[subset[0]]
-    members = {int(i) for i in subset}
-    n_plus = n_minus = 0
-    for q, yq in enumerate(Yi):
-        if q in members:
-            continue
-        s = sum(c * (a - b) for c, a, b in zip(normal, yq, p0, strict=True))
-        if s > 0:
-            n_plus += int(W[q])
-        elif s < 0:
-            n_minus += int(W[q])
-    return n_plus, n_minus
