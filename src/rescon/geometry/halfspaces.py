@@ -409,7 +409,8 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
         return plus, minus, dependent
     # in integers: s(q) = C·(q − p_0) for every point q at once (object arrays, in
     # blocks of ≤ EXACT_BLOCK (subset, point) pairs); a member q of the subset lies on
-    # its hyperplane (s = 0), so it counts on neither side
+    # its hyperplane (s = 0), so it counts on neither side; a dependent subset's zero
+    # normal puts every point there
     P = np.array(Yi, dtype=object).reshape(len(Yi), k)
     Wi = np.asarray(W, dtype=np.int64)
     block = max(1, EXACT_BLOCK // max(1, len(Yi)))
@@ -421,5 +422,4 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
         plus[s0:s0 + len(sub)] = np.asarray(S > 0, dtype=np.bool_) @ Wi
         minus[s0:s0 + len(sub)] = np.asarray(S < 0, dtype=np.bool_) @ Wi
         dependent[s0:s0 + len(sub)] = ~np.asarray(N != 0, dtype=np.bool_).any(axis=1)
-    plus[dependent] = minus[dependent] = 0
     return plus, minus, dependent
