@@ -214,7 +214,7 @@ def _run(tmp_path, *extra):
 
 def test_harness_runs_and_writes_results(tmp_path):
     assert _run(tmp_path, "--candidate", "leblanc", "--name", "t") == 0
-    rows = list(csv.DictReader(open(tmp_path / "t.csv")))
+    rows = list(csv.DictReader((tmp_path / "t.csv").read_text().splitlines()))
     assert {r["method"] for r in rows} == {"leblanc(candidate)", "leblanc", "milp"}
     assert all(r["status"] in ("exact", "optimal") for r in rows)
     md = (tmp_path / "t.md").read_text()
@@ -230,7 +230,7 @@ def test_harness_flags_a_wrong_candidate(tmp_path, monkeypatch):
 
     monkeypatch.setitem(R.CANDIDATES, "wrong", wrong)
     assert _run(tmp_path, "--candidate", "wrong", "--name", "w") == 1
-    rows = list(csv.DictReader(open(tmp_path / "w.csv")))
+    rows = list(csv.DictReader((tmp_path / "w.csv").read_text().splitlines()))
     errs = [r for r in rows if r["method"] == "check"]
     assert errs and all(r["status"] == "error" and "rho mismatch" in r["detail"] for r in errs)
     assert "Errors" in (tmp_path / "w.md").read_text()
