@@ -243,6 +243,20 @@ def test_read_points_csv_errors(tmp_path, text, pattern):
         read_points(_write(tmp_path, "p.csv", text))
 
 
+def test_read_points_whitespace_separated(tmp_path):
+    """numpy.savetxt's default output (spaces, %.18e) and tab-separated columns with
+    a header read as the same points; a file with no comma used to be one CSV column
+    whose first line passed for a header ("'3 4' is not a number")."""
+    X = np.array([[1e308, -5e-324], [0.1, 2.0], [-3.0, 1e-300]])
+    p = tmp_path / "x.txt"
+    np.savetxt(p, X)
+    np.testing.assert_array_equal(read_points(p), X)
+    q = _write(tmp_path, "t.txt", "# comment\nx\ty\n1\t2\n 3   4 \n")
+    np.testing.assert_array_equal(read_points(q), [[1.0, 2.0], [3.0, 4.0]])
+    with pytest.raises(InputError, match=r"m\.txt:2: row has 2 entries; expected 1"):
+        read_points(_write(tmp_path, "m.txt", "1 2\n3,4\n"))  # any comma: CSV throughout
+
+
 @pytest.mark.parametrize(
     ("array", "pattern"),
     [

@@ -468,7 +468,8 @@ def _parser() -> argparse.ArgumentParser:
     rob.set_defaults(func=_cmd_robustness)
 
     ker = sub.add_parser("kernel", help="the safe kernel of a point set (exact polytope)")
-    ker.add_argument("points", help="CSV (n rows of d numbers, optional header) or .npy")
+    ker.add_argument("points", help="text (n rows of d numbers, comma- or "
+                     "whitespace-separated, optional header) or .npy")
     ker.add_argument("--F", type=_nonneg_int, required=True, help="points that may be removed")
     ker.add_argument("--plot", metavar="PNG", help="draw points, kernel and point (d = 2, 3)")
     ker.add_argument("--certificate", metavar="FILE", help="write the certificate (JSON)")

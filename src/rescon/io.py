@@ -275,10 +275,12 @@ def read_points(path: str | os.PathLike[str]) -> np.ndarray:
     Parameters
     ----------
     path : str or os.PathLike
-        ``.npy``: a 2-D numeric array (no pickles). Anything else: CSV with n rows
-        of d comma-separated numbers, an optional header row (recognised by
-        having no number cell, ignored; a first row mixing numbers and other cells
-        is an error), ``#`` comment lines and blank lines ignored.
+        ``.npy``: a 2-D numeric array (no pickles). Anything else: text with n
+        rows of d numbers — comma-separated (CSV) if any data line has a comma,
+        else separated by spaces or tabs (``numpy.savetxt``'s and MATLAB's default);
+        an optional header row (recognised by having no number cell, ignored; a
+        first row mixing numbers and other cells is an error), ``#`` comment lines
+        and blank lines ignored.
 
     Returns
     -------
@@ -295,7 +297,7 @@ def read_points(path: str | os.PathLike[str]) -> np.ndarray:
     p = _existing_file(path, "points file")
     if p.suffix.lower() == ".npy":
         return _read_npy_points(p)
-    rows = _csv_rows(p, error=InputError)
+    rows = _point_rows(p)
     if not rows:
         raise InputError(f"{p}: no points (expected n >= 1 rows of d numbers)")
     first_line, width = rows[0][0], len(rows[0][1])
@@ -367,6 +369,15 @@ def _csv_rows(p: Path, error: type[InputError] = GraphFormatError) -> list[tuple
         (lineno, [c.strip() for c in next(csv.reader([line]))])
         for lineno, line in _data_lines(p, error=error)
     ]
+
+
+def _point_rows(p: Path) -> list[tuple[int, list[str]]]:
+    """A points file's data rows: CSV cells if any line has a comma, else the
+    whitespace-separated fields of each line."""
+    lines = list(_data_lines(p, error=InputError))
+    if any("," in line for _, line in lines):
+        return _csv_rows(p, error=InputError)
+    return [(lineno, line.split()) for lineno, line in lines]
 
 
 def _number(cell: str) -> float | None:
