@@ -19,12 +19,16 @@ from math import comb
 
 import numpy as np
 
-__all__ = ["HUGE", "TINY", "classify", "cofactors", "in_range", "k_subsets", "sets_in_range"]
+__all__ = ["HUGE", "PIVOT_ERR", "TINY", "classify", "cofactors", "in_range", "k_subsets",
+           "sets_in_range", "side_signs"]
 
 #: nonzero |coordinates| must lie in [TINY, HUGE] for the expansion predicates of
 #: :mod:`._expansions` to be exact: then products of up to four differences neither
 #: underflow nor overflow
 TINY, HUGE = 2.0**-120, 2.0**120
+#: relative error bound of :func:`side_signs`' orientations (k ≤ 3), 16u = 2^-49: twice
+#: the proven 8u (see there), and a power of two, so the bound itself is exact
+PIVOT_ERR = 2.0**-49
 
 
 def in_range(Y: np.ndarray) -> bool:
@@ -136,3 +140,71 @@ def cofactors(Y: np.ndarray, subsets: np.ndarray) -> tuple[np.ndarray, np.ndarra
     """The cofactors C and their permanents |C| of the subsets (rows), as
     :func:`rescon.geometry._candidates.cofactors` computes them."""
     return _cofactors(Y[subsets[:, 1:]] - Y[subsets[:, :1]])
+
+
+def _det_per(R) -> tuple[np.ndarray, np.ndarray]:
+    """det and permanent of |·| of k × k matrices given by rows of columns, R[r][c] an
+    array over the matrices, k ∈ {2, 3}: for k = 3 the cofactors c of the first two
+    rows (a₁b₂ − a₂b₁, …) and det = (c₀r₀ + c₁r₁) + c₂r₂ with the third row r, so every
+    monomial passes through ≤ 5 roundings (product, difference, product, two sums);
+    for k = 2, a₀c₁ − a₁c₀ (2 roundings)."""
+    if len(R) == 2:
+        p, q = R[0][0] * R[1][1], R[0][1] * R[1][0]
+        return p - q, np.abs(p) + np.abs(q)
+    a, b, r = R
+    det = per = None
+    for j, (u, v) in enumerate(((1, 2), (2, 0), (0, 1))):
+        p, q = a[u] * b[v], a[v] * b[u]
+        t, tp = (p - q) * r[j], (np.abs(p) + np.abs(q)) * np.abs(r[j])
+        det, per = (t, tp) if det is None else (det + t, per + tp)
+    return det, per
+
+
+def side_signs(Y: np.ndarray, subsets: np.ndarray) -> np.ndarray:
+    """Signs (T, m) of s(q) = C·(q − p_0) for every subset (p_0..p_{k−1}) = Y[subsets[t]]
+    and point q = Y[i] (C the cofactor normal, :func:`cofactors`), k = Y.shape[1] ∈ {2, 3}:
+    +1 or −1 where the float filter below proves the sign, 0 where it cannot (always
+    for the subset's own points, and for every point of a dependent subset).
+
+    Requires :func:`in_range` (Y): then no product of ≤ 3 differences underflows or
+    overflows (nonzero differences lie in [2^-172, 2^121]); otherwise every point is
+    reported undecided (0).
+
+    Pivots. With x_0..x_k = (p_0, …, p_{k−1}, q), s(q) = det[x_j − x_0]_{j≥1} = D_0,
+    and D_i = det[x_j − x_i]_{j≠i, increasing} = (−1)^i D_0 (subtract row i of the
+    (k+1) × (k+1) matrix [x_j, 1] from the others and expand along the column of ones:
+    the determinant is (−1)^(i+k) D_i for every i). The filter tries every pivot i and
+    keeps the first decision: for a cluster with one far point, the pivot in the
+    cluster has well-conditioned differences where p_0 = the far point cancels ~1e8-fold.
+
+    Bound. Each difference is rounded once (|δ| ≤ u = 2^-53) and every monomial of
+    :func:`_det_per` passes through at most 5 more roundings, so the computed det is
+    Σ_t m_t Π(1 + δ) over ≤ k + 5 ≤ 8 factors: |fl(det) − det| ≤ γ_8 Σ_t |m_t|, with
+    m_t the monomials of the exact differences; the computed permanent P satisfies
+    Σ_t |m_t| ≤ P / (1 − u)^8 (the same factors, at most 8 of them). Hence
+    |fl(det) − det| ≤ 8u(1 + 20u) P < 16u · P = PIVOT_ERR · P, and |fl(det)| >
+    PIVOT_ERR · P proves sign(det) = sign(fl(det)). A NaN or inf never passes."""
+    T, k = subsets.shape
+    m = len(Y)
+    sign = np.zeros((T, m), dtype=np.int8)
+    if not in_range(Y) or not T:
+        return sign
+    # coordinate c of point j of every (subset, point) pair: X[j][c], flat over pairs
+    X = [[np.repeat(Y[subsets[:, j], c], m) for c in range(k)] for j in range(k)]
+    X.append([np.tile(Y[:, c], T) for c in range(k)])
+    flat = sign.reshape(-1)
+    todo = np.arange(T * m)
+    for i in range(k + 1):  # each pivot on the pairs still undecided
+        R = [[X[j][c] - X[i][c] for c in range(k)] for j in range(k + 1) if j != i]
+        det, per = _det_per(R)
+        bound = PIVOT_ERR * per
+        s = 1 if i % 2 == 0 else -1
+        pos, neg = det > bound, det < -bound
+        flat[todo[pos]] = s
+        flat[todo[neg]] = -s
+        left = ~(pos | neg)
+        todo = todo[left]
+        if not len(todo):
+            break
+        X = [[x[left] for x in row] for row in X]
+    return sign

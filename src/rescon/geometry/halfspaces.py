@@ -284,7 +284,8 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     sure_p, sure_m = np.flatnonzero(sure_plus), np.flatnonzero(sure_minus)
     maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
     n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F,
-                                                    expansions and not small)  # exactly
+                                                    expansions and not small,  # exactly
+                                                    pivots=small and expansions)
     add_p = ~dependent & (n_plus <= F) & ~sure_plus[maybe]
     add_m = ~dependent & (n_minus <= F) & ~sure_minus[maybe]
     idx = np.concatenate([sure_p, sure_m, maybe[add_p], maybe[add_m]])
@@ -356,8 +357,20 @@ def _rounded_cofactors(Y: np.ndarray, Yi: list[tuple[int, ...]], subsets: np.nda
     i, j = np.unravel_index(np.abs(Y).argmax(), Y.shape)
     unit = Fraction(Yi[i][j]) / Fraction(float(Y[i, j]))
     den = unit ** (k - 1)
-    return np.array([[float(c / den) for c in exact_normal(Yi, sub)]
-                     for sub in subsets.tolist()], dtype=np.float64).reshape(-1, k)
+    if k < 2 or not len(subsets):
+        return np.array([[float(c / den) for c in exact_normal(Yi, sub)]
+                         for sub in subsets.tolist()], dtype=np.float64).reshape(-1, k)
+    # all normals at once (:func:`.exact.cross_all` on object arrays of Python ints,
+    # (−1)^(k−1) × the cross product is :func:`exact_normal`), then c / den = c·q / p
+    # (den = p/q) by int true division, which is correctly rounded like float(Fraction)
+    P = np.empty((len(Yi), k), dtype=object)
+    P[:] = Yi
+    N = cross_all(P[subsets[:, 1:]] - P[subsets[:, :1]])
+    if k % 2 == 0:
+        N = -N
+    num, dnm = den.denominator, den.numerator
+    return np.array([[c * num / dnm for c in row] for row in N.tolist()],
+                    dtype=np.float64).reshape(-1, k)
 
 
 def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
@@ -391,12 +404,16 @@ def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
 EXACT_BLOCK = 4096
 
 
-def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
+def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool, pivots: bool = False
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Exact weighted numbers of points strictly on the + and − side of the hyperplane
     through each subset (those above F may be lower bounds), and whether the subset is
     affinely dependent: by floating-point expansions in numba for k ≤ 3 when
-    ``expansions`` (Y exact and in their range), else in integers."""
+    ``expansions`` (Y exact and in their range), else in integers — after, when
+    ``pivots`` (k ≤ 3, Y exact and in range), the pivoted float filter
+    (:func:`._scan_np.side_signs`), which settles every subset whose other points it
+    all decides: its counts are then exact and complete, and it is independent (a
+    dependent subset has every det exactly 0). The rest go to the integers."""
     k = Y.shape[1]
     plus = np.zeros(len(subsets), dtype=np.int64)
     minus = np.zeros(len(subsets), dtype=np.int64)
@@ -406,6 +423,20 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool
 
         side_counts(np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64),
                     np.ascontiguousarray(subsets), F, plus, minus, dependent)
+        return plus, minus, dependent
+    if pivots and k in (2, 3) and len(Y) > k and len(subsets):
+        from ._scan_np import side_signs
+
+        sg = side_signs(np.ascontiguousarray(Y, dtype=np.float64), subsets)
+        sg[np.arange(len(subsets))[:, None], subsets] = 2  # members: on the hyperplane
+        done = np.flatnonzero(np.all(sg != 0, axis=1))
+        Wi = np.asarray(W, dtype=np.int64)
+        plus[done] = (sg[done] == 1) @ Wi
+        minus[done] = (sg[done] == -1) @ Wi
+        rest = np.flatnonzero(np.any(sg == 0, axis=1))
+        if len(rest):
+            p, m, dep = _exact_side_counts(Y, Yi, W, subsets[rest], F, False)
+            plus[rest], minus[rest], dependent[rest] = p, m, dep
         return plus, minus, dependent
     # in integers: s(q) = C·(q − p_0) for every point q at once (object arrays, in
     # blocks of ≤ EXACT_BLOCK (subset, point) pairs); a member q of the subset lies on
