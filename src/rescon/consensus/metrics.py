@@ -44,16 +44,28 @@ BLOCK = 2**20
 
 
 def monitor_names(metrics: Any) -> tuple[str, ...]:
-    """The :data:`MONITORS` a run records: every one for None, else the names given
-    (a string or a sequence of strings; duplicates ignored, order of MONITORS)."""
+    """The :data:`MONITORS` a run records: every one for None, else the names given —
+    a string of comma-separated names (the CLI's ``--metrics a,b``; blanks around a
+    name ignored) or a sequence of such strings; duplicates ignored, order of
+    MONITORS. Bytes, and items that are not strings, are refused (bytes iterate as
+    integer codes)."""
     if metrics is None:
         return MONITORS
     names = [metrics] if isinstance(metrics, str) else metrics
+    wrong = InputError(f"metrics must be a string of comma-separated names or a list of "
+                       f"names from {', '.join(MONITORS)}; got {metrics!r}")
+    if isinstance(metrics, (bytes, bytearray, memoryview)):
+        raise wrong
     try:
-        chosen = set(names)
+        items = list(names)
     except TypeError:
-        raise InputError(f"metrics must be a list of names from {MONITORS}; got {metrics!r}"
-                         ) from None
+        raise wrong from None
+    if not all(isinstance(item, str) for item in items):
+        raise wrong
+    chosen = {name.strip() for item in items for name in item.split(",") if name.strip()}
+    if items and not chosen:
+        raise InputError(f"metrics {metrics!r} names no monitor; give some of "
+                         f"{', '.join(MONITORS)}")
     unknown = sorted(map(repr, chosen - set(MONITORS)))
     if unknown:
         raise InputError(f"metrics: unknown name(s) {', '.join(unknown)}; "
@@ -236,6 +248,7 @@ class ValidityMonitor:
         self._edges = _polygon_edges(self.hull) if full and initial.shape[1] == 2 else None
         self._triangles = _hull_triangles(self.hull) if full and initial.shape[1] == 3 else None
         self._inner = _inner_rows(self.hull) if self._edges is not None else None
+        self._edge_tree = _edge_tree(*self._edges) if self._inner is not None else None
         self._cones = _cone_filter(self.hull) if full and initial.shape[1] == 3 else None
 
     def distance(self, x: np.ndarray) -> float:
@@ -256,21 +269,27 @@ class ValidityMonitor:
         the dot product) plus (d + 2)(‖x‖∞ + 1)·2^-1074 for gradual underflow; twice
         the first term covers the rounding of the bound itself. Overflow makes the
         bound inf or the value NaN, and the row unproven. A polygon of many edges first
-        tries its inner polygon (:func:`_inner_rows`) and its fan (:meth:`_in_fan`), a
-        polytope from :func:`_exact_polytope` the cones of its triangles
-        (:meth:`_in_cones`), then its own facets in blocks."""
+        tries its inner polygon (:func:`_inner_rows`) and its fan (:meth:`_in_fan`), and
+        rows that the facet of their angular cone proves outside (:meth:`_outside_guess`:
+        S > bound there, so S < −bound on no facet) skip the loop; a polytope from
+        :func:`_exact_polytope` tries the cones of its triangles (:meth:`_in_cones`);
+        then its own facets in blocks."""
         sure = np.zeros(len(states), dtype=bool)
         if self._rows is None:
             return sure
+        out = np.zeros(len(states), dtype=bool)  # proven outside: no facet loop
         if self._inner is not None:
             S, bound = _slacks(*self._inner, states)
             sure = (S < -bound).all(axis=1)
             todo = np.flatnonzero(~sure)
             sure[todo] = self._in_fan(states[todo])
+        if self._edge_tree is not None:
+            todo = np.flatnonzero(~sure)
+            out[todo] = self._outside_guess(states[todo])[0]
         if self._cones is not None:
             todo = np.flatnonzero(~sure)
             sure[todo] = self._in_cones(states[todo])
-        todo = np.flatnonzero(~sure)
+        todo = np.flatnonzero(~sure & ~out)
         block = max(1, BLOCK // len(self._rows[1]))
         for s in range(0, todo.size, block):
             rows = todo[s:s + block]
@@ -285,11 +304,17 @@ class ValidityMonitor:
     def distances(self, states: np.ndarray) -> np.ndarray:
         """Distances of the rows of ``states``: rows :meth:`surely_inside` the hull or
         equal to their initial state are 0, rows a facet proves outside a polygon get
-        :meth:`edge_distances`, outside a polytope in R³ :meth:`triangle_distances`
-        where their bound is below the distance, the others the exact :meth:`distance`."""
+        :meth:`edge_distances` (for a polygon of many edges the same floats in
+        O(log h) per row, :meth:`_nearest_edges`), outside a polytope in R³
+        :meth:`triangle_distances` where their bound is below the distance, the others
+        the exact :meth:`distance`."""
         out = np.zeros(len(states))
         rest = np.flatnonzero(~self._initial_rows(states))
         rest = rest[~self.surely_inside(states[rest])]
+        if rest.size and self._edge_tree is not None:
+            fast, dist = self._nearest_edges(states[rest])
+            out[rest[fast]] = dist[fast]
+            rest = rest[~fast]
         if rest.size and self._edges is not None:
             dist, err = self.edge_distances(states[rest])
             # dist > 0: a state just outside a thin polygon may get a float distance 0
@@ -342,6 +367,79 @@ class ValidityMonitor:
         big = np.maximum(np.abs(X).max(axis=1), np.abs(C).max()) > 1e150
         return ok & (S < -bound) & ~big
 
+    def _outside_guess(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(out, j) for rows of X (n, 2) and a polygon of many edges (cycle C, edge j
+        from C_j to C_{j+1}, facet j): j is the edge whose angular interval about c
+        (the float mean of the vertices) holds the angle of x − c — a guess, right
+        when c is inside H (the angles of C about c then increase cyclically, and the
+        ray from c through an outside x leaves H across edge j, beyond its line) — and
+        out the rows facet j's float filter proves outside (S > bound,
+        :meth:`surely_inside`): a wrong guess leaves a row unproven, never wrongly
+        outside. O(n log h)."""
+        A, b = self._rows
+        c, order, rays = self._edge_tree[3:6]
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            phi = np.arctan2(X[:, 1] - c[1], X[:, 0] - c[0])
+            j = order[np.searchsorted(rays, phi, side="right") - 1]  # −1: the last
+            S = (X * A[j]).sum(axis=1) - b[j]
+            bound = _slack_bound(2, (np.abs(X) * np.abs(A[j])).sum(axis=1), np.abs(b[j]),
+                                 np.abs(X).max(axis=1))
+        return S > bound, j
+
+    def _nearest_edges(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(fast, dist) for rows of X (n, 2) outside a polygon of many edges: fast
+        marks the rows that :meth:`distances` answers by :meth:`edge_distances` (a
+        facet proves them outside — here the facet of their cone,
+        :meth:`_outside_guess` —, ``edge_error`` finite, distance > 0), dist the same
+        float fl(min_k f_k) over the edges k, f_k the float distance to edge k as
+        :meth:`edge_distances` computes it, but in O(log h) edges per row for states
+        near H: a tree of boxes over runs of consecutive edges (:func:`_edge_tree`)
+        is descended, leaving out a box whose lower bound on f_k exceeds f_s for a
+        seed edge s (j and its two neighbours). The bound: the rounded edge k lies in
+        its box, so its exact distance D̂_k ≥ dist(x, box) ≥ ĝ(1 − 4u) − 4·2^-1074
+        (ĝ = fl(hypot) of the rounded gaps, each one rounding, hypot within 2u;
+        the subnormal term for gradual underflow), and |f_k − D̂_k| ≤ 32uM
+        (:meth:`edge_error`: w, e, r within a few uM per coordinate, t's error moves
+        the point by ≤ 3u‖w‖ along the edge, hypot adds u), taken as 64uM, the
+        factor as 1 − 16u and 8·2^-1074 (the rounding of the bound itself). An edge
+        left out has f_k > f_s ≥ min_k f_k, so the minimum over the edges kept is the
+        minimum over all, bit for bit (the same float operations per edge). Rows
+        whose cone facet proves nothing (a guess gone wrong) are not fast: the
+        caller takes them to the O(h) path."""
+        P, Q = self._edges
+        lo, hi, leaf = self._edge_tree[:3]
+        h = len(P)
+        out, j = self._outside_guess(X)
+        M = np.maximum(np.abs(X).max(axis=1), max(np.abs(P).max(), np.abs(Q).max()))
+        rows = np.flatnonzero(out & (M > 1e-100) & (M < 1e100))
+        seed = np.stack([j[rows], (j[rows] + 1) % h, (j[rows] - 1) % h], axis=1)
+        best = _edge_float(X[rows, None, :], P[seed], Q[seed]).min(axis=1)
+        slack = 64 * UNIT_ROUNDOFF * M[rows] + 8 * MIN_SUBNORMAL
+        q, node = np.arange(len(rows)), np.zeros(len(rows), dtype=np.int64)
+        for level, (L, H) in enumerate(zip(lo, hi)):
+            if level:
+                q, node = np.repeat(q, 2), np.repeat(2 * node, 2) + np.tile([0, 1], len(q))
+                real = node < len(L)
+                q, node = q[real], node[real]
+            x = X[rows[q]]
+            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                gap = np.maximum(np.maximum(L[node] - x, x - H[node]), 0.0)
+                g = np.hypot(gap[:, 0], gap[:, 1])
+                keep = ~(g * (1 - 16 * UNIT_ROUNDOFF) - slack[q] > best[q])
+            q, node = q[keep], node[keep]
+        q = np.repeat(q, leaf)
+        k = np.repeat(node * leaf, leaf) + np.tile(np.arange(leaf), len(node))
+        real = k < h
+        q, k = q[real], k[real]
+        f = _edge_float(X[rows[q]], P[k], Q[k])
+        dist = np.full(len(X), np.inf)
+        found = np.full(len(rows), np.inf)
+        np.minimum.at(found, q, f)
+        dist[rows] = found
+        fast = np.zeros(len(X), dtype=bool)
+        fast[rows] = found > 0
+        return fast, dist
+
     def _in_cones(self, X: np.ndarray) -> np.ndarray:
         """Rows of X (n, 3) a float filter proves inside the polytope H from
         :func:`_exact_polytope`, through the tetrahedra conv(o, T_f) of its certified
@@ -352,8 +450,9 @@ class ValidityMonitor:
         scaling rounds are left unproven). A wrong guess leaves x unproven, never
         wrongly inside."""
         corners, o, mate, e, tree = self._cones
-        Y = np.ldexp(X, -e)
-        rows = np.flatnonzero((np.ldexp(Y, e) == X).all(axis=1))
+        with np.errstate(over="ignore", under="ignore"):  # such rows are left unproven
+            Y = np.ldexp(X, -e)
+            rows = np.flatnonzero((np.ldexp(Y, e) == X).all(axis=1))
         sure = np.zeros(len(X), dtype=bool)
         for guess in _cone_guesses(tree, corners, mate, o, Y[rows]).T:
             left = ~sure[rows]
@@ -868,6 +967,48 @@ def _orient_sign(a: np.ndarray, B: np.ndarray, X: np.ndarray) -> np.ndarray:
     det = left - right
     bound = 8 * UNIT_ROUNDOFF * (np.abs(left) + np.abs(right)) + 4 * MIN_SUBNORMAL
     return np.where(det > bound, 1, np.where(det < -bound, -1, 0))
+
+
+#: edges per leaf of a polygon's tree of boxes (:func:`_edge_tree`)
+EDGE_LEAF = 8
+
+
+def _edge_tree(P: np.ndarray, Q: np.ndarray) -> tuple:
+    """(lo, hi, EDGE_LEAF, c, order, rays) for :meth:`ValidityMonitor._nearest_edges`
+    and :meth:`ValidityMonitor._outside_guess` over the edges [P_k, Q_k] of a polygon
+    (cycle order): lo[ℓ], hi[ℓ] the corners of the boxes of level ℓ (root first; a
+    box of level ℓ holds the boxes 2i and 2i + 1 of level ℓ + 1, a leaf EDGE_LEAF
+    consecutive edges), c the float mean of the vertices and ``order`` the edges
+    sorted by the angle ``rays`` of P_k about c."""
+    h = len(P)
+    pad = -(-h // EDGE_LEAF) * EDGE_LEAF
+    box = np.stack([P, Q], axis=1)  # (h, 2, 2)
+    box = np.concatenate([box, np.repeat(box[-1:], pad - h, axis=0)])
+    lo = [box.min(axis=1).reshape(-1, EDGE_LEAF, 2).min(axis=1)]
+    hi = [box.max(axis=1).reshape(-1, EDGE_LEAF, 2).max(axis=1)]
+    while len(lo[-1]) > 1:
+        L, H = lo[-1], hi[-1]
+        if len(L) % 2:
+            L, H = np.concatenate([L, L[-1:]]), np.concatenate([H, H[-1:]])
+        lo.append(L.reshape(-1, 2, 2).min(axis=1))
+        hi.append(H.reshape(-1, 2, 2).max(axis=1))
+    c = P.mean(axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        angle = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
+    order = np.argsort(angle, kind="stable")
+    return lo[::-1], hi[::-1], EDGE_LEAF, c, order, angle[order]
+
+
+def _edge_float(X: np.ndarray, P: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """fl‖w − t e‖ per broadcast row (e = q − p, w = x − p, t = clip(w·e / e·e, 0, 1)):
+    the same operations, in the same order, as :meth:`ValidityMonitor.edge_distances`."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        e = Q - P
+        ee = (e * e).sum(axis=-1)
+        w = X - P
+        t = np.clip(np.where(ee > 0, (w * e).sum(axis=-1) / ee, 0.0), 0.0, 1.0)
+        r = w - t[..., None] * e
+        return np.hypot(r[..., 0], r[..., 1])
 
 
 def _inner_rows(hull) -> tuple[np.ndarray, np.ndarray] | None:
