@@ -117,13 +117,15 @@ def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F:
         coarse = coarse + cof_abs[:, j]
     coarse = coarse * c_err * 2.0 * M + floor
     degenerate = np.all(cof == 0.0, axis=1) & (c_err == 0.0)
-    Q = Y[None, :, :] - P0[:, None, :]  # (count, n, k): q − p_0
     s = np.zeros((count, n))
     precise = np.zeros((count, n))
-    for j in range(k):
-        s = s + Q[:, :, j] * cof[:, None, j]
-        precise = precise + np.abs(Q[:, :, j]) * cof_abs[:, None, j]
-    precise = precise * c_err + floor
+    for j in range(k):  # coordinate j of q − p_0, (count, n), contiguous
+        Q = Y[:, j] - P0[:, j, None]
+        s += Q * cof[:, j, None]
+        np.abs(Q, out=Q)
+        precise += Q * cof_abs[:, j, None]
+    precise *= c_err
+    precise += floor
     near = np.abs(s) <= coarse[:, None]
     bound = np.where(near, precise, coarse[:, None])
     off = np.ones((count, n), dtype=np.bool_)
