@@ -16,7 +16,7 @@ clouds against the exact clipping, and concurrent kernels on threads.
 from __future__ import annotations
 
 import itertools
-from concurrent.futures import Future, ThreadPoolExecutor, wait
+from concurrent.futures import ThreadPoolExecutor, wait
 from fractions import Fraction
 from math import gcd
 
@@ -430,11 +430,10 @@ def _recorded_certify(X, F, monkeypatch, joggled: bool):
     seen = []
     real = fastpath._certify
 
-    def record(H, k, scale, sel, facets, V=None, top=None, pieces=False):
-        P = real(H, k, scale, sel, facets, V, top, pieces)
+    def record(H, k, scale, sel, facets, pieces=False):
+        P = real(H, k, scale, sel, facets, pieces)
         if P is not None:
-            seen.append((H, k, scale, np.array(sel), [list(f) for f in facets],
-                         np.array(V), pieces))
+            seen.append((H, k, scale, np.array(sel), [list(f) for f in facets], pieces))
         return P
 
     with monkeypatch.context() as mp:
@@ -446,32 +445,29 @@ def _recorded_certify(X, F, monkeypatch, joggled: bool):
     return seen[-1]
 
 
-def _tampered(facets, V, k, rng):
-    """(name, facets, float vertices): proposals copied, dropped, merged, given wrong
-    rows, every proposal through one row dropped (P_S may be unbounded), floats moved."""
+def _tampered(facets, k, rng):
+    """(name, facets): proposals copied, dropped, merged, given wrong rows, every
+    proposal through one row dropped (P_S may be unbounded)."""
     n = len(facets)
     rows = sorted({h for f in facets for h in f})
-    yield "copied", [*facets, facets[0]], np.vstack([V, V[:1]])
+    yield "copied", [*facets, facets[0]]
     for size in (1, 2, max(1, n // 5)):
         for _ in range(2):
             gone = set(rng.choice(n, size, replace=False).tolist())
             keep = [i for i in range(n) if i not in gone]
-            yield "dropped", [facets[i] for i in keep], V[keep]
+            yield "dropped", [facets[i] for i in keep]
     for _ in range(3):
         i, j = rng.choice(n, 2, replace=False).tolist()
         keep = [x for x in range(n) if x not in (i, j)]
-        yield ("merged", [*(facets[x] for x in keep), sorted({*facets[i], *facets[j]})],
-               np.vstack([V[keep], (V[i] + V[j]) / 2]))
+        yield "merged", [*(facets[x] for x in keep), sorted({*facets[i], *facets[j]})]
     for _ in range(3):
         bad = [list(f) for f in facets]
         bad[int(rng.integers(n))] = sorted(rng.choice(rows, k, replace=False).tolist())
-        yield "wrong rows", bad, V
+        yield "wrong rows", bad
     for _ in range(2):
         h = int(rng.choice(rows))
         keep = [i for i in range(n) if h not in facets[i]]
-        yield "row dropped", [facets[i] for i in keep], V[keep]
-    yield "moved floats", facets, V + rng.normal(size=V.shape) * np.abs(V).max()
-    yield "permuted floats", facets, V[rng.permutation(n)]
+        yield "row dropped", [facets[i] for i in keep]
 
 
 def _same_polytope(P, Q) -> bool:
@@ -479,14 +475,6 @@ def _same_polytope(P, Q) -> bool:
     return sorted(pv) == sorted(qv) and sorted(
         (pv[v], *sorted(pv[u] for u in e)) for v, e in enumerate(P.edges)) == sorted(
         (qv[v], *sorted(qv[u] for u in e)) for v, e in enumerate(Q.edges))
-
-
-def _certify(H, k, scale, sel, facets, V, pieces, background: bool):
-    if not background:
-        return fastpath._certify(H, k, scale, sel, facets, None, None, pieces)
-    top: Future = Future()
-    top.set_result(fastpath._row_max(H, V))
-    return fastpath._certify(H, k, scale, sel, facets, V, top, pieces)
 
 
 TAMPERED = [("cell24", 4, 28, 4), ("lattice", 5, 40, 3), ("gaussian", 3, 30, 3),
@@ -499,19 +487,16 @@ TAMPERED = [("cell24", 4, 28, 4), ("lattice", 5, 40, 3), ("gaussian", 3, 30, 3),
 @pytest.mark.parametrize("kind,d,n,F", TAMPERED)
 def test_tampered_proposals_give_none_or_the_same_polytope(kind, d, n, F, joggled,
                                                            monkeypatch):
-    """Whatever the proposals (merged qhull's or joggled pieces, the rows' maxima over
-    the float proposals or over the exact vertices), ``_certify`` returns None or the
-    polytope the untampered proposals give."""
-    H, k, scale, sel, facets, V, pieces = _recorded_certify(_cloud(kind, d, n, F), F,
-                                                            monkeypatch, joggled)
-    want = _certify(H, k, scale, sel, facets, V, pieces, False)
-    assert want is not None and _same_polytope(want, _certify(H, k, scale, sel, facets, V,
-                                                              pieces, True))
+    """Whatever the proposals (merged qhull's or joggled pieces), ``_certify`` returns
+    None or the polytope the untampered proposals give."""
+    H, k, scale, sel, facets, pieces = _recorded_certify(_cloud(kind, d, n, F), F,
+                                                         monkeypatch, joggled)
+    want = fastpath._certify(H, k, scale, sel, facets, pieces)
+    assert want is not None
     rng = np.random.default_rng([d, n, F, joggled])
-    for name, bad, W in _tampered(facets, V, k, rng):
-        for background in (False, True):
-            P = _certify(H, k, scale, sel, bad, W, pieces, background)
-            assert P is None or _same_polytope(P, want), (name, background)
+    for name, bad in _tampered(facets, k, rng):
+        P = fastpath._certify(H, k, scale, sel, bad, pieces)
+        assert P is None or _same_polytope(P, want), name
 
 
 # --- whole kernels -------------------------------------------------------------------
@@ -579,9 +564,9 @@ def test_kernels_the_fast_path_declines_identical_to_the_exact_clipping(kind, d,
 
 @pytest.mark.slow
 def test_concurrent_kernels_on_threads_give_the_same_answers():
-    """Kernels computed at once on four threads (each fast path with its background
-    thread for the row maxima where it pays: d = 4, n = 50 and d = 5, n = 30), each
-    twice, equal the serial ones; none hangs."""
+    """Kernels computed at once on four threads (each fast path with its own range
+    threads where they pay: d = 4, n = 50 and d = 5, n = 30), each twice, equal the
+    serial ones; none hangs."""
     from benchmarks.kernel_clouds import make_cloud
 
     clouds = [make_cloud(*c) for c in [("gaussian", 4, 50, 9), ("sphere", 5, 30, 3),

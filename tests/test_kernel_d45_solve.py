@@ -121,16 +121,14 @@ def test_kernels_identical_to_the_exact_clipping(kind, d, n, F, monkeypatch):
     _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
 
 
-@pytest.mark.parametrize("background", [True, False])
 @pytest.mark.parametrize("seed", range(3))
-def test_rows_violated_by_a_proposal_join_the_next_round(seed, background, monkeypatch):
+def test_rows_violated_by_a_proposal_join_the_next_round(seed, monkeypatch):
     """A third of the defining rows given to qhull: its first proposal cuts off too
-    little, the certification (with the row maxima computed meanwhile on a second
-    thread, or before) fails, the violated rows join, and the next round's kernel is
-    the exact clipping's."""
+    little, the certification fails (a walk on the graph the closure proves finds a
+    row cutting a vertex), the rows the proposal violates join, and the next round's
+    kernel is the exact clipping's."""
     from tests.test_kernel_d45 import _both_paths
 
-    monkeypatch.setattr(fastpath, "BACKGROUND_MIN_PAIRS", 0 if background else 10**18)
     X = np.random.default_rng(seed).normal(size=(22, 4))
     _, slow, H, unit, first = _both_paths(X, 2)
     few = np.sort(np.random.default_rng(seed).choice(first, size=len(first) // 3,

@@ -906,3 +906,112 @@ def _near_run(common: tuple, parallel: bool, fill: bool, offsets, out_r, out_v, 
         _near_range(*common, lo, hi, fill, offsets, out_r, out_v, first)
 
     on_threads(scan, len(offsets), 64 if parallel else 1)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pair_bound(A, b, A_abs, b_abs, V, h, v, c_err, c, floor):
+    """The rounding bound of the float slack of (row h, point v), as in :func:`_near_range`."""
+    perm = 0.0
+    mag = 0.0
+    for j in range(A.shape[1]):
+        perm += A_abs[h, j] * abs(V[v, j])
+        mag += abs(A[h, j] * V[v, j])
+    return c_err * (perm + b_abs[h]) + c * (mag + abs(b[h])) + floor
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _slack(A, b, V, h, v):
+    s = 0.0
+    for j in range(A.shape[1]):
+        s += A[h, j] * V[v, j]
+    return s - b[h]
+
+
+@njit(cache=True, nogil=True)
+def _walk_range(A, b, A_abs, b_abs, V, ptr, nbr, seeds, c_err, c, floor, h0, h1, out):
+    """Rows h0 ≤ h < h1 of :func:`graph_top`."""
+    last = seeds[0]
+    for h in range(h0, h1):
+        cur = last  # the previous row's end: neighbouring rows often share data points
+        best = _slack(A, b, V, h, cur)
+        for i in range(len(seeds)):
+            s = _slack(A, b, V, h, seeds[i])
+            if s > best:
+                best, cur = s, seeds[i]
+        while True:  # steepest ascent: the float values increase strictly, so it ends
+            nxt = -1
+            for p in range(ptr[cur], ptr[cur + 1]):
+                s = _slack(A, b, V, h, nbr[p])
+                if s > best:
+                    best, nxt = s, nbr[p]
+            if nxt < 0:
+                break
+            cur = nxt
+        own = _pair_bound(A, b, A_abs, b_abs, V, h, cur, c_err, c, floor)
+        ok = True
+        for p in range(ptr[cur], ptr[cur + 1]):
+            u = nbr[p]
+            drop = best - _slack(A, b, V, h, u)
+            need = max(own + _pair_bound(A, b, A_abs, b_abs, V, h, u, c_err, c, floor),
+                       WALK_TINY)
+            # drop ≥ need (1 + 4ε), both finite: the real s_h(v*) − s_h(u) ≥ e_h(v*) +
+            # e_h(u) (see graph_top); NaN or inf fails
+            if not (drop >= need * (1.0 + 4.0 * UNIT_ROUNDOFF) and drop < np.inf
+                    and need < np.inf):
+                ok = False
+                break
+        out[h] = best if ok else np.inf
+        last = cur
+
+
+#: :func:`graph_top`'s final comparisons raise a smaller bound to this normal float (a
+#: larger bound only makes them stricter; it keeps the product by 1 + 4ε relative)
+WALK_TINY = 2.0**-1000
+#: :func:`graph_top` starts each row's walk from the best of this many vertices spread
+#: over the polytope (those extreme along each coordinate, then evenly spaced ones)
+WALK_SEEDS = 8
+#: from this many rows on, :func:`graph_top` runs on threads (16 ranges)
+WALK_THREADS_MIN = 4_000
+
+
+def graph_top(A, b, A_abs, b_abs, V, ptr, nbr, c_err: float, c: float, floor: float
+              ) -> np.ndarray:
+    """Per row h a float t_h with max_v g_h(v) ≤ t_h + e_h(v*) for some vertex v* of the
+    polytope P, or t_h = +inf where the walk proves nothing. g_h is the exact affine
+    function the row's floats a_h, b_h approximate: the float slack s_h(v) = a_h·v − b_h
+    at a vertex's float v (row of V) is within e_h(v) = c_err (A_abs·|v| + b_abs) +
+    c (|a|·|v| + |b|) + floor of g_h at the exact vertex (the bound :func:`near_pairs`
+    decides on). ``ptr``, ``nbr``: P's graph in CSR form (v's neighbours nbr[ptr[v]:
+    ptr[v + 1]]), which must be complete — every edge of P listed at both ends.
+
+    Each row starts at the best of a few seeds (the vertices extreme along each
+    coordinate, evenly spaced ones, and the previous row's end — neighbouring rows
+    often share data points) and walks to the neighbour of largest float slack while
+    one is larger (steepest ascent; the float values increase strictly, so the walk
+    ends) — floats only guide it. At its end v* the row gets t_h = s_h(v*) when
+    the real s_h(v*) − s_h(u) ≥ e_h(v*) + e_h(u) for every neighbour u, so g_h(u) ≤
+    g_h(v*). In floats (e_h's as computed, the bound :func:`near_pairs` decides on):
+    d = fl(s_h(v*) − s_h(u)) and E = max(fl(e_h(v*) + e_h(u)), WALK_TINY) are within a
+    factor 1 ± ε of the reals (a sum or difference of floats rounds relatively, also
+    below the normal range), and fl(E (1 + 4ε)) ≥ E (1 + 4ε)(1 − ε) ≥ E (1 + ε)/(1 − ε)
+    (E normal), so d ≥ fl(E (1 + 4ε)) with d and E finite proves it (NaN or inf fails:
+    t_h = +inf). Then g_h ≤ g_h(v*) on P:
+    P = conv(vertices) lies in v* + its tangent cone at v*, which the edge directions
+    u − v* generate (a polytope's cone at a vertex is spanned by its edges), and
+    g_h − g_h(v*) is ≤ 0 on each of them. Hence max g_h = g_h(v*) ≤ t_h + e_h(v*):
+    the caller's per-row bound of e_h over P (its ``coarse``) turns t_h into a
+    certificate that row h is slack at every vertex (t_h < −coarse_h) or not."""
+    n, k = V.shape
+    out = np.full(len(b), np.inf)
+    if not n:
+        return out
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    spread = np.linspace(0, n - 1, max(WALK_SEEDS - 2 * k, 1)).astype(np.int64)
+    seeds = np.unique(np.concatenate([V.argmax(axis=0), V.argmin(axis=0), spread]))
+    args = [np.ascontiguousarray(x) for x in (A, b, A_abs, b_abs)]
+
+    def scan(lo: int, hi: int) -> None:
+        _walk_range(*args, V, ptr, nbr, seeds, c_err, c, floor, lo, hi, out)
+
+    on_threads(scan, len(b), 16 if len(b) >= WALK_THREADS_MIN else 1)
+    return out

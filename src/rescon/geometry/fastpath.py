@@ -41,7 +41,6 @@ import contextlib
 import gc
 import itertools
 import operator
-from concurrent.futures import Future, ThreadPoolExecutor
 from math import gcd
 
 import numpy as np
@@ -185,10 +184,8 @@ def _collection_deferred():
 def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
              ) -> ExactPolytope | None:
     """Proposals from qhull with ``options``, certified by :func:`_certify`; None on
-    failure. The rows' float maxima over the proposed vertices (:func:`_row_maxima`)
-    are computed while the vertices are solved exactly; if the certification fails,
-    the halfspaces clearly violated by a proposed vertex join ``sel`` for the next
-    round."""
+    failure. If the certification fails, the halfspaces clearly violated by a proposed
+    vertex (:func:`_row_max` of the float proposals) join ``sel`` for the next round."""
     for _ in range(MAX_ROUNDS):
         prop = _propose(H, sel, options)
         if prop is None:
@@ -196,57 +193,36 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
         V, facets = prop
         if any(len(f) < k for f in facets):
             return None
-        with _row_maxima(H, V) as top:
-            P = _certify(H, k, scale, sel, facets, V, top, pieces=options == "QJ")
-            bad = top.result() > 1e-9 * (1.0 + np.abs(H.bf))
-        if P is not None or not bad.any():
+        P = _certify(H, k, scale, sel, facets, pieces=options == "QJ")
+        if P is not None:
             return P
+        bad = _row_max(H, V) > 1e-9 * (1.0 + np.abs(H.bf))
+        if not bad.any():
+            return None
         sel = np.union1d(sel, np.flatnonzero(bad))
     return None
 
 
-#: from this many (row, vertex) pairs on, the row maxima run on a second thread: the
-#: thread costs ~0.1–0.4 ms, row_top ~0.3 ns per pair (d = 4, n = 50, F = 9: 4·10⁷
-#: pairs, 15–30 CPU-ms)
-BACKGROUND_MIN_PAIRS = 10**7
-
-
-@contextlib.contextmanager
-def _row_maxima(H, V: np.ndarray):
-    """:func:`_row_max` of the float vertices V as a Future: on a second thread
-    (compiled code without the GIL, one thread) when it is costly, so that the caller
-    solves the vertices exactly (Python integers) meanwhile; else computed at once."""
-    if len(H) * len(V) < BACKGROUND_MIN_PAIRS:
-        done: Future = Future()
-        done.set_result(_row_max(H, V))
-        yield done
-        return
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        yield pool.submit(_row_max, H, V, False)
-
-
-def _row_max(H, V: np.ndarray, parallel: bool = True) -> np.ndarray:
+def _row_max(H, V: np.ndarray) -> np.ndarray:
     """Per row h, an upper bound on max_v a_h·v − b_h over the float vertices V (the
     value itself where it may be ≥ 0): :func:`._candidates.row_top` — balls around
     chunks of nearby vertices bound the rows that pass far from them, only the
-    chunks a row may reach are evaluated vertex by vertex (on one thread, without
-    the GIL, unless ``parallel``)."""
+    chunks a row may reach are evaluated vertex by vertex."""
     from ._candidates import row_top
 
-    return row_top(H.af, H.bf, V, H.floor(), parallel)
+    return row_top(H.af, H.bf, V, H.floor())
 
 
 def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
-             V: np.ndarray | None = None, top: Future | None = None,
              pieces: bool = False) -> ExactPolytope | None:
     """Exact vertices from the proposed defining sets (merged when equal), their full
     tight sets among the defining halfspaces S, feasibility against every valid
     halfspace, and closure: every extreme ray of every vertex's tangent cone leads to
     another proposed vertex (see the module docstring). ``pieces``: the proposals are
     simplicial pieces (joggled qhull), several per non-simple vertex — one per point
-    is solved (:func:`_one_per_point`). ``top``: the rows' maxima over V
-    (:func:`_row_max`, being computed), else they are computed over the exact
-    vertices' floats."""
+    is solved (:func:`_one_per_point`). The rows of S are decided against every vertex
+    before the closure; the others after it, by walks on the graph it proves
+    (:func:`_outside_feasible`)."""
     sizes = np.fromiter(map(len, facets), dtype=np.int64, count=len(facets))
     flat = sel[np.fromiter(itertools.chain.from_iterable(facets), dtype=np.int64,
                            count=int(sizes.sum()))]
@@ -276,7 +252,7 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     tight_v = [np.repeat(of_proposal, k)]
     tight_h = [np.searchsorted(S, T_kept).ravel()]
     # h · len(facets) + i: row h tight at vertex i by construction
-    known = (T_kept * len(facets) + of_proposal[:, None]).ravel()
+    known = np.sort((T_kept * len(facets) + of_proposal[:, None]).ravel())
     # exact feasibility, and the complete tight sets within S: floats of the exact
     # vertices (correctly rounded, int / int) with a rounding bound, plus the underflow
     # term, decide the clear cases; inf or NaN is never "clear"
@@ -285,49 +261,22 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     floor = H.floor()
     l1, perm_sum, babs = H.row_terms()
     coarse = H.c_err * (perm_sum * M + H.b_abs) + c * (l1 * M + babs) + floor
-    row_bound = coarse
-    if V is None or top is None:
-        top = _row_max(H, Vx)
-    else:  # the proposals' maxima: the points moved by at most ‖a‖₁ · max |V − Vx|, and
-        # evaluated at |V| ≤ M + shift (rounding c ‖a‖₁ · shift more than at Vx)
-        shift = np.abs(V[kept] - Vx[of_proposal]).max()
-        row_bound = row_bound + (1.0 + c) * l1 * shift
-        top = top.result()
-    rows = np.flatnonzero(~(top < -row_bound))  # the rows not surely slack at every vertex
-    near = _near_pairs(H, rows, Vx, coarse[rows], c, floor)
-    if near is None:
+    # the defining rows' pairs: feasibility and the complete tight sets within S
+    on_S = _decided_pairs(H, scale, verts, W, T_kept[firsts], S, Vx, coarse[S], c, floor,
+                          known, len(facets), k)
+    if on_S is None:
         return None
-    near_r, near_v = near
-    # not tight by construction
-    known.sort()
-    pair = rows[near_r] * len(facets) + near_v
-    fresh = known[np.minimum(np.searchsorted(known, pair), len(known) - 1)] != pair
-    near_r, near_v = near_r[fresh], near_v[fresh]
-    hs = rows[near_r]
-    # the pairs whose row provably passes through the vertex (a flat of data points on
-    # the row holds it: :func:`._certify_nb.tight_through`) are tight; the others are
-    # decided on the integers
-    on = _tight_through(H, T_kept[firsts], hs, near_v, k)
-    rest = np.flatnonzero(~on)
-    slacks = _int64_slacks(H, scale, verts, hs[rest], near_v[rest])
-    if slacks is None:  # in Python integers: a·y − b·w, all pairs at once
-        used, at = np.unique(hs[rest], return_inverse=True)
-        H.exact_all(used.tolist())
-        E = _homogeneous(H, used.tolist(), k)[at.ravel()]  # (−b, a), each row built once
-        slacks = (E * W[near_v[rest]]).sum(axis=1) if len(rest) else np.zeros(0, dtype=object)
-    if (slacks > 0).any():
-        return None
-    on[rest] = slacks == 0
-    at = np.minimum(np.searchsorted(S, hs[on]), len(S) - 1)
-    in_S = S[at] == hs[on]
-    tight_v.append(near_v[on][in_S])
-    tight_h.append(at[in_S])
+    tight_v.append(on_S[1])
+    tight_h.append(np.searchsorted(S, on_S[0]))
     tight, pairs = _tight_sets(np.concatenate(tight_v), np.concatenate(tight_h), len(verts),
                                len(S))
     normals = [H.exact(h)[0] for h in S_set]
     edges = _closed(tight, basis, normals, k,
                     lambda bases: _simplicial_rays(H, S_set, normals, bases, k), pairs)
     if edges is None:
+        return None
+    if not _outside_feasible(H, scale, verts, W, T_kept[firsts], S, Vx, coarse, c, floor,
+                             edges, k):
         return None
     P = ExactPolytope(k, unit=scale)
     for h in S_set:
@@ -340,6 +289,71 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     P.edges = edges
     P._fv = Vx
     return P
+
+
+def _decided_pairs(H, scale: int, verts: list[tuple[int, ...]], W: np.ndarray,
+                   basis: np.ndarray, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray,
+                   c: float, floor: float, known: np.ndarray, n_props: int, k: int
+                   ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The pairs (row of H, vertex) among ``rows`` × the vertices (homogeneous W, floats
+    Vx; ``basis``: per vertex k rows tight by construction) whose row passes through the
+    vertex, beyond those tight by construction (``known``: h · n_props + vertex, sorted),
+    or None if a row cuts a vertex: floats with a rounding bound decide the clear pairs
+    (:func:`_near_pairs`; ``coarse``: per row the bound for every vertex), the rest by
+    data points on the row (:func:`_tight_through`) or on the integers."""
+    near = _near_pairs(H, rows, Vx, coarse, c, floor)
+    if near is None:
+        return None
+    near_r, near_v = near
+    # not tight by construction
+    pair = rows[near_r] * n_props + near_v
+    if len(known):
+        fresh = known[np.minimum(np.searchsorted(known, pair), len(known) - 1)] != pair
+        near_r, near_v = near_r[fresh], near_v[fresh]
+    hs = rows[near_r]
+    # the pairs whose row provably passes through the vertex (a flat of data points on
+    # the row holds it: :func:`._certify_nb.tight_through`) are tight; the others are
+    # decided on the integers
+    on = _tight_through(H, basis, hs, near_v, k)
+    rest = np.flatnonzero(~on)
+    slacks = _int64_slacks(H, scale, verts, hs[rest], near_v[rest])
+    if slacks is None:  # in Python integers: a·y − b·w, all pairs at once
+        used, at = np.unique(hs[rest], return_inverse=True)
+        H.exact_all(used.tolist())
+        E = _homogeneous(H, used.tolist(), k)[at.ravel()]  # (−b, a), each row built once
+        slacks = (E * W[near_v[rest]]).sum(axis=1) if len(rest) else np.zeros(0, dtype=object)
+    if (slacks > 0).any():
+        return None
+    on[rest] = slacks == 0
+    return hs[on], near_v[on]
+
+
+def _outside_feasible(H, scale: int, verts: list[tuple[int, ...]], W: np.ndarray,
+                      basis: np.ndarray, S: np.ndarray, Vx: np.ndarray, coarse: np.ndarray,
+                      c: float, floor: float, edges: list[list[int]], k: int) -> bool:
+    """Every valid row outside S holds at every vertex, given P_S = conv(V) with the
+    complete graph ``edges`` (proven by the closure): each row's maximum over V by a
+    walk on the graph (:func:`._candidates.graph_top`: a vertex no neighbour of which
+    is above it is the maximum), and the rows it leaves open (not proven slack
+    everywhere) by :func:`_decided_pairs`."""
+    from ._candidates import graph_top
+
+    out = np.ones(len(H), dtype=np.bool_)
+    out[S] = False
+    rows = np.flatnonzero(out)
+    if not len(rows):
+        return True
+    sizes = np.fromiter(map(len, edges), dtype=np.int64, count=len(edges))
+    ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    nbr = np.fromiter(itertools.chain.from_iterable(edges), dtype=np.int64,
+                      count=int(ptr[-1]))
+    top = graph_top(H.af[rows], H.bf[rows], H.af_abs[rows], H.b_abs[rows], Vx, ptr, nbr,
+                    H.c_err, c, floor)
+    rows = rows[~(top < -coarse[rows])]
+    if not len(rows):
+        return True
+    return _decided_pairs(H, scale, verts, W, basis, rows, Vx, coarse[rows], c, floor,
+                          np.zeros(0, dtype=np.int64), 1, k) is not None
 
 
 def _tight_sets(vs: np.ndarray, hs: np.ndarray, n: int, width: int
