@@ -189,3 +189,37 @@ def test_rounded_cofactors_are_the_correctly_rounded_normals(kind, k, shift):
     want = _rounded_reference(Yf, Yi, subsets)
     assert got.tobytes() == want.tobytes()
     assert list(itertools.chain(got.shape)) == [len(subsets), k]
+
+
+@pytest.mark.parametrize("dnm", [1, 2**40, 2**1100, 2**2100, 3 * 2**40, 10**30],
+                         ids=["1", "2^40", "2^1100", "2^2100", "3*2^40", "10^30"])
+@pytest.mark.parametrize("num", [1, 3])
+def test_quotients_are_correctly_rounded(num, dnm):
+    """c · num / dnm as float(Fraction) for every c: halfway cases, results in the
+    subnormal range and below it, c beyond the float range (the fallbacks)."""
+    rng = np.random.default_rng(dnm % 1000 + num)
+    ints = [0, 1, -1, 2**53 + 1, -(2**53 + 3), 2**54 + 2, 3 << 1100, -(1 << 1023) * 3,
+            (1 << 1024) + 1, 2**60 - 1,
+            # over 2^1100 a subnormal with spacing 2^26 in c: float(c) drops the last 1
+            # and lands on a halfway point that ldexp would round to even (down)
+            2**62 + 2**25 + 1, -(2**62 + 2**25 + 1)]
+    ints += [int(v) << int(s) for v, s in zip(rng.integers(-2**62, 2**62, 40),
+                                              rng.integers(0, 1200, 40), strict=True)]
+    want = []
+    for c in ints:
+        try:
+            want.append(float(Fraction(c * num, dnm)))
+        except OverflowError:
+            want.append(None)
+    if None in want:
+        with pytest.raises(OverflowError):
+            halfspaces._quotients(ints, num, dnm)
+        ok = [c for c, w in zip(ints, want, strict=True) if w is not None]
+        want = [w for w in want if w is not None]
+        ints = ok
+    got = halfspaces._quotients(ints, num, dnm)
+    assert got.tobytes() == np.array(want, dtype=np.float64).tobytes()
+    # without the c beyond the float range (which send every c to the integers)
+    fits = [i for i, c in enumerate(ints) if abs(c) < 2**1000]
+    got = halfspaces._quotients([ints[i] for i in fits], num, dnm)
+    assert got.tobytes() == np.array([want[i] for i in fits], dtype=np.float64).tobytes()

@@ -357,6 +357,14 @@ def _rounded_cofactors(Y: np.ndarray, Yi: list[tuple[int, ...]], subsets: np.nda
     i, j = np.unravel_index(np.abs(Y).argmax(), Y.shape)
     unit = Fraction(Yi[i][j]) / Fraction(float(Y[i, j]))
     den = unit ** (k - 1)
+    num, dnm = den.denominator, den.numerator
+    if k == 3:  # the cross product (p_1 − p_0) × (p_2 − p_0), in plain Python ints
+        flat: list[int] = []
+        for i0, i1, i2 in subsets.tolist():
+            (x, y, z), (x1, y1, z1), (x2, y2, z2) = Yi[i0], Yi[i1], Yi[i2]
+            a0, a1, a2, b0, b1, b2 = x1 - x, y1 - y, z1 - z, x2 - x, y2 - y, z2 - z
+            flat += (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+        return _quotients(flat, num, dnm).reshape(-1, 3)
     if k < 2 or not len(subsets):
         return np.array([[float(c / den) for c in exact_normal(Yi, sub)]
                          for sub in subsets.tolist()], dtype=np.float64).reshape(-1, k)
@@ -368,9 +376,27 @@ def _rounded_cofactors(Y: np.ndarray, Yi: list[tuple[int, ...]], subsets: np.nda
     N = cross_all(P[subsets[:, 1:]] - P[subsets[:, :1]])
     if k % 2 == 0:
         N = -N
-    num, dnm = den.denominator, den.numerator
-    return np.array([[c * num / dnm for c in row] for row in N.tolist()],
-                    dtype=np.float64).reshape(-1, k)
+    return _quotients(N.ravel().tolist(), num, dnm).reshape(-1, k)
+
+
+def _quotients(ints: list[int], num: int, dnm: int) -> np.ndarray:
+    """c · num / dnm correctly rounded for each integer c (num, dnm > 0). For num = 1,
+    dnm = 2^e: float(c) is c correctly rounded and the scaling by 2^-e is exact unless
+    the result leaves the normal range, so each such result is the correctly rounded
+    quotient; a c beyond the float range (OverflowError) or a result below 2^-1022
+    (nonzero c: the scaling may round a second time) is divided as integers, Python's
+    int / int being correctly rounded."""
+    if num == 1 and dnm & (dnm - 1) == 0:
+        try:
+            out = np.ldexp(np.array([float(c) for c in ints], dtype=np.float64),
+                           1 - dnm.bit_length())
+        except OverflowError:
+            pass
+        else:
+            for i in np.flatnonzero(np.abs(out) < MIN_NORMAL).tolist():
+                out[i] = ints[i] / dnm
+            return out
+    return np.array([c * num / dnm for c in ints], dtype=np.float64)
 
 
 def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
