@@ -156,8 +156,7 @@ def test_valid_halfspaces_identical_without_pivots(family, k, monkeypatch):
     Yf, _, exact_view = float_view(Yi, den)
     W = np.ones(len(Yi), dtype=np.int64)
     got = halfspaces.valid_halfspaces(Yf, Yi, W, 4, exact_view)
-    monkeypatch.setattr(_scan_np, "side_signs",
-                        lambda Y, s: np.zeros((len(s), len(Y)), dtype=np.int8))
+    monkeypatch.setattr(_scan_np, "side_signs", lambda Y, s, start: start)  # no more
     want = halfspaces.valid_halfspaces(Yf, Yi, W, 4, exact_view)
     for name in ("through", "sign", "af", "bf", "af_abs", "b_abs", "outside"):
         assert np.array_equal(getattr(got, name), getattr(want, name)), name
@@ -223,3 +222,34 @@ def test_quotients_are_correctly_rounded(num, dnm):
     fits = [i for i, c in enumerate(ints) if abs(c) < 2**1000]
     got = halfspaces._quotients([ints[i] for i in fits], num, dnm)
     assert got.tobytes() == np.array([want[i] for i in fits], dtype=np.float64).tobytes()
+
+
+@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("kind", KINDS)
+def test_classify_pair_signs_are_exact_and_seed_the_pivots(kind, k):
+    """``classify(..., pairs=True)``: its nonzero signs are the exact ones and make its
+    counts; seeding the pivot filter with them gives the integer path's counts."""
+    from math import factorial
+
+    from rescon._rounding import UNIT_ROUNDOFF, underflow_floor
+
+    Y = np.unique(_cloud(kind, k, 10, 5 * k), axis=0)
+    m = len(Y)
+    Yi, den = _integers(Y)
+    Yf, _, exact_view = float_view(Yi, den)
+    W = np.random.default_rng(m).integers(1, 4, size=m)
+    subsets = _scan_np.k_subsets(m, k)
+    c_err = 4.0 * (3 * k + factorial(k) + 4) * UNIT_ROUNDOFF
+    floor = underflow_floor(k, float(np.abs(Yf).max()))
+    plus, minus, unc, dege, sg = _scan_np.classify(Yf, W, subsets, c_err, 3, floor,
+                                                   pairs=True)
+    assert ((sg == 1) @ W).tolist() == plus.tolist()
+    assert ((sg == -1) @ W).tolist() == minus.tolist()
+    for t, sub in enumerate(subsets.tolist()):
+        for q in np.flatnonzero(sg[t]).tolist():
+            assert sg[t, q] == _exact_sign(Yf, sub, q)
+    want = halfspaces._exact_side_counts(Yf, Yi, W, subsets, m, False)
+    got = halfspaces._exact_side_counts(Yf, Yi, W, subsets, m, False, pivots=exact_view,
+                                        start=sg)
+    for a, b in zip(want, got, strict=True):
+        assert a.tolist() == b.tolist()

@@ -98,9 +98,10 @@ def _expand_last(row: np.ndarray, r: int, cols, minors: dict
 
 
 def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F: int,
-             floor: float = 0.0) -> tuple[np.ndarray, ...]:
+             floor: float = 0.0, pairs: bool = False) -> tuple[np.ndarray, ...]:
     """(plus, minus, unc, degenerate) for every k-subset, as
-    :func:`rescon.geometry._candidates.classify` defines them.
+    :func:`rescon.geometry._candidates.classify` defines them; with ``pairs``, also
+    the (count, n) signs (int8: +1, −1, 0 undecided or a member) behind them.
 
     A point q off the subset is surely on the + side when s(q) > bound, on the − side
     when s(q) < −bound, else uncertain (c_err > 0) or on the hyperplane (c_err = 0,
@@ -135,6 +136,8 @@ def classify(Y: np.ndarray, W: np.ndarray, subsets: np.ndarray, c_err: float, F:
     w = W.astype(np.int64)
     plus, minus = pos @ w, neg @ w
     unc = (off & ~pos & ~neg) @ w if c_err != 0.0 else np.zeros(count, dtype=np.int64)
+    if pairs:
+        return plus, minus, unc, degenerate, pos.view(np.int8) - neg.view(np.int8)
     return plus, minus, unc, degenerate
 
 
@@ -162,7 +165,8 @@ def _det_per(R) -> tuple[np.ndarray, np.ndarray]:
     return det, per
 
 
-def side_signs(Y: np.ndarray, subsets: np.ndarray) -> np.ndarray:
+def side_signs(Y: np.ndarray, subsets: np.ndarray, start: np.ndarray | None = None
+               ) -> np.ndarray:
     """Signs (T, m) of s(q) = C·(q − p_0) for every subset (p_0..p_{k−1}) = Y[subsets[t]]
     and point q = Y[i] (C the cofactor normal, :func:`cofactors`), k = Y.shape[1] ∈ {2, 3}:
     +1 or −1 where the float filter below proves the sign, 0 where it cannot (always
@@ -185,17 +189,21 @@ def side_signs(Y: np.ndarray, subsets: np.ndarray) -> np.ndarray:
     m_t the monomials of the exact differences; the computed permanent P satisfies
     Σ_t |m_t| ≤ P / (1 − u)^8 (the same factors, at most 8 of them). Hence
     |fl(det) − det| ≤ 8u(1 + 20u) P < 16u · P = PIVOT_ERR · P, and |fl(det)| >
-    PIVOT_ERR · P proves sign(det) = sign(fl(det)). A NaN or inf never passes."""
+    PIVOT_ERR · P proves sign(det) = sign(fl(det)). A NaN or inf never passes.
+
+    ``start``: (T, m) int8 signs already proven (e.g. by :func:`classify`); its nonzero
+    entries are returned as they are and not evaluated again."""
     T, k = subsets.shape
     m = len(Y)
-    sign = np.zeros((T, m), dtype=np.int8)
+    sign = np.zeros((T, m), dtype=np.int8) if start is None else start.astype(np.int8)
     if not in_range(Y) or not T:
         return sign
-    # coordinate c of point j of every (subset, point) pair: X[j][c], flat over pairs
-    X = [[np.repeat(Y[subsets[:, j], c], m) for c in range(k)] for j in range(k)]
-    X.append([np.tile(Y[:, c], T) for c in range(k)])
     flat = sign.reshape(-1)
-    todo = np.arange(T * m)
+    todo = np.flatnonzero(flat == 0)
+    t, q = np.divmod(todo, m)
+    # coordinate c of point j of every pair (subset t, point q) still open: X[j][c]
+    X = [[Y[subsets[t, j], c] for c in range(k)] for j in range(k)]
+    X.append([Y[q, c] for c in range(k)])
     for i in range(k + 1):  # each pivot on the pairs still undecided
         R = [[X[j][c] - X[i][c] for c in range(k)] for j in range(k + 1) if j != i]
         det, per = _det_per(R)

@@ -274,6 +274,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     elif exact_only:  # no float filter: every subset is decided exactly below
         plus, minus, degenerate = (np.zeros(count, dtype=t) for t in (np.int64, np.int64, np.bool_))
         unc = np.full(count, int(W.sum()), dtype=np.int64)
+    elif small:  # with the decided (subset, point) pairs, for the pivot filter below
+        plus, minus, unc, degenerate, signs = classify(
+            np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, c_err, F,
+            floor, pairs=True)
     else:
         plus, minus, unc, degenerate = classify(
             np.ascontiguousarray(Y, dtype=np.float64), W.astype(np.int64), subsets, c_err, F,
@@ -283,9 +287,10 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     sure_minus = live & (minus + unc <= F)
     sure_p, sure_m = np.flatnonzero(sure_plus), np.flatnonzero(sure_minus)
     maybe = np.flatnonzero(live & (((plus <= F) & ~sure_plus) | ((minus <= F) & ~sure_minus)))
-    n_plus, n_minus, dependent = _exact_side_counts(Y, Yi, W, subsets[maybe], F,
-                                                    expansions and not small,  # exactly
-                                                    pivots=small and expansions)
+    pivots = small and expansions and not exact_only
+    n_plus, n_minus, dependent = _exact_side_counts(
+        Y, Yi, W, subsets[maybe], F, expansions and not small,  # exactly
+        pivots=pivots, start=signs[maybe] if pivots else None)
     add_p = ~dependent & (n_plus <= F) & ~sure_plus[maybe]
     add_m = ~dependent & (n_minus <= F) & ~sure_minus[maybe]
     idx = np.concatenate([sure_p, sure_m, maybe[add_p], maybe[add_m]])
@@ -430,7 +435,8 @@ def _distinct_rows(af: np.ndarray, bf: np.ndarray) -> np.ndarray:
 EXACT_BLOCK = 4096
 
 
-def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool, pivots: bool = False
+def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool, pivots: bool = False,
+                       start: np.ndarray | None = None
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Exact weighted numbers of points strictly on the + and − side of the hyperplane
     through each subset (those above F may be lower bounds), and whether the subset is
@@ -439,7 +445,8 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool, pivots: bool = Fa
     ``pivots`` (k ≤ 3, Y exact and in range), the pivoted float filter
     (:func:`._scan_np.side_signs`), which settles every subset whose other points it
     all decides: its counts are then exact and complete, and it is independent (a
-    dependent subset has every det exactly 0). The rest go to the integers."""
+    dependent subset has every det exactly 0). The rest go to the integers.
+    ``start``: signs already proven (:func:`._scan_np.classify` with ``pairs``)."""
     k = Y.shape[1]
     plus = np.zeros(len(subsets), dtype=np.int64)
     minus = np.zeros(len(subsets), dtype=np.int64)
@@ -453,8 +460,10 @@ def _exact_side_counts(Y, Yi, W, subsets, F, expansions: bool, pivots: bool = Fa
     if pivots and k in (2, 3) and len(Y) > k and len(subsets):
         from ._scan_np import side_signs
 
-        sg = side_signs(np.ascontiguousarray(Y, dtype=np.float64), subsets)
+        sg = np.zeros((len(subsets), len(Y)), dtype=np.int8) if start is None else \
+            np.array(start, dtype=np.int8)
         sg[np.arange(len(subsets))[:, None], subsets] = 2  # members: on the hyperplane
+        sg = side_signs(np.ascontiguousarray(Y, dtype=np.float64), subsets, sg)
         done = np.flatnonzero(np.all(sg != 0, axis=1))
         Wi = np.asarray(W, dtype=np.int64)
         plus[done] = (sg[done] == 1) @ Wi
