@@ -13,7 +13,12 @@ rule); the proposal is accepted only if, in exact arithmetic,
    the defining halfspaces S (the rows of all proposals) is computed exactly — so
    conv(V) ⊆ Ψ by the characterisation theorem (a row the floats cannot place is tight
    where a flat of data points on it holds v, :func:`._certify_nb.tight_through` — on
-   the bench clouds every such row — else its slack is computed on the integers);
+   the bench clouds every such row — else its slack is computed on the integers). The
+   rows of S are decided pair by pair; the valid rows outside S (most of them) only
+   once step 2 has proven conv(V) = P_S and its graph: a linear function's maximum over
+   a polytope is at any vertex no neighbour of which is above it, found by a walk on
+   the graph and proven with rounding bounds (:func:`._candidates.graph_top`), the
+   rows it leaves open pair by pair;
 2. every extreme ray of every vertex's tangent cone {d : a_h·d ≤ 0, h tight at v}
    leads to another proposed vertex: for a simple vertex the rays keep all but one of
    its k rows tight; for a non-simple one they are the directions u − v to the
