@@ -68,7 +68,7 @@ def test_nearest_edges_are_the_edge_distances_bit_for_bit(i):
     assert np.array_equal(dist[fast], want)
     assert mon._surely_outside(S[fast]).all() and np.isfinite(err).all()
     assert (want > 0).all()
-    if name in ("circle just outside", "circle far", "circle 1e99", "edge lines beyond ends"):
+    if name in ("circle just outside", "circle far", "edge lines beyond ends"):
         assert fast.all()
 
 

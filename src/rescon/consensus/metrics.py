@@ -250,6 +250,8 @@ class ValidityMonitor:
         self._inner = _inner_rows(self.hull) if self._edges is not None else None
         self._edge_tree = _edge_tree(*self._edges) if self._inner is not None else None
         self._cones = _cone_filter(self.hull) if full and initial.shape[1] == 3 else None
+        self._tri_tree = (_triangle_tree(*self._triangles, self.hull._cache["planes"])
+                          if self._cones is not None and self._triangles is not None else None)
 
     def distance(self, x: np.ndarray) -> float:
         """dist(x, H): 0 iff x ∈ H (exact test); else ‖x − y‖ for the exact projection y
@@ -289,6 +291,9 @@ class ValidityMonitor:
         if self._cones is not None:
             todo = np.flatnonzero(~sure)
             sure[todo] = self._in_cones(states[todo])
+        if self._tri_tree is not None:
+            todo = np.flatnonzero(~sure)
+            out[todo] = self._outside_cones(states[todo])[0]
         todo = np.flatnonzero(~sure & ~out)
         block = max(1, BLOCK // len(self._rows[1]))
         for s in range(0, todo.size, block):
@@ -321,6 +326,12 @@ class ValidityMonitor:
             fast = self._surely_outside(states[rest]) & np.isfinite(err) & (dist > 0)
             out[rest[fast]] = dist[fast]
             rest = rest[~fast]
+        if rest.size and self._tri_tree is not None:
+            fast, known, dist = self._nearest_triangles(states[rest])
+            out[rest[fast]] = dist[fast]
+            exact, rest = rest[known & ~fast], rest[~known]
+            for i in exact:
+                out[i] = self.distance(states[i])
         if rest.size and self._triangles is not None:
             dist, err = self.triangle_distances(states[rest])
             fast = self._surely_outside(states[rest]) & (dist > err)
@@ -373,9 +384,13 @@ class ValidityMonitor:
         (the float mean of the vertices) holds the angle of x − c — a guess, right
         when c is inside H (the angles of C about c then increase cyclically, and the
         ray from c through an outside x leaves H across edge j, beyond its line) — and
-        out the rows facet j's float filter proves outside (S > bound,
-        :meth:`surely_inside`): a wrong guess leaves a row unproven, never wrongly
-        outside. O(n log h)."""
+        out the rows facet j's float filter proves outside with a margin: S > 3·bound
+        (:meth:`surely_inside`). Any other order of the same float operations (the
+        matrix products of :meth:`_surely_outside` and :meth:`surely_inside`) is
+        within the bound of the exact slack, as this one is, so it differs by at most
+        the bound from S and exceeds its own bound there too: those filters reach the
+        same verdict on facet j, and the fast paths the same answers as theirs. A
+        wrong guess leaves a row unproven, never wrongly outside. O(n log h)."""
         A, b = self._rows
         c, order, rays = self._edge_tree[3:6]
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
@@ -384,7 +399,7 @@ class ValidityMonitor:
             S = (X * A[j]).sum(axis=1) - b[j]
             bound = _slack_bound(2, (np.abs(X) * np.abs(A[j])).sum(axis=1), np.abs(b[j]),
                                  np.abs(X).max(axis=1))
-        return S > bound, j
+        return S > 3 * bound, j
 
     def _nearest_edges(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(fast, dist) for rows of X (n, 2) outside a polygon of many edges: fast
@@ -395,14 +410,16 @@ class ValidityMonitor:
         :meth:`edge_distances` computes it, but in O(log h) edges per row for states
         near H: a tree of boxes over runs of consecutive edges (:func:`_edge_tree`)
         is descended, leaving out a box whose lower bound on f_k exceeds f_s for a
-        seed edge s (j and its two neighbours). The bound: the rounded edge k lies in
-        its box, so its exact distance D̂_k ≥ dist(x, box) ≥ ĝ(1 − 4u) − 4·2^-1074
-        (ĝ = fl(hypot) of the rounded gaps, each one rounding, hypot within 2u;
-        the subnormal term for gradual underflow), and |f_k − D̂_k| ≤ 32uM
-        (:meth:`edge_error`: w, e, r within a few uM per coordinate, t's error moves
-        the point by ≤ 3u‖w‖ along the edge, hypot adds u), taken as 64uM, the
-        factor as 1 − 16u and 8·2^-1074 (the rounding of the bound itself). An edge
-        left out has f_k > f_s ≥ min_k f_k, so the minimum over the edges kept is the
+        seed edge s (j and its two neighbours). The bound: whatever t̂ ∈ [0, 1] the
+        floats give, r̂ = fl(ŵ − t̂ê) = x − y + ε with y = p + t̂e on the rounded edge
+        and |ε_i| ≤ 3u(|w_i| + |e_i|) + 2u|r_i| + 4·2^-1075 (w, e, t̂e, the
+        difference); ‖w‖ ≤ ‖x − y‖ + ‖e‖ and ‖e‖ ≤ 2√2 V (V = max |vertex
+        coordinate|), so f_k ≥ ‖x − y‖(1 − 7u) − 17uV − 8·2^-1074, and ‖x − y‖ ≥
+        D̂_k ≥ dist(x, box) ≥ ĝ(1 − 4u) − 4·2^-1074 (ĝ = fl(hypot) of the rounded
+        gaps). A box is left out when ĝ(1 − 40u) − 64uV − 16·2^-1074 > f_s (the
+        factors and terms beyond those above cover this bound's own rounding; the
+        bound scales with V, not with ‖x‖: far states prune as well). An edge left
+        out has f_k > f_s ≥ min_k f_k, so the minimum over the edges kept is the
         minimum over all, bit for bit (the same float operations per edge). Rows
         whose cone facet proves nothing (a guess gone wrong) are not fast: the
         caller takes them to the O(h) path."""
@@ -414,23 +431,11 @@ class ValidityMonitor:
         rows = np.flatnonzero(out & (M > 1e-100) & (M < 1e100))
         seed = np.stack([j[rows], (j[rows] + 1) % h, (j[rows] - 1) % h], axis=1)
         best = _edge_float(X[rows, None, :], P[seed], Q[seed]).min(axis=1)
-        slack = 64 * UNIT_ROUNDOFF * M[rows] + 8 * MIN_SUBNORMAL
-        q, node = np.arange(len(rows)), np.zeros(len(rows), dtype=np.int64)
-        for level, (L, H) in enumerate(zip(lo, hi)):
-            if level:
-                q, node = np.repeat(q, 2), np.repeat(2 * node, 2) + np.tile([0, 1], len(q))
-                real = node < len(L)
-                q, node = q[real], node[real]
-            x = X[rows[q]]
-            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-                gap = np.maximum(np.maximum(L[node] - x, x - H[node]), 0.0)
-                g = np.hypot(gap[:, 0], gap[:, 1])
-                keep = ~(g * (1 - 16 * UNIT_ROUNDOFF) - slack[q] > best[q])
-            q, node = q[keep], node[keep]
-        q = np.repeat(q, leaf)
-        k = np.repeat(node * leaf, leaf) + np.tile(np.arange(leaf), len(node))
-        real = k < h
-        q, k = q[real], k[real]
+        Mv = max(np.abs(P).max(), np.abs(Q).max())
+        slack = 64 * UNIT_ROUNDOFF * Mv + 16 * MIN_SUBNORMAL
+        prunes = _prunes(lo, hi, best, slack, 40 * UNIT_ROUNDOFF)
+        rows, best = rows[prunes], best[prunes]
+        q, k = _descend(lo, hi, leaf, h, X[rows], best, slack, 40 * UNIT_ROUNDOFF)
         f = _edge_float(X[rows[q]], P[k], Q[k])
         dist = np.full(len(X), np.inf)
         found = np.full(len(rows), np.inf)
@@ -439,6 +444,84 @@ class ValidityMonitor:
         fast = np.zeros(len(X), dtype=bool)
         fast[rows] = found > 0
         return fast, dist
+
+    def _outside_cones(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(out, guesses) for rows of X (n, 3) and a polytope from
+        :func:`_exact_polytope`: the triangles of the walk towards x's cone
+        (:func:`_cone_guesses`, (n, CONE_STEPS + 1)) and the rows the facet of one of
+        them proves outside with the margin of :meth:`_outside_guess` (S > 3·bound: the
+        facet loops of :meth:`surely_inside` and :meth:`_surely_outside` then decide
+        the same)."""
+        corners, o, mate, e, tree = self._cones
+        A, b = self._rows
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            Y = np.ldexp(X, -e)  # a guess only: rounded or inf rows merely guess worse
+        guesses = _cone_guesses(tree, corners, mate, o, np.where(np.isfinite(Y), Y, 0.0))
+        out = np.zeros(len(X), dtype=bool)
+        top = np.abs(X).max(axis=1)
+        for g in guesses.T:
+            f = self._tri_tree[3][g]
+            with np.errstate(over="ignore", invalid="ignore"):
+                S = (X * A[f]).sum(axis=1) - b[f]
+                bound = _slack_bound(3, (np.abs(X) * np.abs(A[f])).sum(axis=1),
+                                     np.abs(b[f]), top)
+            out |= S > 3 * bound
+        return out, guesses
+
+    def _nearest_triangles(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(fast, known, dist) for rows of X (n, 3) outside a polytope from
+        :func:`_exact_polytope`: ``known`` the rows whose verdict in :meth:`distances`
+        is settled here — a facet of their walk proves them outside
+        (:meth:`_outside_cones`), 1e-100 < M < 1e100 —, ``fast`` those of them that
+        :meth:`triangle_distances` answers (δ > its bound) and dist its δ, the same
+        float, in O(log T) triangles per row for states near H (the rest of ``known``
+        goes to the exact :meth:`distance`, as there). The closest point y is the
+        float one of the triangle of least fl‖x − y‖² (the first such in triangle
+        order, as numpy's argmin), found by descending a tree of boxes over runs of
+        triangles (:func:`_triangle_tree`) and leaving out a box whose lower bound on
+        ‖x − y‖ exceeds ‖x − y_s‖ for the seeds s (the walk's triangles): y =
+        fl(a + s ê₀ + t ê₁) with s, t ≥ 0, s + t ≤ 1 + 8u (:func:`_closest_points`) is
+        within 6u(|a| + |e₀| + |e₁|) ≤ 30uV per coordinate of a + s e₀ + t e₁ (V =
+        max |corner coordinate|), which is within 8u‖e₁‖ ≤ 28uV of the triangle, in
+        the box: ‖x − y‖ ≥ ĝ(1 − 4u) − 80uV (ĝ the float norm of the rounded gaps to
+        the box; a gap square rounded up from below 2^-1074 adds < 2^-536), and
+        fl‖x − y‖² ≥ (‖x − y‖(1 − 4u))² (x − y, squares and sum rounded; above
+        2^-500 underflow is negligible). A box is left out only when ĝ(1 − 24u) −
+        128uV − 2^-500 > fl(√(least seed fl‖x − y_s‖²))·(1 + 8u): each of its
+        triangles then has fl‖x − y‖² > the seeds' least ≥ the least, so the least
+        and its first triangle are among the triangles kept, bit for bit (the same
+        float operations per triangle). δ and the bound are then
+        :meth:`triangle_distances`' from y."""
+        A, B, C = self._triangles
+        lo, hi, leaf, _, perm = self._tri_tree
+        n = len(X)
+        out, guesses = self._outside_cones(X)
+        M = np.maximum(np.abs(X).max(axis=1), np.abs(self.hull.vertices).max())
+        rows = np.flatnonzero(out & (M > 1e-100) & (M < 1e100))
+        G = guesses[rows]
+        sq = _closest_points(X[rows, None, :], A[G], B[G], C[G])[1]
+        with np.errstate(invalid="ignore", over="ignore"):
+            best = np.sqrt(np.where(np.isnan(sq), np.inf, sq).min(axis=1))
+            best = best * (1 + 8 * UNIT_ROUNDOFF)
+        Mv = max(np.abs(A).max(), np.abs(B).max(), np.abs(C).max())
+        slack = 128 * UNIT_ROUNDOFF * Mv + 2.0**-500
+        prunes = _prunes(lo, hi, best, slack, 24 * UNIT_ROUNDOFF)
+        rows, best = rows[prunes], best[prunes]
+        q, k = _descend(lo, hi, leaf, len(perm), X[rows], best, slack, 24 * UNIT_ROUNDOFF)
+        k = perm[k]
+        Y, sq = _closest_points(X[rows[q]], A[k], B[k], C[k])
+        sq = np.where(np.isnan(sq), np.inf, sq)
+        order = np.lexsort((k, sq, q))
+        first = order[np.r_[True, q[order][1:] != q[order][:-1]]] if len(q) else order
+        fast = np.zeros(n, dtype=bool)
+        known = np.zeros(n, dtype=bool)
+        dist = np.zeros(n)
+        good = np.isfinite(sq[first])  # else the argmin over all-inf rows: the slow path
+        mine, Ysel = rows[q[first][good]], Y[first][good]
+        dist[mine], err = self._triangle_bounds(X[mine], Ysel)
+        known[mine] = True
+        fast[mine] = dist[mine] > err
+        return fast, known, dist
 
     def _in_cones(self, X: np.ndarray) -> np.ndarray:
         """Rows of X (n, 3) a float filter proves inside the polytope H from
@@ -504,7 +587,11 @@ class ValidityMonitor:
         block = max(1, BLOCK // 16 // len(A))  # ~20 (rows, triangles, 3) temporaries
         for s in range(0, len(X), block):
             rows.append(_closest_on_triangles(X[s:s + block], A, B, C))
-        Y = np.concatenate(rows) if rows else np.empty((0, 3))
+        return self._triangle_bounds(X, np.concatenate(rows) if rows else np.empty((0, 3)))
+
+    def _triangle_bounds(self, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(δ, error bound) of :meth:`triangle_distances` from the states X and their
+        float closest points Y on the triangles."""
         with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
             n = X - Y
             dist = np.sqrt((n * n).sum(axis=1))
@@ -901,7 +988,7 @@ def _polytope_of(U: np.ndarray, orient: _Orient3, T: np.ndarray, mate: np.ndarra
     corners on ≥ 3 distinct planes (a corner on 1 lies inside a facet, on 2 inside an
     edge), the certificate's adjacency from the chains of crease edges
     (:func:`_crease_adjacency`); its cache keeps the triangles and o for the
-    validity monitor's cone filter."""
+    validity monitor's cone filter and the facet of each triangle ("planes")."""
     P = orient.P
     planes: dict[tuple[int, ...], int] = {}
     facets = []
@@ -936,7 +1023,7 @@ def _polytope_of(U: np.ndarray, orient: _Orient3, T: np.ndarray, mate: np.ndarra
 
     return SafeKernel(V, 0, dim, V.copy(), A, b, origin, basis, Aeq, beq, seconds, verts,
                       _Exact(verts, facets, (), facets), certificate,
-                      {"cones": (U[T], orient.R[len(U)], mate)})
+                      {"cones": (U[T], orient.R[len(U)], mate), "planes": plane_of})
 
 
 def _crease_adjacency(T: np.ndarray, crease: np.ndarray, is_vertex: np.ndarray
@@ -969,6 +1056,96 @@ def _orient_sign(a: np.ndarray, B: np.ndarray, X: np.ndarray) -> np.ndarray:
     return np.where(det > bound, 1, np.where(det < -bound, -1, 0))
 
 
+#: (row, box) pairs a level of :func:`_descend` may hold before it splits the rows
+DESCEND_PAIRS = 2**20
+
+
+def _prunes(lo: list, hi: list, best: np.ndarray, slack: float, rel: float) -> np.ndarray:
+    """Rows for which :func:`_descend` can leave boxes out: the uncertainty rel·best +
+    slack of its bound is below an eighth of the root box's diagonal (states so far
+    from H that the rounding of their distance exceeds H's size compare every item:
+    the dense O(h) path does that faster; a choice of speed, not of answers)."""
+    diag = float(np.sqrt(((hi[0][0] - lo[0][0]) ** 2).sum()))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return rel * best + slack < diag / 8
+
+
+def _descend(lo: list, hi: list, leaf: int, count: int, X: np.ndarray, best: np.ndarray,
+             slack: float, rel: float) -> tuple[np.ndarray, np.ndarray]:
+    """(q, k): the pairs (row q of X, item k < ``count``) of the leaves of a tree of
+    boxes (:func:`_box_levels`, ``leaf`` items per leaf) that no bound leaves out: a
+    box is left out for row x when fl‖gaps of x to the box‖·(1 − ``rel``) −
+    ``slack`` > best[q] (the callers' proofs, :meth:`ValidityMonitor._nearest_edges`
+    and :meth:`ValidityMonitor._nearest_triangles`). Rows are taken in halves while
+    a level would hold more than DESCEND_PAIRS pairs (memory O(DESCEND_PAIRS), also
+    when nothing can be left out: states far beyond a thin hull)."""
+    qs, ks = [], []
+    todo = [np.arange(len(X))]
+    while todo:
+        rows = todo.pop()
+        q, node = np.arange(len(rows)), np.zeros(len(rows), dtype=np.int64)
+        for level, (L, H) in enumerate(zip(lo, hi)):
+            if level:
+                q, node = np.repeat(q, 2), np.repeat(2 * node, 2) + np.tile([0, 1], len(q))
+                real = node < len(L)
+                q, node = q[real], node[real]
+            if len(q) > DESCEND_PAIRS and len(rows) > 1:
+                todo += [rows[:len(rows) // 2], rows[len(rows) // 2:]]
+                break
+            x = X[rows[q]]
+            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                gap = np.maximum(np.maximum(L[node] - x, x - H[node]), 0.0)
+                g = np.sqrt((gap * gap).sum(axis=1)) if x.shape[1] > 2 else np.hypot(
+                    gap[:, 0], gap[:, 1])
+                keep = ~(g * (1 - rel) - slack > best[rows[q]])
+            q, node = q[keep], node[keep]
+        else:
+            q = np.repeat(q, leaf)
+            k = np.repeat(node * leaf, leaf) + np.tile(np.arange(leaf), len(node))
+            real = k < count
+            qs.append(rows[q[real]])
+            ks.append(k[real])
+    if not qs:
+        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    return np.concatenate(qs), np.concatenate(ks)
+
+
+def _triangle_tree(A: np.ndarray, B: np.ndarray, C: np.ndarray, planes: np.ndarray
+                   ) -> tuple:
+    """(lo, hi, EDGE_LEAF, planes, perm) for :meth:`ValidityMonitor._nearest_triangles`
+    over the triangles (A_k, B_k, C_k): ``perm`` the triangles in the Morton order of
+    their centroids (nearby triangles in the same runs), lo[ℓ], hi[ℓ] the boxes of
+    level ℓ as in :func:`_edge_tree` over runs of EDGE_LEAF triangles of ``perm``, and
+    ``planes`` the facet of each triangle (:func:`_polytope_of`)."""
+    cent = (A + B + C) / 3
+    span = cent.max(axis=0) - cent.min(axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cell = np.nan_to_num((cent - cent.min(axis=0)) / span * 1023).astype(np.int64)
+    code = np.zeros(len(A), dtype=np.int64)
+    for bit in range(10):
+        for axis in range(3):
+            code |= ((cell[:, axis] >> bit) & 1) << (3 * bit + axis)
+    perm = np.argsort(code, kind="stable")
+    pad = -(-len(A) // EDGE_LEAF) * EDGE_LEAF
+    box = np.stack([A, B, C], axis=1)[np.r_[perm, np.full(pad - len(A), perm[-1])]]
+    return (*_box_levels(box.min(axis=1), box.max(axis=1)), EDGE_LEAF, planes, perm)
+
+
+def _box_levels(lo: np.ndarray, hi: np.ndarray) -> tuple[list, list]:
+    """The levels (root first) of a binary tree of boxes over leaves of EDGE_LEAF
+    consecutive items of boxes [lo, hi] (rows; len a multiple of EDGE_LEAF)."""
+    d = lo.shape[1]
+    los = [lo.reshape(-1, EDGE_LEAF, d).min(axis=1)]
+    his = [hi.reshape(-1, EDGE_LEAF, d).max(axis=1)]
+    while len(los[-1]) > 1:
+        L, H = los[-1], his[-1]
+        if len(L) % 2:
+            L, H = np.concatenate([L, L[-1:]]), np.concatenate([H, H[-1:]])
+        los.append(L.reshape(-1, 2, d).min(axis=1))
+        his.append(H.reshape(-1, 2, d).max(axis=1))
+    return los[::-1], his[::-1]
+
+
 #: edges per leaf of a polygon's tree of boxes (:func:`_edge_tree`)
 EDGE_LEAF = 8
 
@@ -984,19 +1161,12 @@ def _edge_tree(P: np.ndarray, Q: np.ndarray) -> tuple:
     pad = -(-h // EDGE_LEAF) * EDGE_LEAF
     box = np.stack([P, Q], axis=1)  # (h, 2, 2)
     box = np.concatenate([box, np.repeat(box[-1:], pad - h, axis=0)])
-    lo = [box.min(axis=1).reshape(-1, EDGE_LEAF, 2).min(axis=1)]
-    hi = [box.max(axis=1).reshape(-1, EDGE_LEAF, 2).max(axis=1)]
-    while len(lo[-1]) > 1:
-        L, H = lo[-1], hi[-1]
-        if len(L) % 2:
-            L, H = np.concatenate([L, L[-1:]]), np.concatenate([H, H[-1:]])
-        lo.append(L.reshape(-1, 2, 2).min(axis=1))
-        hi.append(H.reshape(-1, 2, 2).max(axis=1))
+    lo, hi = _box_levels(box.min(axis=1), box.max(axis=1))
     c = P.mean(axis=0)
     with np.errstate(over="ignore", invalid="ignore"):
         angle = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
     order = np.argsort(angle, kind="stable")
-    return lo[::-1], hi[::-1], EDGE_LEAF, c, order, angle[order]
+    return lo, hi, EDGE_LEAF, c, order, angle[order]
 
 
 def _edge_float(X: np.ndarray, P: np.ndarray, Q: np.ndarray) -> np.ndarray:
@@ -1149,16 +1319,33 @@ def _closest_on_triangles(X: np.ndarray, A: np.ndarray, B: np.ndarray,
     """For each row x of X (n, 3), the closest point to x over the triangles (A, B, C)
     (floats): per triangle y = a + s(b − a) + t(c − a) by the Voronoi regions of its
     vertices, edges and face (Ericson, Real-Time Collision Detection §5.1.5)."""
-    x = X[:, None, :]
-    ab, ac = (B - A)[None], (C - A)[None]
+    Y, sq = _closest_points(X[:, None, :], A[None], B[None], C[None])
+    best = np.argmin(np.where(np.isnan(sq), np.inf, sq), axis=1)
+    return Y[np.arange(len(X)), best]
+
+
+def _closest_points(x: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(y, fl‖x − y‖²) per broadcast row of x and the triangle (a, b, c) (shapes
+    (..., 3)): :func:`_closest_on_triangles`' float closest point. In the face region
+    s = v_b/denom and t = v_c/denom are clipped to [0, 1], and t to 1 − s where
+    s + t > 1 + 8u — no change when v_a, v_b, v_c > 0 in floats (the exact partition
+    of the regions: then denom ≥ fl(v_b + v_c), so 0 ≤ s, t ≤ 1 and s + t ≤ 1 + 3u);
+    floats that break it (a sliver or flat triangle, a far x: v_b/denom was ±inf or
+    huge) now give a point of the triangle (s, t ≥ 0, s + t ≤ 1 + 8u), not one far
+    off it, as the bounds of :meth:`ValidityMonitor.triangle_distances` and
+    :meth:`ValidityMonitor._nearest_triangles` assume (every other region's s, t are
+    in [0, 1] with s + t ≤ 1: quotients of same-signed terms)."""
+    ab, ac = B - A, C - A
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        ap, bp, cp = x - A[None], x - B[None], x - C[None]
-        d1, d2 = (ab * ap).sum(2), (ac * ap).sum(2)
-        d3, d4 = (ab * bp).sum(2), (ac * bp).sum(2)
-        d5, d6 = (ab * cp).sum(2), (ac * cp).sum(2)
+        ap, bp, cp = x - A, x - B, x - C
+        d1, d2 = (ab * ap).sum(-1), (ac * ap).sum(-1)
+        d3, d4 = (ab * bp).sum(-1), (ac * bp).sum(-1)
+        d5, d6 = (ab * cp).sum(-1), (ac * cp).sum(-1)
         va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
         denom = va + vb + vc
-        s, t = vb / denom, vc / denom  # the face
+        s, t = np.clip(vb / denom, 0.0, 1.0), np.clip(vc / denom, 0.0, 1.0)  # the face
+        t = np.where(s + t > 1 + 8 * UNIT_ROUNDOFF, 1 - s, t)
         w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
         for mask, s_, t_ in (  # later regions take precedence, as in Ericson's order
                 ((va <= 0) & (d4 >= d3) & (d5 >= d6), 1 - w, w),
@@ -1168,10 +1355,9 @@ def _closest_on_triangles(X: np.ndarray, A: np.ndarray, B: np.ndarray,
                 ((d3 >= 0) & (d4 <= d3), 1.0, 0.0),
                 ((d1 <= 0) & (d2 <= 0), 0.0, 0.0)):
             s, t = np.where(mask, s_, s), np.where(mask, t_, t)
-        Y = A[None] + s[..., None] * ab + t[..., None] * ac
-        sq = ((x - Y) ** 2).sum(2)
-    best = np.argmin(np.where(np.isnan(sq), np.inf, sq), axis=1)
-    return Y[np.arange(len(X)), best]
+        Y = A + s[..., None] * ab + t[..., None] * ac
+        sq = ((x - Y) ** 2).sum(-1)
+    return Y, sq
 
 
 def _filter_rows(facets) -> tuple[np.ndarray, np.ndarray]:
