@@ -84,6 +84,11 @@ def hostile(kind: str, k: int, m: int, seed: int) -> np.ndarray:
         nudge = rng.integers(-1, 2, (m, k))
         Y = np.where(nudge > 0, np.nextafter(Y, np.inf),
                      np.where(nudge < 0, np.nextafter(Y, -np.inf), Y))
+    elif kind == "exact_flat":  # exactly on a line / plane (40-bit mantissas: the
+        # last coordinate is exact) while products of differences are not
+        x = rng.integers(0, 2**40, (m, k - 1)) * 2.0**-40
+        last = x @ np.array([3.0, -2.0][: k - 1]) + 0.25
+        Y = np.column_stack([x, last])
     elif kind == "converged":  # 1e-15 across around 1e6
         Y = rng.uniform(-1, 1, k) * 1e6 + 1e-9 * rng.uniform(-1, 1, (m, k))
     elif kind == "tight":  # 1e-15 across around 1
@@ -102,7 +107,8 @@ def hostile(kind: str, k: int, m: int, seed: int) -> np.ndarray:
 
 
 KINDS = [f"scale{e}" for e in SCALES] + [
-    "subnormal", "mixed_points", "mixed_coords", "edges", "flat", "flat_ulp", "converged",
+    "subnormal", "mixed_points", "mixed_coords", "edges", "flat", "exact_flat", "flat_ulp",
+    "converged",
     "tight", "far_pivot", "grid", "duplicates"]
 
 
@@ -146,6 +152,8 @@ def test_side_signs_decide_only_exact_signs(kind, k):
         assert decided == 0
     if kind in ("scale0", "scale60", "mixed_points", "mixed_coords", "converged", "far_pivot"):
         assert decided >= 0.9 * len(subsets) * (m - k)
+    if kind == "exact_flat":  # every orientation exactly 0, the products inexact
+        assert not sg.any()
 
 
 def test_side_signs_in_range_is_checked_and_edges_decide():
