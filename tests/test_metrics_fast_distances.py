@@ -104,9 +104,9 @@ def test_no_n_by_h_work_outside_a_10000_gon(monkeypatch):
     assert np.array_equal(got[sample], mon.edge_distances(S[sample])[0])
 
 
-@pytest.mark.parametrize("seed", range(16))
+@pytest.mark.parametrize("seed", range(24))
 def test_small_polygons_through_the_tree_agree_with_brute_force(monkeypatch, seed):
-    """The tree forced on small polygons (INNER_FACETS = 3): 70 initial rows at 4–9
+    """The tree forced on small polygons (INNER_FACETS = 3): 70 initial rows at 6–12
     distinct points — general, a few ulps apart, subnormal, collinear (flat: no tree)
     — at 1e-300 … 1e300; states inside, a few ulps off, on an edge's line beyond its
     end, far outside and at other magnitudes: every distance as the Fractions brute
@@ -116,7 +116,7 @@ def test_small_polygons_through_the_tree_agree_with_brute_force(monkeypatch, see
     kind = ("gauss", "ulps", "subnormal", "line")[seed % 4]
     scale = 1.0 if kind == "subnormal" else float(
         rng.choice([1e-300, 2.0**-1000, 1e-5, 1.0, 1e100, 1e300]))
-    m = int(rng.integers(4, 10))
+    m = int(rng.integers(6, 13))
     B = _few_points(rng, 2, kind, m) * scale
     X0 = B[np.r_[np.arange(m), rng.integers(0, m, 70 - m)]]
     mon = ValidityMonitor(X0)
@@ -162,3 +162,102 @@ def test_monitor_names_reads_the_cli_comma_form():
         monitor_names(" , ")
     with pytest.raises(InputError, match="metrics must be"):
         monitor_names(["spread", 3])
+
+
+# --------------------------------------------------------------------------- #
+# R³: the tree of triangle boxes
+# --------------------------------------------------------------------------- #
+
+
+def _setups3():
+    """(name, initial states, states) in R³: a sphere of 800 points (~1600
+    triangles), a 1e-8-flat ellipsoid (at 1e90 too), a cylinder, a cube of grid points
+    (coplanar corners on each face), and states just outside, far, mixed, at 1e99."""
+    rng = np.random.default_rng(7)
+    X = _circle(800, 3)
+    yield "sphere just outside", X, X * (1 + 2.0**-20)
+    yield "sphere far", X, X * 1e3 + rng.standard_normal(X.shape)
+    yield "sphere mixed", X, rng.standard_normal((800, 3)) * 1.2
+    yield "sphere 1e99", X, X * 1e99
+    E = X * [1e-8, 1.0, 1.0]
+    yield "flat ellipsoid", E, rng.standard_normal((800, 3))
+    yield "flat ellipsoid 1e90", E * 1e90, rng.standard_normal((800, 3)) * 1e90
+    t = rng.uniform(0, 2 * np.pi, 800)
+    yield "cylinder", np.c_[np.cos(t), np.sin(t), rng.choice([-1.0, 1.0], 800)], \
+        rng.standard_normal((800, 3)) * 2
+    G = rng.integers(-5, 6, (1500, 3)).astype(float)
+    yield "grid cube", G, rng.integers(-8, 9, (800, 3)).astype(float)
+    yield "grid cube faces", G, rng.integers(-8, 9, (800, 3)) * 1e-3 + 5
+
+
+SETUPS3 = list(_setups3())
+
+
+@pytest.mark.parametrize("i", range(len(SETUPS3)), ids=[s[0] for s in SETUPS3])
+def test_nearest_triangles_are_triangle_distances_bit_for_bit(i):
+    """The rows the tree settles get triangle_distances' δ bit for bit and its verdict
+    (δ > bound: fast, else the exact path), proven outside by a facet as
+    _surely_outside proves them; distances() equals the dense path's (the tree off)."""
+    name, X0, S = SETUPS3[i]
+    mon = ValidityMonitor(X0)
+    assert mon._tri_tree is not None
+    fast, known, dist = mon._nearest_triangles(S)
+    want, err = mon.triangle_distances(S[known])
+    assert np.array_equal(dist[known], want)
+    assert np.array_equal(fast[known], want > err)
+    assert mon._surely_outside(S[known]).all()
+    if name in ("sphere just outside", "sphere far"):
+        assert fast.all()
+    if "1e90" not in name:  # exact projections of ~500 states: slow
+        got = mon.distances(S)
+        mon._tri_tree = None
+        assert np.array_equal(got, mon.distances(S))
+
+
+def test_no_n_by_t_work_outside_a_sphere(monkeypatch):
+    """V13: 1000 states just outside the hull of 1000 points on a sphere (~2000
+    triangles) took ~0.8 CPU-s per step (every state against every triangle). Now
+    O(log T) closest-point evaluations per state (spy; the dense path takes 2·10⁶)."""
+    X0 = _circle(1000, 3)
+    mon = ValidityMonitor(X0)
+    S = X0 * (1 + 2.0**-20)
+    pairs = []
+    real = metrics._closest_points
+    monkeypatch.setattr(metrics, "_closest_points", lambda x, A, B, C: pairs.append(
+        np.broadcast_shapes(x.shape, A.shape)[:-1]) or real(x, A, B, C))
+    got = mon.distances(S)
+    assert sum(int(np.prod(p)) for p in pairs) < 200 * len(S), pairs
+    assert (got > 0).all()
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_small_polytopes_through_the_tree_agree_with_brute_force(seed):
+    """70 initial rows at 4–9 distinct points in R³ (past PROPOSE_MIN: the certified
+    surface and its tree) — general, a few ulps apart, subnormal — at 1e-300 … 1e300;
+    states inside, a few ulps off, on a line through two corners beyond them, far
+    outside and at other magnitudes: every distance as the Fractions brute force."""
+    rng = np.random.default_rng(100 + seed)
+    kind = ("gauss", "ulps", "subnormal")[seed % 3]
+    scale = 1.0 if kind == "subnormal" else float(
+        rng.choice([1e-300, 2.0**-1000, 1e-5, 1.0, 1e100, 1e300]))
+    m = int(rng.integers(4, 10))
+    B = _few_points(rng, 3, kind, m) * scale
+    X0 = B[np.r_[np.arange(m), rng.integers(0, m, 70 - m)]]
+    mon = ValidityMonitor(X0)
+    i, j = rng.integers(0, m, 2)
+    S = np.vstack([rng.dirichlet(np.ones(m), size=2) @ B,
+                   B[rng.integers(0, m, 3)] * rng.uniform(0.5, 1.5, (3, 1)),
+                   B[i] + 2 * (B[j] - B[i]), 2 * B[i] - B[j],
+                   rng.standard_normal((3, 3)) * scale,
+                   B[:1] + np.spacing(B[:1]) * rng.integers(-2, 3, (1, 3)),
+                   rng.standard_normal((1, 3)) * float(rng.choice([1e-320, 1e-300, 1e300]))])
+    S = S[np.isfinite(S).all(axis=1)]
+    if mon._tri_tree is not None:
+        fast, known, dist = mon._nearest_triangles(S)
+        want, err = mon.triangle_distances(S[known])
+        assert np.array_equal(dist[known], want) and np.array_equal(fast[known], want > err)
+    got = mon.distances(S)
+    M = np.abs(X0).max()
+    for g, x in zip(got, S):
+        want = _distance(X0, x)
+        assert _close(g, want, max(M, np.abs(x).max())), (g, want, x)

@@ -1065,8 +1065,8 @@ def _prunes(lo: list, hi: list, best: np.ndarray, slack: float, rel: float) -> n
     slack of its bound is below an eighth of the root box's diagonal (states so far
     from H that the rounding of their distance exceeds H's size compare every item:
     the dense O(h) path does that faster; a choice of speed, not of answers)."""
-    diag = float(np.sqrt(((hi[0][0] - lo[0][0]) ** 2).sum()))
     with np.errstate(over="ignore", invalid="ignore"):
+        diag = float(np.hypot.reduce(hi[0][0] - lo[0][0]))
         return rel * best + slack < diag / 8
 
 
