@@ -384,6 +384,66 @@ def test_valid_halfspaces_small_path_against_brute_force(k, kind, seed, F):
         assert set(got) == set(valid)
 
 
+def _own_units(X: np.ndarray, k: int, F: int = 2, shift: int = 0) -> None:
+    """valid_halfspaces(X, Yi, 1, F) with X in its own units, no float_view — Yi = X ·
+    scale (exact_points), or with ``shift`` Yi = X / 2^shift (integers: a unit < 1) —
+    against the brute force (see above)."""
+    X = np.unique(X, axis=0)
+    P = exact_points(X)
+    Yi = [tuple(r) for r in P.ints]
+    unit = Fraction(P.scale)
+    if shift:
+        Yi = [tuple(int(Fraction(v) / 2**shift) for v in r) for r in X.tolist()]
+        unit = Fraction(1, 2**shift)
+        assert all(y == unit * Fraction(v) for r, yr in zip(X.tolist(), Yi, strict=True)
+                   for v, y in zip(r, yr, strict=True))  # Yi = Y · unit
+    if len(Yi) <= k:
+        pytest.skip("too few distinct points")
+    W = np.ones(len(Yi), dtype=np.int64)
+    with np.errstate(all="ignore"):
+        hs = halfspaces.valid_halfspaces(X, Yi, W, F, True)
+    valid, rows = _brute_valid(X, W, F)
+    got = {(tuple(t), int(s)): int(o) for t, s, o in
+           zip(hs.through.tolist(), hs.sign.tolist(), hs.outside.tolist(), strict=True)}
+    for key, out in got.items():
+        assert key in valid and out <= valid[key], (key, out, valid.get(key))
+    assert {_canonical(*hs.exact(h), unit) for h in range(len(hs))} == rows
+    if hs.c_err != 0.0 or k == 2:
+        assert set(got) == set(valid)
+
+
+@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("kind", [kind for kind in KINDS if kind != "subnormal"])
+def test_valid_halfspaces_own_units_against_brute_force(kind, k):
+    """``halfspaces.valid_halfspaces`` called directly with the data in their own units
+    (Yf = X up to 2^±1000, no float_view rescaling; Yi = X · scale, exact_view): the
+    same checks as above against the brute force (the pivot filter runs where X is in
+    the expansions' range)."""
+    _own_units(hostile(kind, k, 9 if k == 2 else 7, 3), k)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "pre-existing (not cf7fec2): valid_halfspaces takes exact_floats (c_err = 0: a float "
+    "orientation of 0 means on the hyperplane) from the bit length of Yi alone; its "
+    "comment's premise 'a unit <= 2^(bits + 32)' holds only for float_view's units: small "
+    "integers over a unit of 2^1000 (or subnormal data) underflow to 0, under a unit of "
+    "2^-1000 overflow to inf/nan, and points count as on the line (k = 2, 2^-1000: 72 "
+    "rows where 29 are valid; k = 3, 2^-400: none of 46)"))
+@pytest.mark.parametrize("k, e", [(2, -1000), (3, -400), (2, -1074), (3, -1074), (2, 1000),
+                                  (3, 400)])
+def test_valid_halfspaces_exact_floats_need_float_views_units(k, e):
+    """A small-integer grid times 2^e handed to valid_halfspaces in its own units (Y = X
+    exact, Yi = X · 2^-e: unit 2^-e, a power of two as its docstring asks): the rows
+    must be the brute-force ones. Only direct calls get here (its one caller,
+    kernel._clip_rows, passes float_view's Y with 2^-32 ≤ max |Y| < 2^32). Fix: require
+    the premise, ``exact_floats = exact_view and (k == 1 or (bits <=
+    _exact_float_bits(k) and 2.0**-32 <= float(np.abs(Y).max()) < 2.0**32))`` (then
+    unit ≤ 2^(bits + 32): no product of k + 1 differences, each ≥ 1/unit and ≤ 2^33,
+    underflows or overflows), or refuse such a call with a one-line ValueError."""
+    G = hostile("grid", k, 9 if k == 2 else 7, 3)
+    _own_units(G * 2.0**e, k, shift=max(e, 0))
+
+
 # ---------------------------------------------------------------- the public results
 
 
