@@ -1,0 +1,386 @@
+"""Hostile review V17 of the d ≥ 4 fast path's walks on the vertex graph (commit 3e97a68:
+:func:`rescon.geometry._candidates.graph_top`, :func:`rescon.geometry.fastpath.
+_outside_feasible`).
+
+* The graph the walks use is exactly P_S's edge graph — u ~ v iff the rows of S tight at
+  both have rank k − 1 (exact ranks over ℚ) — on non-simple, duplicated, converged,
+  grid, near-threshold and extreme-scale clouds in d = 4 and 5; flat, 0-dimensional,
+  empty and tiny-n kernels never reach the walks.
+* graph_top against an exact oracle on crafted polytopes (rational affine images of the
+  4-cube and the 4-cross-polytope, whose graphs are known): a finite t_h is the float
+  slack at the row's unique exact maximiser, t_h < −bound only for rows slack
+  everywhere; plateaus (rows parallel to a face), float ties of distinct exact values,
+  vertices at 2^±990 and subnormal, rows of huge norm, overflow, NaN and ±inf give
+  +inf (pair by pair) or a proven value, never a wrong one; threaded = one range.
+* The graph matters: with one vertex cut out of the graph the walk "proves" a cutting
+  row slack (the oracle catches it) — the tests above can fail.
+* Public results (vertices, A, b, dim, exact vertices, certificate) equal the exact
+  clipping's on further hostile clouds, and the certificates check valid.
+"""
+
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import rescon
+from rescon._rounding import UNIT_ROUNDOFF, underflow_floor
+from rescon.geometry import _candidates, fastpath
+from tests.test_kernel_d45_around2 import _cloud, _same_as_clipping
+from tests.test_kernel_d45_walk import _captured, _csr
+
+# ---------------------------------------------------------------- the graph is exact
+
+
+def _rank(rows: list[tuple[int, ...]]) -> int:
+    """Rank over ℚ (Gaussian elimination on Fractions)."""
+    M = [[Fraction(x) for x in r] for r in rows]
+    r = 0
+    width = len(M[0]) if M else 0
+    for c in range(width):
+        p = next((i for i in range(r, len(M)) if M[i][c] != 0), None)
+        if p is None:
+            continue
+        M[r], M[p] = M[p], M[r]
+        for i in range(r + 1, len(M)):
+            if M[i][c] != 0:
+                f = M[i][c] / M[r][c]
+                M[i] = [a - f * b for a, b in zip(M[i], M[r], strict=True)]
+        r += 1
+    return r
+
+
+def _exact_graph(got: dict) -> list[set[int]]:
+    """P_S's edge graph from scratch: the exact tight sets of every vertex within S, and
+    u ~ v iff the rows tight at both have rank k − 1 (the face they cut out is then an
+    edge holding both vertices — its two ends)."""
+    H, verts, k = got["H"], got["verts"], got["k"]
+    rows = [H.exact(h) for h in got["S"].tolist()]
+    tight = [{i for i, (a, b) in enumerate(rows)
+              if sum(x * y for x, y in zip(a, v[1:], strict=True)) == b * v[0]}
+             for v in verts]
+    out: list[set[int]] = [set() for _ in verts]
+    for u, v in itertools.combinations(range(len(verts)), 2):
+        Z = tight[u] & tight[v]
+        if len(Z) >= k - 1 and _rank([rows[i][0] for i in Z]) == k - 1:
+            out[u].add(v)
+            out[v].add(u)
+    return out
+
+
+GRAPH_CLOUDS = [("gaussian", 4, 20, 2, 1.0), ("cell24", 4, 28, 4, 1.0),
+                ("lattice", 4, 27, 4, 1.0), ("grid", 4, 20, 2, 1.0),
+                ("nearsame", 4, 20, 2, 1.0), ("cube", 4, 20, 3, 2.0**-990),
+                ("converged", 4, 20, 2, 2.0**990), ("attack", 4, 20, 2, 1.0),
+                ("integer", 4, 20, 3, 1.0), ("subnormal", 4, 20, 2, 1.0),
+                pytest.param("gaussian", 5, 13, 1, 1.0, marks=pytest.mark.slow),
+                ("nearsame", 5, 13, 1, 1.0)]
+
+
+@pytest.mark.parametrize("kind,d,n,F,scale", GRAPH_CLOUDS)
+def test_the_walked_graph_is_exactly_the_edge_graph(kind, d, n, F, scale, monkeypatch):
+    """The neighbour lists handed to graph_top (from the closure: keyed simple vertices,
+    the combinatorial check at non-simple ones, the double description) are exactly
+    P_S's edges, each listed at both ends, no vertex its own neighbour, no repeats."""
+    got = _captured(_cloud(kind, d, n, F) * scale, F, monkeypatch)
+    assert got["ok"]
+    edges = got["edges"]
+    assert [len(e) for e in edges] == [len(set(e)) for e in edges]
+    assert [set(e) for e in edges] == _exact_graph(got)
+    assert all(v not in e for v, e in enumerate(edges))
+
+
+def test_a_flat_cloud_walks_in_its_affine_hull(monkeypatch):
+    """Points on a hyperplane of R^4: the fast path works in k = 3 pivot coordinates
+    (the kernel is full-dimensional in the cloud's affine hull), and the graph it walks
+    is exactly that 3-polytope's; the kernel is the clipping's."""
+    X = _cloud("flat", 4, 20, 2)
+    got = _captured(X, 2, monkeypatch)
+    assert got["ok"] and got["k"] == 3
+    assert [set(e) for e in got["edges"]] == _exact_graph(got)
+    K = _same_as_clipping(X, 2, monkeypatch)
+    assert K.dim == 3
+
+
+def _hostile(name: str) -> tuple[np.ndarray, int]:
+    """Clouds beyond the d45 test families: converged at offset 10⁶ (spread a few ulps),
+    rounded to a small integer grid, half the points duplicated, kernels near the
+    emptiness threshold, tiny n, subnormal data, per-column scales 2^±600."""
+    rng = np.random.default_rng(sum(map(ord, name)))
+    d = 5 if name.endswith("5") else 4
+    n = 14 if d == 5 else 20
+    Z = rng.normal(size=(n, d))
+    F = 2 if d == 4 else 1
+    return {
+        "offset1e6_4": lambda: (1e6 + 2.0**-33 * np.round(8 * Z), F),
+        "offset1e6_5": lambda: (1e6 + 2.0**-33 * np.round(8 * Z), F),
+        "int_grid_4": lambda: (np.round(2 * Z), F),
+        "int_grid_5": lambda: (np.round(2 * Z), F),
+        "half_duplicated_4": lambda: (np.vstack([Z[:10], Z[:10]]), 4),
+        "threshold_n15_4": lambda: (Z[:15], 2),
+        "threshold_n12_4": lambda: (Z[:12], 1),
+        "threshold_n30_4": lambda: (rng.normal(size=(30, 4)), 5),
+        "sphere_int_4": lambda: (np.round(100 * Z / np.linalg.norm(Z, axis=1)[:, None]), F),
+        "subnormal_4": lambda: (Z * 2.0**-1060, F),
+        "tiny_n5_F0_4": lambda: (Z[:5], 0),
+        "tiny_n6_F1_4": lambda: (Z[:6], 1),
+        "tiny_n7_F1_4": lambda: (Z[:7], 1),
+        "tiny_n8_F1_5": lambda: (Z[:8], 1),
+        "mixed_columns_4": lambda: (Z * 2.0 ** np.array([600, 0, -600, 300]), F),
+    }[name]()
+
+
+@pytest.mark.parametrize("name", ["offset1e6_4", "int_grid_4", "half_duplicated_4",
+                                  "threshold_n15_4", "threshold_n12_4", "sphere_int_4",
+                                  "subnormal_4",
+                                  pytest.param("threshold_n30_4", marks=pytest.mark.slow),
+                                  pytest.param("offset1e6_5", marks=pytest.mark.slow),
+                                  pytest.param("int_grid_5", marks=pytest.mark.slow)])
+def test_hostile_graphs_exact_and_kernels_equal_the_clipping(name, monkeypatch):
+    """Further hostile clouds: the walked graph is exact and every public output equals
+    the exact clipping's; the certificate checks valid."""
+    X, F = _hostile(name)
+    got = _captured(X, F, monkeypatch)
+    assert got["ok"]
+    assert [set(e) for e in got["edges"]] == _exact_graph(got)
+    K = _same_as_clipping(X, F, monkeypatch)
+    verdict = rescon.check_certificate(K.certificate).verdict
+    # 2^-1060-scaled data exceed the checker's bit-size limits, the d = 5 kernels' ~10³
+    # vertices its work limit: "unchecked" there, never "invalid"
+    assert verdict == ("unchecked" if name == "subnormal_4" or name.endswith("5")
+                       else "valid")
+
+
+@pytest.mark.parametrize("name", ["tiny_n5_F0_4", "tiny_n6_F1_4", "tiny_n7_F1_4",
+                                  "tiny_n8_F1_5",
+                                  pytest.param("mixed_columns_4", marks=pytest.mark.slow)])
+def test_kernels_that_never_reach_the_walks_equal_the_clipping(name, monkeypatch):
+    """n = d + 1 .. d + 4 (empty, 0-dimensional and full kernels) and per-column scales
+    2^±600 (qhull's proposal fails; ~5 s of clipping): the walks never run, the results
+    are the clipping's and check valid."""
+    X, F = _hostile(name)
+    calls = []
+    real = fastpath._outside_feasible
+    monkeypatch.setattr(fastpath, "_outside_feasible",
+                        lambda *a: calls.append(1) or real(*a))
+    K = _same_as_clipping(X, F, monkeypatch)
+    assert not calls
+    # 1934-bit numbers at 2^±600: beyond the checker's limits, never "invalid"
+    assert rescon.check_certificate(K.certificate).verdict == (
+        "unchecked" if name == "mixed_columns_4" else "valid")
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("above_helly", 4, 19, 4), ("simplex", 4, 5, 0),
+                                        ("duplicates", 4, 21, 2)])
+def test_empty_and_simplex_kernels_do_not_walk(kind, d, n, F, monkeypatch):
+    """An empty kernel, the simplex of n = d + 1 points and a duplicated cloud the small
+    path takes: no walk runs, and the results are the clipping's."""
+    calls = []
+    real = fastpath._outside_feasible
+    monkeypatch.setattr(fastpath, "_outside_feasible",
+                        lambda *a: calls.append(1) or real(*a))
+    _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
+    assert not calls
+
+
+# ------------------------------------------- graph_top against an exact oracle
+
+
+def _cube() -> tuple[list[tuple[int, ...]], list[list[int]]]:
+    """The 4-cube {±1}^4 (simple) and its graph: vertices differing in one sign."""
+    V = list(itertools.product((-1, 1), repeat=4))
+    return V, [[u for u, w in enumerate(V) if sum(a != b for a, b in zip(v, w, strict=True))
+                == 1] for v in V]
+
+
+def _cross() -> tuple[list[tuple[int, ...]], list[list[int]]]:
+    """The 4-cross-polytope ±e_i (every vertex non-simple: 6 facets at each, degree 6):
+    all pairs but the antipodal ones are edges."""
+    V = [tuple(s if j == i else 0 for j in range(4)) for i in range(4) for s in (1, -1)]
+    return V, [[u for u in range(8) if u != v and u != v ^ 1] for v in range(8)]
+
+
+#: the image map T = I + N (N strictly upper triangular, dyadic): T⁻¹ is dyadic, so
+#: rows parallel to a face of the image are exact floats
+_N = np.array([[0, 0.5, -0.25, 0.125], [0, 0, 0.75, -0.5], [0, 0, 0, 0.375],
+               [0, 0, 0, 0]])
+
+
+def _image(shape, scale: Fraction, offset: Fraction):
+    """Exact vertices scale·T·v + offset·(1, 1/3·…) of a polytope (an affine image keeps
+    its graph), their correctly rounded floats, and the graph in CSR form."""
+    V0, edges = shape()
+    T = [[Fraction(x) for x in row] for row in (np.eye(4) + _N).tolist()]
+    o = [offset * Fraction(1, 3 + 2 * j) for j in range(4)]
+    exact = [tuple(scale * sum(T[i][j] * v[j] for j in range(4)) + o[i] for i in range(4))
+             for v in V0]
+    Vx = np.array([[float(x) for x in v] for v in exact])
+    return exact, Vx, *_csr(edges)
+
+
+def _plateau_rows(scale: float) -> np.ndarray:
+    """Rows a with Tᵀa = ±e_i or ±(e_i + e_j) (exact dyadic floats): constant on a
+    facet or a 2-face of the image of the cube — exact ties along its edges."""
+    Tinv = np.linalg.inv(np.eye(4) + _N)  # exact: dyadic, small
+    assert np.array_equal(Tinv @ (np.eye(4) + _N), np.eye(4))
+    dirs = [np.eye(4)[i] for i in range(4)] + [np.eye(4)[i] + np.eye(4)[j]
+                                               for i, j in itertools.combinations(range(4), 2)]
+    return np.array([s * Tinv.T @ d for d in dirs for s in (1.0, -1.0)]) * scale
+
+
+def _float_slack(a: np.ndarray, b: float, v: np.ndarray) -> float:
+    """The walk's float slack: Σ_j a_j v_j in order, then − b (as _candidates._slack)."""
+    s = 0.0
+    with np.errstate(all="ignore"):
+        for j in range(len(a)):
+            s = float(np.float64(s) + np.float64(a[j]) * np.float64(v[j]))
+        return float(np.float64(s) - np.float64(b))
+
+
+def _bound(a, b, v, c: float, floor: float) -> Fraction:
+    """The per-pair rounding bound c (|a|·|v| + |b|) + floor (c_err = 0: the rows are
+    exact floats), as a Fraction (inf → None)."""
+    e = c * (float(np.abs(a) @ np.abs(v)) + abs(b)) + floor
+    return Fraction(e) * (1 + Fraction(1, 2**40)) if np.isfinite(e) else None
+
+
+def _check_rows(A, b, exact, Vx, ptr, nbr) -> tuple[int, int]:
+    """graph_top on the rows against the exact oracle: a finite t_h is the float slack at
+    the row's unique exact maximiser v*, within the bound of its exact maximum, and
+    t_h < −coarse only for rows slack everywhere. Returns (rows, finite t)."""
+    k = A.shape[1]
+    c = 2.0 * (k + 4) * UNIT_ROUNDOFF
+    M = float(np.abs(Vx).max())
+    floor = underflow_floor(k, M)
+    with np.errstate(all="ignore"):
+        top = _candidates.graph_top(A, b, np.abs(A), np.abs(b), Vx, ptr, nbr, 0.0, c, floor)
+        coarse = c * (np.abs(A).sum(axis=1) * M + np.abs(b)) + floor
+    finite = 0
+    for h in range(len(b)):
+        if not np.isfinite(top[h]):
+            assert top[h] == np.inf, h  # never −inf or NaN
+            continue
+        finite += 1
+        assert np.isfinite(A[h]).all() and np.isfinite(b[h]), h
+        g = [sum(Fraction(float(x)) * y for x, y in zip(A[h], v, strict=True))
+             - Fraction(float(b[h])) for v in exact]
+        best = max(g)
+        at = [v for v, x in enumerate(g) if x == best]
+        assert len(at) == 1, (h, at)  # an exact tie on the top face is never "proven"
+        assert _float_slack(A[h], b[h], Vx[at[0]]) == top[h], h
+        e = _bound(A[h], b[h], Vx[at[0]], c, floor)
+        assert e is not None and best <= Fraction(float(top[h])) + e, h
+        if top[h] < -coarse[h]:
+            assert best < 0, h
+    return len(b), finite
+
+
+SCALES = [(Fraction(1), Fraction(0)), (Fraction(1), Fraction(10**6)),
+          (Fraction(1, 2**40), Fraction(10**6)), (Fraction(2**990), Fraction(2**990)),
+          (Fraction(1, 2**990), Fraction(1, 2**989)),
+          (Fraction(1, 2**1070), Fraction(1, 2**1068))]
+
+
+@pytest.mark.parametrize("shape", [_cube, _cross])
+@pytest.mark.parametrize("scale,offset", SCALES)
+def test_graph_top_on_crafted_polytopes_is_proven_or_open(shape, scale, offset):
+    """Random rows, rows through a vertex, plateau rows (ties along a facet / 2-face) and
+    rows 2^-50 off a plateau (float ties and reversals of distinct exact values), on
+    the cube and the cross-polytope at unit size, at offset 10⁶ (spreads of 1 and
+    2^-40: cancellation), at 2^±990 and with subnormal vertices (2^-1070): every
+    finite answer is right (:func:`_check_rows`)."""
+    exact, Vx, ptr, nbr = _image(shape, scale, offset)
+    rng = np.random.default_rng(17)
+    size = float(np.abs(Vx).max())
+    span = float(np.ptp(Vx, axis=0).max())
+    P = _plateau_rows(1.0)
+    R = rng.normal(size=(40, 4))
+    A = np.vstack([R, P, P + 2.0**-50 * rng.normal(size=P.shape),
+                   P + 2.0**-30 * rng.normal(size=P.shape)])
+    # b: the float maximum shifted by −2 spans … +2 spans, and exactly through a vertex
+    # (Vx exact) where the rows are dyadic and short
+    top = (A @ Vx.T).max(axis=1)
+    shift = rng.uniform(-2, 2, size=len(A)) * span * np.abs(A).sum(axis=1)
+    b = np.concatenate([top + shift, top])
+    A = np.vstack([A, A])
+    rows, finite = _check_rows(A, b, exact, Vx, ptr, nbr)
+    if span > 2.0**20 * underflow_floor(4, size):  # not subnormal, not at 2^990
+        assert finite > rows // 4  # the walks prove something
+
+
+def test_plateau_rows_stay_open():
+    """A row constant on a facet of the cube (exact ties along its edges): its maximum
+    is the facet, and the walk ends on it with a tied neighbour — +inf (pair by pair),
+    never a value."""
+    exact, Vx, ptr, nbr = _image(_cube, Fraction(1), Fraction(0))
+    P = _plateau_rows(1.0)
+    top = _candidates.graph_top(P, np.zeros(len(P)), np.abs(P), np.zeros(len(P)), Vx, ptr,
+                                nbr, 0.0, 16 * UNIT_ROUNDOFF, underflow_floor(4, 2.0))
+    assert np.isinf(top).all()
+
+
+def test_graph_top_overflow_nan_and_inf_rows_stay_open():
+    """Rows whose slacks overflow (norm 2^1022 against vertices ~5), rows with a NaN or
+    ±inf entry or b = ±inf, and b ~ 2^1023 (slacks at the top of the range): +inf,
+    pair by pair — never a finite value or NaN."""
+    exact, Vx, ptr, nbr = _image(_cube, Fraction(3), Fraction(0))
+    A = np.array([[2.0**1022, 2.0**1022, 0, 0], [np.nan, 1, 0, 0], [np.inf, 0, 0, 0],
+                  [-np.inf, 1, 1, 1], [1, 1, 1, 1], [1, 1, 1, 1], [1, 1, 1, 1],
+                  [2.0**1022, -(2.0**1022), 2.0**1022, 2.0**1022]])
+    b = np.array([0.0, 0, 0, 0, np.inf, -np.inf, np.nan, -(2.0**1023)])
+    with np.errstate(all="ignore"):
+        top = _candidates.graph_top(A, b, np.abs(A), np.abs(b), Vx, ptr, nbr, 0.0,
+                                    16 * UNIT_ROUNDOFF, underflow_floor(4, 9.0))
+    assert np.isinf(top).all() and (top > 0).all()
+    # norm 2^1000: the slacks ~2^1002 stay finite, and what the walk proves is right
+    big = np.array([[2.0**1000, 2.0**1000, 0, -(2.0**999)], [2.0**1000, 1, 1, 1]])
+    _check_rows(big, np.array([0.0, 2.0**1001]), exact, Vx, ptr, nbr)
+
+
+def test_graph_top_threaded_agrees_with_one_range():
+    """≥ WALK_THREADS_MIN rows run on 16 ranges, each starting from its own previous end:
+    a finite t_h is the float slack at the unique exact maximiser, so wherever both are
+    finite the threaded and the row-by-row answers are equal; the oracle holds for all."""
+    exact, Vx, ptr, nbr = _image(_cross, Fraction(1), Fraction(10**6))
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(_candidates.WALK_THREADS_MIN + 37, 4))
+    b = (A @ Vx.T).max(axis=1) + rng.uniform(-1, 1, size=len(A))
+    args = (np.abs(A), np.abs(b), Vx, ptr, nbr, 0.0, 16 * UNIT_ROUNDOFF,
+            underflow_floor(4, float(np.abs(Vx).max())))
+    many = _candidates.graph_top(A, b, *args)
+    one = np.array([_candidates.graph_top(A[h:h + 1], b[h:h + 1], args[0][h:h + 1],
+                                          args[1][h:h + 1], *args[2:])[0]
+                    for h in range(0, len(A), 97)])
+    both = np.isfinite(many[::97]) & np.isfinite(one)
+    assert both.mean() > 0.5
+    assert np.array_equal(many[::97][both], one[both])
+    _check_rows(A[::97], b[::97], exact, Vx, ptr, nbr)
+
+
+# --------------------------------------------- the graph matters: one edge missing
+
+
+def test_a_graph_missing_a_vertex_lets_the_walk_certify_a_cutting_row():
+    """The row x₁ + x₂ + x₃ + x₄ ≤ 3.5 cuts the cube's corner (1, 1, 1, 1) only (slack
+    0.5 there, −1.5 at its four neighbours). On the true graph graph_top reports the
+    corner (t = 0.5: not slack). With the corner cut out of every neighbour list (it is
+    no seed) the walk stops at a neighbour, all of whose remaining neighbours are lower,
+    and "proves" t = −1.5 < −coarse: the certificate then rests on the graph alone —
+    which is why it must be the closure's complete graph, and why the oracle above can
+    fail."""
+    exact, Vx, ptr, nbr = _image(_cube, Fraction(1), Fraction(0))
+    a = np.linalg.inv(np.eye(4) + _N).T @ np.ones(4)  # Tᵀa = (1, 1, 1, 1)
+    A, b = a[None, :], np.array([3.5])
+    corner = 15  # (1, 1, 1, 1) in product order
+    args = (np.abs(A), np.abs(b), Vx)
+    rest = (0.0, 16 * UNIT_ROUNDOFF, underflow_floor(4, float(np.abs(Vx).max())))
+    assert _candidates.graph_top(A, b, *args, ptr, nbr, *rest)[0] == 0.5
+    edges = [[u for u in nbr[ptr[v]:ptr[v + 1]].tolist() if u != corner]
+             for v in range(len(Vx))]
+    cut = _candidates.graph_top(A, b, *args, *_csr(edges), *rest)[0]
+    assert cut == -1.5  # wrong: the corner's slack is +0.5
+    with pytest.raises(AssertionError):
+        _check_rows(A, b, exact, Vx, *_csr(edges))
