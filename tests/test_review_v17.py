@@ -384,3 +384,56 @@ def test_a_graph_missing_a_vertex_lets_the_walk_certify_a_cutting_row():
     assert cut == -1.5  # wrong: the corner's slack is +0.5
     with pytest.raises(AssertionError):
         _check_rows(A, b, exact, Vx, *_csr(edges))
+
+
+# ------------------------------------- the walks run only after a proven closure
+
+
+def _ordering_spies(monkeypatch) -> list:
+    """Spies on _closed and _outside_feasible: each walk must get the very graph a
+    closure just proved (not None)."""
+    log: list = []
+    closed, outside = fastpath._closed, fastpath._outside_feasible
+
+    def spy_closed(*args, **kw):
+        edges = closed(*args, **kw)
+        log.append(("closed", edges))
+        return edges
+
+    def spy_outside(*args):
+        assert log and log[-1][0] == "closed" and log[-1][1] is not None
+        assert args[10] is log[-1][1]  # edges
+        log.append(("walk", None))
+        return outside(*args)
+
+    monkeypatch.setattr(fastpath, "_closed", spy_closed)
+    monkeypatch.setattr(fastpath, "_outside_feasible", spy_outside)
+    return log
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("gaussian", 4, 20, 2), ("cell24", 4, 28, 4),
+                                        ("gaussian", 5, 13, 1)])
+def test_a_proposal_missing_a_vertex_never_reaches_the_walks(kind, d, n, F, monkeypatch):
+    """qhull's proposals with one vertex left out (all of its joggled pieces; every
+    round, every option): the
+    closure refuses each of them, no walk runs, and the kernel is the exact clipping's.
+    With the proposals whole, each walk gets the graph its closure just proved."""
+    X = _cloud(kind, d, n, F)
+    log = _ordering_spies(monkeypatch)
+    rescon.safe_kernel(X, F)
+    assert [e for e, _ in log][-2:] == ["closed", "walk"]
+    log.clear()
+    real = fastpath._propose
+
+    def short(*args, **kw):
+        got = real(*args, **kw)
+        if got is None:
+            return None
+        V, facets = got  # every proposal near one point out (joggled pieces too)
+        gap = np.abs(V - V[len(V) // 2]).max(axis=1)
+        keep = gap > 1e-6 * (np.ptp(V, axis=0).max() + np.abs(V).max())
+        return V[keep], [f for f, x in zip(facets, keep, strict=True) if x]
+
+    monkeypatch.setattr(fastpath, "_propose", short)
+    _same_as_clipping(X, F, monkeypatch)
+    assert log and all(e == "closed" and g is None for e, g in log)
