@@ -9,7 +9,11 @@ gives
 O(n^k) candidates instead of C(n, F) subsets. Each candidate's side counts are
 decided by the float filter of :mod:`._candidates`; the undecided ones (points within
 the rounding-error bound of the hyperplane, or degenerate subsets) are re-decided in
-exact integer arithmetic, so the set returned never depends on a tolerance.
+exact integer arithmetic, so the set returned never depends on a tolerance. On small
+inputs in the plane and in space a second float filter comes first: the orientation
+about each of the k + 1 points in turn, with a proven bound
+(:func:`._scan_np.side_signs`) — a hyperplane through a far point and a tight cluster
+cancels about the far point, not about a cluster point.
 """
 
 from __future__ import annotations
