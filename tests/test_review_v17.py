@@ -437,3 +437,25 @@ def test_a_proposal_missing_a_vertex_never_reaches_the_walks(kind, d, n, F, monk
     monkeypatch.setattr(fastpath, "_propose", short)
     _same_as_clipping(X, F, monkeypatch)
     assert log and all(e == "closed" and g is None for e, g in log)
+
+
+# ------------------------------------------- a forced fallback that forces nothing
+
+
+@pytest.mark.xfail(strict=True, reason="numba freezes the global WALK_TINY into the "
+                   "compiled _walk_range at compile time: monkeypatching _candidates."
+                   "WALK_TINY changes nothing, so test_kernel_d45_walk's 'tiny raised' "
+                   "fallback test runs the normal walks (fix: pass WALK_TINY to "
+                   "_walk_range as an argument read at call time)")
+def test_raising_walk_tiny_makes_every_walk_prove_nothing(monkeypatch):
+    """test_kernel_d45_walk forces "every row pair by pair" by setting WALK_TINY = 1e300
+    (every comparison then needs a drop ≥ 1e300). On the cube with rows the walks
+    normally prove, the raised constant must leave every row +inf."""
+    exact, Vx, ptr, nbr = _image(_cube, Fraction(1), Fraction(0))
+    A = np.random.default_rng(1).normal(size=(50, 4))
+    b = np.full(50, 10.0)
+    args = (A, b, np.abs(A), np.abs(b), Vx, ptr, nbr, 0.0, 16 * UNIT_ROUNDOFF,
+            underflow_floor(4, 2.0))
+    assert np.isfinite(_candidates.graph_top(*args)).all()
+    monkeypatch.setattr(_candidates, "WALK_TINY", 1e300)
+    assert np.isinf(_candidates.graph_top(*args)).all()
