@@ -576,6 +576,9 @@ def test_rescon_kernel_cli_same_with_and_without_the_pivot_filter(monkeypatch, t
             outs.append((data, cert.read_text()))
     assert outs[0] == outs[1]
     assert outs[0][0]["empty"] is True
+    import rescon
+
+    assert rescon.check_certificate(json.loads(outs[0][1])).valid
 
 
 # ---------------------------------------------------------------- the rounded normals
