@@ -459,3 +459,25 @@ def test_raising_walk_tiny_makes_every_walk_prove_nothing(monkeypatch):
     assert np.isfinite(_candidates.graph_top(*args)).all()
     monkeypatch.setattr(_candidates, "WALK_TINY", 1e300)
     assert np.isinf(_candidates.graph_top(*args)).all()
+
+
+@pytest.mark.parametrize("c_err", [0.0, 8 * UNIT_ROUNDOFF])
+def test_a_nan_or_infinite_bound_never_proves(c_err):
+    """Bounds that are NaN (an infinite permanent times a zero coordinate, 0 · inf) or
+    +inf (b_abs = inf, floor = inf) with finite slacks: the comparison's max(bound,
+    WALK_TINY) must not turn NaN into WALK_TINY (numba's max(NaN, x) is NaN only with
+    NaN first) — every row +inf."""
+    exact, Vx, ptr, nbr = _image(_cross, Fraction(1), Fraction(0))
+    Vx = np.where(np.abs(Vx) < 0.2, 0.0, Vx)  # exact zeros in the cross-polytope's floats
+    A = np.random.default_rng(5).normal(size=(20, 4))
+    b = np.full(20, 10.0)
+    bad_perm = np.abs(A).copy()
+    bad_perm[:, :] = np.inf
+    for A_abs, b_abs, floor in [(bad_perm, np.abs(b), 0.0),
+                                (np.abs(A), np.full(20, np.inf), 0.0),
+                                (np.abs(A), np.abs(b), np.inf),
+                                (np.full_like(A, np.nan), np.abs(b), 0.0)]:
+        with np.errstate(all="ignore"):
+            top = _candidates.graph_top(A, b, A_abs, b_abs, Vx, ptr, nbr, c_err,
+                                        16 * UNIT_ROUNDOFF, floor)
+        assert np.isinf(top).all() and (top > 0).all()  # (0 · inf is NaN too)
