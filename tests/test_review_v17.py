@@ -481,3 +481,38 @@ def test_a_nan_or_infinite_bound_never_proves(c_err):
             top = _candidates.graph_top(A, b, A_abs, b_abs, Vx, ptr, nbr, c_err,
                                         16 * UNIT_ROUNDOFF, floor)
         assert np.isinf(top).all() and (top > 0).all()  # (0 · inf is NaN too)
+
+
+def test_outside_feasible_rests_on_the_graph(monkeypatch):
+    """On a real d = 4 kernel, a row (floats only) positive at one vertex u alone — no
+    seed of the walks — is appended outside S. With the closure's graph,
+    _outside_feasible refuses (the walk climbs to u); with u cut out of every neighbour
+    list it accepts: nothing downstream re-checks the rows the walk proves, so the
+    exactness of the graph (tested above against exact ranks) is what the fast path's
+    soundness rests on."""
+    import dataclasses
+
+    got = _captured(_cloud("gaussian", 4, 22, 2), 2, monkeypatch)
+    H, Vx, k = got["H"], got["Vx"], got["k"]
+    seeds = set(Vx.argmax(axis=0).tolist() + Vx.argmin(axis=0).tolist() + [0])
+    rng = np.random.default_rng(11)
+    for _ in range(100):
+        c = rng.normal(size=k)
+        vals = Vx @ c
+        u = int(vals.argmax())
+        if u not in seeds and np.sort(vals)[-2] < vals[u] - 1e-3 * np.ptp(vals):
+            break
+    else:
+        pytest.skip("no vertex off the seeds is a clear maximum")
+    cut = 0.5 * (vals[u] + np.sort(vals)[-2])  # positive at u only
+    R = dataclasses.replace(
+        H, through=np.vstack([H.through, H.through[:1]]), sign=np.append(H.sign, 1),
+        af=np.vstack([H.af, c]), bf=np.append(H.bf, cut),
+        af_abs=np.vstack([H.af_abs, np.abs(c)]), b_abs=np.append(H.b_abs, abs(cut)),
+        outside=np.append(H.outside, 0), _cache={})
+    coarse = np.append(got["coarse"], got["coarse"].max())
+    args = [got[x] for x in ("scale", "verts", "W", "basis", "S", "Vx")]
+    rest = (got["c"], got["floor"])
+    assert not fastpath._outside_feasible(R, *args, coarse, *rest, got["edges"], k)
+    cut_out = [[w for w in e if w != u] for e in got["edges"]]
+    assert fastpath._outside_feasible(R, *args, coarse, *rest, cut_out, k)
