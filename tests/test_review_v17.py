@@ -93,6 +93,29 @@ def test_the_walked_graph_is_exactly_the_edge_graph(kind, d, n, F, scale, monkey
     assert all(v not in e for v, e in enumerate(edges))
 
 
+@pytest.mark.parametrize("kind,d,n,F", [("cell24", 4, 28, 4), ("grid", 4, 20, 2),
+                                        ("nearsame", 4, 20, 2), ("gaussian", 4, 20, 2)])
+def test_the_double_descriptions_graph_is_exact(kind, d, n, F, monkeypatch):
+    """With the combinatorial check deferring at every non-simple vertex, their
+    neighbours come from the integer double description (_tangent_rays, _RayIndex):
+    the walked graph is still exactly P_S's."""
+    from rescon.geometry import _closure
+
+    real = _closure.combinatorial_rays
+    deferred = []
+
+    def deferring(tight, normals, k, pairs=None):
+        ok, ends = real(tight, normals, k, pairs)
+        wide = np.array([t.bit_count() > k for t in tight], dtype=bool)
+        deferred.append(int(wide.sum()))
+        return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
+
+    monkeypatch.setattr(_closure, "combinatorial_rays", deferring)
+    got = _captured(_cloud(kind, d, n, F), F, monkeypatch)
+    assert got["ok"] and deferred[-1] > 0
+    assert [set(e) for e in got["edges"]] == _exact_graph(got)
+
+
 def test_a_flat_cloud_walks_in_its_affine_hull(monkeypatch):
     """Points on a hyperplane of R^4: the fast path works in k = 3 pivot coordinates
     (the kernel is full-dimensional in the cloud's affine hull), and the graph it walks
