@@ -139,6 +139,8 @@ def _hostile(name: str) -> tuple[np.ndarray, int]:
     F = 2 if d == 4 else 1
     return {
         "offset1e6_4": lambda: (1e6 + 2.0**-33 * np.round(8 * Z), F),
+        "converged_rel_4": lambda: (1e6 * (1.0 + 1e-12 * Z), F),
+        "collapsed_4": lambda: (1e6 + 1e-12 * Z, F),
         "offset1e6_5": lambda: (1e6 + 2.0**-33 * np.round(8 * Z), F),
         "int_grid_4": lambda: (np.round(2 * Z), F),
         "int_grid_5": lambda: (np.round(2 * Z), F),
@@ -156,9 +158,9 @@ def _hostile(name: str) -> tuple[np.ndarray, int]:
     }[name]()
 
 
-@pytest.mark.parametrize("name", ["offset1e6_4", "int_grid_4", "half_duplicated_4",
-                                  "threshold_n15_4", "threshold_n12_4", "sphere_int_4",
-                                  "subnormal_4",
+@pytest.mark.parametrize("name", ["offset1e6_4", "converged_rel_4", "int_grid_4",
+                                  "half_duplicated_4", "threshold_n15_4",
+                                  "threshold_n12_4", "sphere_int_4", "subnormal_4",
                                   pytest.param("threshold_n30_4", marks=pytest.mark.slow),
                                   pytest.param("offset1e6_5", marks=pytest.mark.slow),
                                   pytest.param("int_grid_5", marks=pytest.mark.slow)])
@@ -177,11 +179,12 @@ def test_hostile_graphs_exact_and_kernels_equal_the_clipping(name, monkeypatch):
                        else "valid")
 
 
-@pytest.mark.parametrize("name", ["tiny_n5_F0_4", "tiny_n6_F1_4", "tiny_n7_F1_4",
+@pytest.mark.parametrize("name", ["collapsed_4", "tiny_n5_F0_4", "tiny_n6_F1_4", "tiny_n7_F1_4",
                                   "tiny_n8_F1_5",
                                   pytest.param("mixed_columns_4", marks=pytest.mark.slow)])
 def test_kernels_that_never_reach_the_walks_equal_the_clipping(name, monkeypatch):
-    """n = d + 1 .. d + 4 (empty, 0-dimensional and full kernels) and per-column scales
+    """1e-12 across at offset 10⁶ (one float point: a 0-dimensional kernel), n = d + 1
+    .. d + 4 (empty, 0-dimensional and full kernels) and per-column scales
     2^±600 (qhull's proposal fails; ~5 s of clipping): the walks never run, the results
     are the clipping's and check valid."""
     X, F = _hostile(name)
