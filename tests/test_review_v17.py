@@ -542,3 +542,17 @@ def test_outside_feasible_rests_on_the_graph(monkeypatch):
     assert not fastpath._outside_feasible(R, *args, coarse, *rest, got["edges"], k)
     cut_out = [[w for w in e if w != u] for e in got["edges"]]
     assert fastpath._outside_feasible(R, *args, coarse, *rest, cut_out, k)
+
+
+@pytest.mark.parametrize("kind,d,n,F", [("cell24", 4, 28, 4), ("gaussian", 4, 20, 2),
+                                        ("nearsame", 5, 13, 1)])
+def test_joggled_proposals_walk_the_exact_graph(kind, d, n, F, monkeypatch):
+    """Proposals from joggled qhull only (simplicial pieces, several per non-simple
+    vertex, one solved per point): the walked graph is exactly P_S's and the kernel the
+    clipping's."""
+    monkeypatch.setattr(fastpath, "QHULL_OPTIONS", ("QJ",))
+    X = _cloud(kind, d, n, F)
+    got = _captured(X, F, monkeypatch)
+    assert got["ok"]
+    assert [set(e) for e in got["edges"]] == _exact_graph(got)
+    _same_as_clipping(X, F, monkeypatch)
