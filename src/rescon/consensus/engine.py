@@ -60,15 +60,16 @@ class _Links:
         self.in_nbrs = [self.send[self.start[i]:self.start[i + 1]] for i in range(n)]
 
 
-def simulate(scenario: Scenario, *, metrics: Sequence[str] | None = None,
+def simulate(scenario: Scenario, *, metrics: Sequence[str] | str | None = None,
              progress: bool | None = None) -> Trajectory:
     """Run the scenario (Algorithm 1 or a baseline); see the module docstring for one step.
 
     Parameters
     ----------
     metrics : the monitors to run, names from :data:`rescon.consensus.metrics.MONITORS`
-        ("spread", "diameter", "validity"; default: every one). ``blocked_links`` and
-        ``starved`` are always recorded.
+        ("spread", "diameter", "validity"; default: every one), as a list or as one
+        string of comma-separated names (``"validity,spread"``, as the CLI's
+        ``--metrics``). ``blocked_links`` and ``starved`` are always recorded.
 
     Returns
     -------
