@@ -594,3 +594,21 @@ def test_the_fast_path_takes_clouds_with_columns_at_different_scales(factors, mo
     unscaled = X * 2.0 ** -np.array([600, 0, -600, 300])
     assert _fast_path_certifies(unscaled, F, monkeypatch)
     assert _fast_path_certifies(unscaled * factors, F, monkeypatch)
+
+
+def test_distinct_vertices_with_equal_floats_stay_open():
+    """The cube squeezed to 2^-60 along x₁ at x₁ ≈ 1: adjacent vertices (1 ± 2^-60, …)
+    have equal floats but distinct exact slacks under rows with a₁ ≠ 0. Where such a
+    pair holds the maximum the walk cannot separate them — +inf — and every finite
+    answer is the oracle's."""
+    V0, edges = _cube()
+    exact = [(1 + Fraction(v[0], 2**60), Fraction(v[1]), Fraction(v[2]) / 3,
+              Fraction(v[3]) / 7) for v in V0]
+    Vx = np.array([[float(x) for x in v] for v in exact])
+    assert len(np.unique(Vx, axis=0)) == 8
+    ptr, nbr = _csr(edges)
+    rng = np.random.default_rng(8)
+    A = rng.normal(size=(60, 4))
+    b = (A @ Vx.T).max(axis=1) + rng.uniform(-0.5, 0.1, size=60)
+    rows, finite = _check_rows(A, b, exact, Vx, ptr, nbr)
+    assert finite == 0  # every maximum sits on a float-merged pair
