@@ -928,8 +928,9 @@ def _slack(A, b, V, h, v):
 
 
 @njit(cache=True, nogil=True)
-def _walk_range(A, b, A_abs, b_abs, V, ptr, nbr, seeds, c_err, c, floor, h0, h1, out):
-    """Rows h0 ≤ h < h1 of :func:`graph_top`."""
+def _walk_range(A, b, A_abs, b_abs, V, ptr, nbr, seeds, c_err, c, floor, tiny, h0, h1, out):
+    """Rows h0 ≤ h < h1 of :func:`graph_top` (``tiny``: its WALK_TINY, an argument so
+    that it is read at call time, not frozen into the compiled code)."""
     last = seeds[0]
     for h in range(h0, h1):
         cur = last  # the previous row's end: neighbouring rows often share data points
@@ -952,12 +953,13 @@ def _walk_range(A, b, A_abs, b_abs, V, ptr, nbr, seeds, c_err, c, floor, h0, h1,
         for p in range(ptr[cur], ptr[cur + 1]):
             u = nbr[p]
             drop = best - _slack(A, b, V, h, u)
-            need = max(own + _pair_bound(A, b, A_abs, b_abs, V, h, u, c_err, c, floor),
-                       WALK_TINY)
-            # drop ≥ need (1 + 4ε), both finite: the real s_h(v*) − s_h(u) ≥ e_h(v*) +
-            # e_h(u) (see graph_top); NaN or inf fails
-            if not (drop >= need * (1.0 + 4.0 * UNIT_ROUNDOFF) and drop < np.inf
-                    and need < np.inf):
+            need = own + _pair_bound(A, b, A_abs, b_abs, V, h, u, c_err, c, floor)
+            if not (need < np.inf and drop < np.inf):  # NaN or inf: nothing proven
+                ok = False
+                break
+            # drop ≥ max(need, tiny) (1 + 4ε): the real s_h(v*) − s_h(u) ≥ e_h(v*) +
+            # e_h(u) (see graph_top)
+            if not drop >= max(need, tiny) * (1.0 + 4.0 * UNIT_ROUNDOFF):
                 ok = False
                 break
         out[h] = best if ok else np.inf
@@ -1009,9 +1011,10 @@ def graph_top(A, b, A_abs, b_abs, V, ptr, nbr, c_err: float, c: float, floor: fl
     spread = np.linspace(0, n - 1, max(WALK_SEEDS - 2 * k, 1)).astype(np.int64)
     seeds = np.unique(np.concatenate([V.argmax(axis=0), V.argmin(axis=0), spread]))
     args = [np.ascontiguousarray(x) for x in (A, b, A_abs, b_abs)]
+    tiny = float(WALK_TINY)
 
     def scan(lo: int, hi: int) -> None:
-        _walk_range(*args, V, ptr, nbr, seeds, c_err, c, floor, lo, hi, out)
+        _walk_range(*args, V, ptr, nbr, seeds, c_err, c, floor, tiny, lo, hi, out)
 
     on_threads(scan, len(b), 16 if len(b) >= WALK_THREADS_MIN else 1)
     return out
