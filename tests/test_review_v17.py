@@ -468,11 +468,6 @@ def test_a_proposal_missing_a_vertex_never_reaches_the_walks(kind, d, n, F, monk
 # ------------------------------------------- a forced fallback that forces nothing
 
 
-@pytest.mark.xfail(strict=True, reason="numba freezes the global WALK_TINY into the "
-                   "compiled _walk_range at compile time: monkeypatching _candidates."
-                   "WALK_TINY changes nothing, so test_kernel_d45_walk's 'tiny raised' "
-                   "fallback test runs the normal walks (fix: pass WALK_TINY to "
-                   "_walk_range as an argument read at call time)")
 def test_raising_walk_tiny_makes_every_walk_prove_nothing(monkeypatch):
     """test_kernel_d45_walk forces "every row pair by pair" by setting WALK_TINY = 1e300
     (every comparison then needs a drop ≥ 1e300). On the cube with rows the walks
