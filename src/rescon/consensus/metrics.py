@@ -1117,10 +1117,11 @@ def _triangle_tree(A: np.ndarray, B: np.ndarray, C: np.ndarray, planes: np.ndarr
     their centroids (nearby triangles in the same runs), lo[ℓ], hi[ℓ] the boxes of
     level ℓ as in :func:`_edge_tree` over runs of EDGE_LEAF triangles of ``perm``, and
     ``planes`` the facet of each triangle (:func:`_polytope_of`)."""
-    cent = (A + B + C) / 3
-    span = cent.max(axis=0) - cent.min(axis=0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cell = np.nan_to_num((cent - cent.min(axis=0)) / span * 1023).astype(np.int64)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # 1e308: any order
+        cent = A / 3 + B / 3 + C / 3
+        span = cent.max(axis=0) - cent.min(axis=0)
+        cell = np.nan_to_num((cent - cent.min(axis=0)) / span * 1023)
+    cell = np.clip(cell, 0, 1023).astype(np.int64)
     code = np.zeros(len(A), dtype=np.int64)
     for bit in range(10):
         for axis in range(3):
@@ -1162,8 +1163,8 @@ def _edge_tree(P: np.ndarray, Q: np.ndarray) -> tuple:
     box = np.stack([P, Q], axis=1)  # (h, 2, 2)
     box = np.concatenate([box, np.repeat(box[-1:], pad - h, axis=0)])
     lo, hi = _box_levels(box.min(axis=1), box.max(axis=1))
-    c = P.mean(axis=0)
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):  # 1e308: a worse guess only
+        c = P.mean(axis=0)
         angle = np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0])
     order = np.argsort(angle, kind="stable")
     return lo, hi, EDGE_LEAF, c, order, angle[order]
