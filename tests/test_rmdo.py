@@ -289,6 +289,16 @@ def test_cost_metrics_agree_with_a_direct_evaluation():
                                direct.max(axis=1) - tr.info["optimum"]["value"])
 
 
+def test_metrics_as_one_comma_separated_string():
+    """rmdo takes simulate's comma form of ``metrics`` ("diameter,spread" = the list)."""
+    sc = scenario(Constant([100.0, -50.0]), steps=5)
+    costs = redundant_quadratics(sc)
+    a = rmdo(sc, costs, metrics="diameter, spread")
+    b = rmdo(sc, costs, metrics=["diameter", "spread"])
+    assert "validity" not in a.metrics and set(a.metrics) == set(b.metrics)
+    np.testing.assert_array_equal(a.metrics["diameter"], b.metrics["diameter"])
+
+
 def test_exact_optimum_of_non_redundant_quadratics():
     """½ w_i ‖x − c_i‖²: X* = {Σ w_i c_i / Σ w_i}, computed in rationals."""
     sc = scenario(None, steps=3, dos=False)

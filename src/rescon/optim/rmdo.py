@@ -42,7 +42,7 @@ __all__ = ["CostMonitor", "Optimum", "SubgradientStep", "rmdo"]
 
 
 def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = "paper",
-         optimum: Any = None, metrics: Sequence[str] | None = None,
+         optimum: Any = None, metrics: Sequence[str] | str | None = None,
          progress: bool | None = None) -> Trajectory:
     """Run Algorithm 2 (resilient multi-dimensional distributed optimisation).
 
@@ -61,7 +61,8 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
         point). Otherwise X* is computed exactly when every cost is a quadratic or affine
         atom (rational linear algebra on the atoms' data), else numerically
         (:class:`Optimum`; ``info["optimum"]`` says which).
-    metrics : the consensus monitors to run, as in :func:`rescon.simulate` ("spread",
+    metrics : the consensus monitors to run, as in :func:`rescon.simulate` (a list of
+        names or one comma-separated string: "spread",
         "diameter", "validity"; default every one); the cost metrics always run.
     progress : a progress bar on stderr (default: when stderr is a terminal).
 
