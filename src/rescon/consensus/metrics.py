@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import operator
 import time
+from collections.abc import Iterator
 from fractions import Fraction
 from typing import Any
 
@@ -435,11 +436,11 @@ class ValidityMonitor:
         slack = 64 * UNIT_ROUNDOFF * Mv + 16 * MIN_SUBNORMAL
         prunes = _prunes(lo, hi, best, slack, 40 * UNIT_ROUNDOFF)
         rows, best = rows[prunes], best[prunes]
-        q, k = _descend(lo, hi, leaf, h, X[rows], best, slack, 40 * UNIT_ROUNDOFF)
-        f = _edge_float(X[rows[q]], P[k], Q[k])
         dist = np.full(len(X), np.inf)
         found = np.full(len(rows), np.inf)
-        np.minimum.at(found, q, f)
+        for q, k in _descend(lo, hi, leaf, h, X[rows], best, slack, 40 * UNIT_ROUNDOFF,
+                             BLOCK):  # edge_distances' BLOCK pairs at a time
+            np.minimum.at(found, q, _edge_float(X[rows[q]], P[k], Q[k]))
         dist[rows] = found
         fast = np.zeros(len(X), dtype=bool)
         fast[rows] = found > 0
@@ -507,17 +508,21 @@ class ValidityMonitor:
         slack = 128 * UNIT_ROUNDOFF * Mv + 2.0**-500
         prunes = _prunes(lo, hi, best, slack, 24 * UNIT_ROUNDOFF)
         rows, best = rows[prunes], best[prunes]
-        q, k = _descend(lo, hi, leaf, len(perm), X[rows], best, slack, 24 * UNIT_ROUNDOFF)
-        k = perm[k]
-        Y, sq = _closest_points(X[rows[q]], A[k], B[k], C[k])
-        sq = np.where(np.isnan(sq), np.inf, sq)
-        order = np.lexsort((k, sq, q))
-        first = order[np.r_[True, q[order][1:] != q[order][:-1]]] if len(q) else order
+        parts = [(np.empty(0, dtype=np.int64), np.empty((0, 3)), np.empty(0))]
+        for q, k in _descend(lo, hi, leaf, len(perm), X[rows], best, slack,
+                             24 * UNIT_ROUNDOFF, BLOCK // 16):  # triangle_distances' block
+            k = perm[k]
+            Y, sq = _closest_points(X[rows[q]], A[k], B[k], C[k])
+            sq = np.where(np.isnan(sq), np.inf, sq)
+            order = np.lexsort((k, sq, q))
+            first = order[np.r_[True, q[order][1:] != q[order][:-1]]] if len(q) else order
+            parts.append((q[first], Y[first], sq[first]))
+        q, Y, sq = (np.concatenate(part) for part in zip(*parts))
         fast = np.zeros(n, dtype=bool)
         known = np.zeros(n, dtype=bool)
         dist = np.zeros(n)
-        good = np.isfinite(sq[first])  # else the argmin over all-inf rows: the slow path
-        mine, Ysel = rows[q[first][good]], Y[first][good]
+        good = np.isfinite(sq)  # else the argmin over all-inf rows: the slow path
+        mine, Ysel = rows[q[good]], Y[good]
         dist[mine], err = self._triangle_bounds(X[mine], Ysel)
         known[mine] = True
         fast[mine] = dist[mine] > err
@@ -1056,10 +1061,6 @@ def _orient_sign(a: np.ndarray, B: np.ndarray, X: np.ndarray) -> np.ndarray:
     return np.where(det > bound, 1, np.where(det < -bound, -1, 0))
 
 
-#: (row, box) pairs a level of :func:`_descend` may hold before it splits the rows
-DESCEND_PAIRS = 2**20
-
-
 def _prunes(lo: list, hi: list, best: np.ndarray, slack: float, rel: float) -> np.ndarray:
     """Rows for which :func:`_descend` can leave boxes out: the uncertainty rel·best +
     slack of its bound is below an eighth of the root box's diagonal (states so far
@@ -1071,15 +1072,16 @@ def _prunes(lo: list, hi: list, best: np.ndarray, slack: float, rel: float) -> n
 
 
 def _descend(lo: list, hi: list, leaf: int, count: int, X: np.ndarray, best: np.ndarray,
-             slack: float, rel: float) -> tuple[np.ndarray, np.ndarray]:
-    """(q, k): the pairs (row q of X, item k < ``count``) of the leaves of a tree of
-    boxes (:func:`_box_levels`, ``leaf`` items per leaf) that no bound leaves out: a
+             slack: float, rel: float, limit: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """(q, k) in parts: the pairs (row q of X, item k < ``count``) of the leaves of a
+    tree of boxes (:func:`_box_levels`, ``leaf`` items per leaf) that no bound leaves out: a
     box is left out for row x when fl‖gaps of x to the box‖·(1 − ``rel``) −
     ``slack`` > best[q] (the callers' proofs, :meth:`ValidityMonitor._nearest_edges`
     and :meth:`ValidityMonitor._nearest_triangles`). Rows are taken in halves while
-    a level would hold more than DESCEND_PAIRS pairs (memory O(DESCEND_PAIRS), also
-    when nothing can be left out: states far beyond a thin hull)."""
-    qs, ks = [], []
+    a level would hold more than ``limit``/``leaf`` boxes, and the pairs are yielded
+    per such part of the rows (all the pairs of a row in one part): at most
+    ``limit`` pairs at a time (memory O(limit) in the callers too, also when nothing
+    can be left out: states 1e8 beyond a thin hull keep all N·h pairs)."""
     todo = [np.arange(len(X))]
     while todo:
         rows = todo.pop()
@@ -1089,7 +1091,7 @@ def _descend(lo: list, hi: list, leaf: int, count: int, X: np.ndarray, best: np.
                 q, node = np.repeat(q, 2), np.repeat(2 * node, 2) + np.tile([0, 1], len(q))
                 real = node < len(L)
                 q, node = q[real], node[real]
-            if len(q) > DESCEND_PAIRS and len(rows) > 1:
+            if len(q) > limit // leaf and len(rows) > 1:
                 todo += [rows[:len(rows) // 2], rows[len(rows) // 2:]]
                 break
             x = X[rows[q]]
@@ -1103,11 +1105,7 @@ def _descend(lo: list, hi: list, leaf: int, count: int, X: np.ndarray, best: np.
             q = np.repeat(q, leaf)
             k = np.repeat(node * leaf, leaf) + np.tile(np.arange(leaf), len(node))
             real = k < count
-            qs.append(rows[q[real]])
-            ks.append(k[real])
-    if not qs:
-        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
-    return np.concatenate(qs), np.concatenate(ks)
+            yield rows[q[real]], k[real]
 
 
 def _triangle_tree(A: np.ndarray, B: np.ndarray, C: np.ndarray, planes: np.ndarray
