@@ -447,24 +447,16 @@ def test_valid_halfspaces_own_units_against_brute_force(kind, k):
     _own_units(hostile(kind, k, 9 if k == 2 else 7, 3), k)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "pre-existing (not cf7fec2): valid_halfspaces takes exact_floats (c_err = 0: a float "
-    "orientation of 0 means on the hyperplane) from the bit length of Yi alone; its "
-    "comment's premise 'a unit <= 2^(bits + 32)' holds only for float_view's units: small "
-    "integers over a unit of 2^1000 (or subnormal data) underflow to 0, under a unit of "
-    "2^-1000 overflow to inf/nan, and points count as on the line (k = 2, 2^-1000: 72 "
-    "rows where 29 are valid; k = 3, 2^-400: none of 46)"))
 @pytest.mark.parametrize("k, e", [(2, -1000), (3, -400), (2, -1074), (3, -1074), (2, 1000),
                                   (3, 400)])
 def test_valid_halfspaces_exact_floats_need_float_views_units(k, e):
     """A small-integer grid times 2^e handed to valid_halfspaces in its own units (Y = X
     exact, Yi = X · 2^-e: unit 2^-e, a power of two as its docstring asks): the rows
     must be the brute-force ones. Only direct calls get here (its one caller,
-    kernel._clip_rows, passes float_view's Y with 2^-32 ≤ max |Y| < 2^32). Fix: require
-    the premise, ``exact_floats = exact_view and (k == 1 or (bits <=
-    _exact_float_bits(k) and 2.0**-32 <= float(np.abs(Y).max()) < 2.0**32))`` (then
-    unit ≤ 2^(bits + 32): no product of k + 1 differences, each ≥ 1/unit and ≤ 2^33,
-    underflows or overflows), or refuse such a call with a one-line ValueError."""
+    kernel._clip_rows, passes float_view's Y with 2^-32 ≤ max |Y| < 2^32). It failed
+    before exact_floats required that premise (k = 2, 2^-1000: 72 rows where 29 are
+    valid; k = 3, 2^-400: none of 46): small integers over a unit of 2^1000 underflowed
+    to 0, under 2^-1000 overflowed, and points counted as on the line."""
     G = hostile("grid", k, 9 if k == 2 else 7, 3)
     _own_units(G * 2.0**e, k, shift=max(e, 0))
 
@@ -584,8 +576,9 @@ def test_rescon_kernel_cli_same_with_and_without_the_pivot_filter(monkeypatch, t
 # ---------------------------------------------------------------- the rounded normals
 
 
-@pytest.mark.parametrize("k", [3, 4])
-@pytest.mark.parametrize("e", [-600, -400, -119, 0, 119, 300, 400])
+@pytest.mark.parametrize(("k", "e"), [(k, e) for k in (3, 4)
+                                      for e in (-600, -400, -119, 0, 119, 300, 400)
+                                      if k == 3 or abs(e) <= 300])  # else beyond floats
 @pytest.mark.parametrize("kind", ["tight", "converged", "flat_ulp", "far_pivot", "mixed_coords"])
 def test_rounded_cofactors_are_float_of_the_exact_normal(kind, e, k):
     """``_rounded_cofactors`` = float(Fraction) of the cofactor normal of the float rows
@@ -593,8 +586,6 @@ def test_rounded_cofactors_are_float_of_the_exact_normal(kind, e, k):
     the normals are subnormal (2^-600 in R^3: ~2^-1200), tiny, huge (2^400: ~2^800) —
     or both raise OverflowError (2^600 in R^3 would; k = 3 reaches this only in the
     expansions' range, |Y| ≤ 2^120)."""
-    if k == 4 and abs(e) > 300:
-        pytest.skip("normals of degree 3 beyond the float range")
     X = np.unique(hostile(kind, k, 7, 9) * 2.0**e, axis=0)
     P = exact_points(X)
     rows = [tuple(r) for r in P.ints]

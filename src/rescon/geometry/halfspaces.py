@@ -249,8 +249,12 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         from ._candidates import ANGLE_ERR, classify, cofactors, k_subsets
         from ._expansions import in_range
     bits = max(abs(v) for row in Yi for v in row).bit_length()
-    # k = 1: the sign of a float difference is exact — of exact floats
-    exact_floats = exact_view and (k == 1 or bits <= _exact_float_bits(k))
+    # k = 1: the sign of a float difference is exact — of exact floats; k ≥ 2: small
+    # integers give exact float orientations of Y = Yi / unit only while no product
+    # of k entries underflows or overflows, which float_view's units ensure
+    # (2^-32 ≤ max |Y| < 2^32); a direct call in other units gets the bounded filters
+    exact_floats = exact_view and (k == 1 or (
+        bits <= _exact_float_bits(k) and 2.0**-32 <= float(np.abs(Y).max()) < 2.0**32))
     # small integers in the plane: two distinct directions between data points differ
     # by an angle ≥ 1/(2D²) (D the coordinate span: |cross| ≥ 1, |u|, |v| ≤ √2 D), so
     # when that exceeds the sweep's window (4·ANGLE_ERR, 2× margin) a point inside the
