@@ -174,7 +174,10 @@ def side_signs(Y: np.ndarray, subsets: np.ndarray, start: np.ndarray | None = No
 
     Requires :func:`in_range` (Y): then no product of ≤ 3 differences underflows or
     overflows (nonzero differences lie in [2^-172, 2^121]); otherwise every point is
-    reported undecided (0).
+    reported undecided (0). Intermediate values too: the entries are floats of
+    magnitude ≥ 2^-120 or 0, so a nonzero computed difference of two of them is ≥ 2^-172
+    (a multiple of their ulp), a 2×2 term fl(p − q)·r ≥ 2^-344 and a 3×3 monomial
+    ≥ 2^-516 — all normal, so every rounding is relative (|δ| ≤ u) as the bound uses.
 
     Pivots. With x_0..x_k = (p_0, …, p_{k−1}, q), s(q) = det[x_j − x_0]_{j≥1} = D_0,
     and D_i = det[x_j − x_i]_{j≠i, increasing} = (−1)^i D_0 (subtract row i of the
