@@ -8,8 +8,10 @@ the fix)."""
 
 from __future__ import annotations
 
+import warnings
 from fractions import Fraction
 
+import networkx as nx
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -18,7 +20,9 @@ from test_metrics_review import _seg2
 from test_review_v13 import _close
 
 from rescon.consensus import metrics
+from rescon.consensus.engine import simulate
 from rescon.consensus.metrics import BLOCK, ValidityMonitor
+from rescon.consensus.scenario import Scenario
 
 
 def _dense(mon: ValidityMonitor, S: np.ndarray) -> np.ndarray:
@@ -261,3 +265,31 @@ def test_polytope_trees_are_the_dense_path_bit_for_bit(kind, n, scale, seed):
     assert np.array_equal(dist[known], want) and np.array_equal(fast[known], want > err)
     rows = np.flatnonzero(fast)[:8]  # the whole path on a few (exact distances are slow)
     assert np.array_equal(mon.distances(S[rows]), _dense(mon, S[rows]))
+
+
+# --------------------------------------------------------------------------- #
+# held: a simulate run's validity metric, trees on and off
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_simulate_validity_is_the_same_with_the_trees_off(monkeypatch, d):
+    """80 agents on a circle (a sphere), a ring, F = 0, the paper's residual 0.1^t
+    pushing every state out of H: the per-agent validity distances (hundreds > 0)
+    are bit for bit those of the run with the trees switched off."""
+    X = np.random.default_rng(3).standard_normal((80, d))
+    x0 = X / np.linalg.norm(X, axis=1)[:, None]
+    sc = Scenario(graph=nx.cycle_graph(80), x0=x0, F=0, steps=5, check_robustness=False)
+    assert ValidityMonitor(x0)._edge_tree is not None or ValidityMonitor(x0)._tri_tree is not None
+
+    def run():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return np.asarray(simulate(sc, metrics="validity").metrics["validity_per_agent"])
+
+    got = run()
+    monkeypatch.setattr(metrics, "_edge_tree", lambda *a: None)
+    monkeypatch.setattr(metrics, "_triangle_tree", lambda *a: None)
+    assert ValidityMonitor(x0)._edge_tree is None and ValidityMonitor(x0)._tri_tree is None
+    assert (got > 0).sum() > 100
+    assert np.array_equal(got, run())
