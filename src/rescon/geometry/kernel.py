@@ -10,6 +10,7 @@ certificate (``safe_kernel``, or ``kernel_empty`` with Farkas multipliers).
 from __future__ import annotations
 
 import functools
+import math
 import operator
 import time
 from collections.abc import Callable
@@ -38,7 +39,7 @@ from .exact import (
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
 from .points import kernel_point_of
-from .polytope import ExactPolytope, _bits, clip_to_fixpoint
+from .polytope import ExactPolytope, Farkas, _bits, clip_to_fixpoint
 
 __all__ = ["SafeKernel", "kernel_point", "kernel_points", "safe_kernel"]
 
@@ -533,9 +534,84 @@ def _moved(poly: ExactPolytope, c: list[int]) -> ExactPolytope:
     return poly
 
 
+#: the pivot rows' columns are brought to one magnitude before clipping
+#: (:func:`_column_shifts`) only when their bit lengths differ by more than this: data
+#: whose columns lie within a factor 2^8 of each other is clipped as it is
+COLUMN_SPREAD_MAX_BITS = 8
+
+
+def _column_shifts(rows: list[tuple[int, ...]]) -> list[int]:
+    """e_j ≥ 0 with 2^{e_j} · max_i |y_ij| of one bit length L = max_j L_j for every
+    column j (L_j the bit length of column j's largest |entry|), or all 0 when the
+    L_j (of the nonzero columns) differ by at most COLUMN_SPREAD_MAX_BITS."""
+    lengths = [max(map(abs, col)).bit_length() for col in zip(*rows, strict=True)]
+    top = max(lengths)
+    if top - min((L for L in lengths if L), default=top) <= COLUMN_SPREAD_MAX_BITS:
+        return [0] * len(lengths)
+    return [top - L if L else 0 for L in lengths]
+
+
 def _clip_rows(rows: list[tuple[int, ...]], weights: list[int], scale: int, k: int,
                F: int) -> ExactPolytope:
-    """:func:`_clip` for the distinct pivot rows (scaled integers) and their weights."""
+    """:func:`_clip` for the distinct pivot rows (scaled integers) and their weights.
+
+    Rows whose columns differ in magnitude by more than 2^COLUMN_SPREAD_MAX_BITS
+    (units mixed: metres and millimetres) are clipped with column j shifted left by
+    e_j (:func:`_column_shifts`): Ψ(Y D) = Ψ(Y) D for the invertible diagonal
+    D = diag(2^{e_j}) (conv, and so every intersection of hulls, is affinely
+    equivariant; the weights go with the rows), so the float filters, the Chebyshev
+    centre and qhull of the fast path see a round cloud instead of one elongated by
+    up to 2^1200 — which they could not certify, leaving seconds of exact clipping —
+    and :func:`_unshifted` maps the exact answer back."""
+    shifts = _column_shifts(rows)
+    if not any(shifts):
+        return _clip_rows_as_given(rows, weights, scale, k, F)
+    wide = [tuple(v << e for v, e in zip(y, shifts, strict=True)) for y in rows]
+    return _unshifted(_clip_rows_as_given(wide, weights, scale, k, F), shifts,
+                      float_view(rows, scale)[1])
+
+
+def _unshifted(poly: ExactPolytope, shifts: list[int], unit: int) -> ExactPolytope:
+    """``poly`` ⊂ R^k in the coordinates z'_j = 2^{e_j} z_j (e_j = ``shifts``) mapped
+    back to z (in place), exactly: the twin of :func:`_moved` for D = diag(2^{e_j}).
+
+    * a vertex (w, z') — the point z'/w — becomes (2^E w, 2^{E − e_j} z'_j), E = max e_j
+      (integers, w > 0 kept: the point z = D⁻¹ z'/w), divided by the gcd of its entries;
+    * a row a'·z' ≤ b' is (a'_j 2^{e_j})·z ≤ b' (as a'·Dz = (a'D)·z), divided by
+      g = gcd(a'D, b') > 0 to stay primitive — the same primitive (a, b) whichever
+      data point's row stated it, which :func:`safe_kernel` dedupes on; box rows
+      ±2^{e_j} z_j ≤ ±lo'_j become ±z_j ≤ ±lo_j;
+    * a Farkas certificate (λ_i ≥ 0, Σ λ_i a'_i = 0, Σ λ_i b'_i < 0) gets λ_i g_i:
+      Σ λ_i g_i a_i = (Σ λ_i a'_i) D = 0 and Σ λ_i g_i b_i = Σ λ_i b'_i < 0;
+    * the tight bitsets, their pairs and the edges are unchanged (same rows, same
+      vertices, same order: D preserves incidences and adjacency);
+    * ``unit`` is :func:`.exact.float_view`'s unit for the unshifted rows (the floats
+      y / (w · unit) then lie within its magnitudes, the vertices lying in the rows'
+      hull, as for rows clipped as given), the float vertices recomputed from it."""
+    top = max(shifts)
+    poly.verts = [_divided((w << top, *(z << top - e for z, e in zip(v, shifts, strict=True))))[0]
+                  for w, *v in poly.verts]
+    rows = [_divided((*(x << e for x, e in zip(a, shifts, strict=True)), b))
+            for a, b in zip(poly.a, poly.b, strict=True)]
+    poly.a = [row[:-1] for row, _ in rows]
+    poly.b = [row[-1] for row, _ in rows]
+    if poly.farkas is not None:
+        poly.farkas = Farkas(poly.farkas.ids, tuple(
+            lam * rows[i][1] for i, lam in zip(poly.farkas.ids, poly.farkas.multipliers,
+                                               strict=True)))
+    poly.unit, poly._fv = unit, None
+    return poly
+
+
+def _divided(row: tuple[int, ...]) -> tuple[tuple[int, ...], int]:
+    """The integer row divided by g = gcd of its entries (> 0), and g."""
+    g = math.gcd(*row)
+    return (tuple(v // g for v in row), g) if g > 1 else (row, 1)
+
+
+def _clip_rows_as_given(rows: list[tuple[int, ...]], weights: list[int], scale: int, k: int,
+                        F: int) -> ExactPolytope:
+    """:func:`_clip_rows` on the rows as they are."""
     Yf, unit, exact_view = float_view(rows, scale)
     H = valid_halfspaces(Yf, rows, np.array(weights), F, exact_view)
     lo = [min(y[j] for y in rows) for j in range(k)]
