@@ -499,11 +499,15 @@ class ValidityMonitor:
         out, guesses = self._outside_cones(X)
         M = np.maximum(np.abs(X).max(axis=1), np.abs(self.hull.vertices).max())
         rows = np.flatnonzero(out & (M > 1e-100) & (M < 1e100))
-        G = guesses[rows]
-        sq = _closest_points(X[rows, None, :], A[G], B[G], C[G])[1]
+        best = np.empty(len(rows))
+        block = max(1, BLOCK // 16 // guesses.shape[1])  # triangle_distances' block
+        for s in range(0, len(rows), block):
+            part = rows[s:s + block]
+            G = guesses[part]
+            sq = _closest_points(X[part, None, :], A[G], B[G], C[G])[1]
+            best[s:s + block] = np.where(np.isnan(sq), np.inf, sq).min(axis=1)
         with np.errstate(invalid="ignore", over="ignore"):
-            best = np.sqrt(np.where(np.isnan(sq), np.inf, sq).min(axis=1))
-            best = best * (1 + 8 * UNIT_ROUNDOFF)
+            best = np.sqrt(best) * (1 + 8 * UNIT_ROUNDOFF)
         Mv = max(np.abs(A).max(), np.abs(B).max(), np.abs(C).max())
         slack = 128 * UNIT_ROUNDOFF * Mv + 2.0**-500
         prunes = _prunes(lo, hi, best, slack, 24 * UNIT_ROUNDOFF)
