@@ -282,16 +282,20 @@ def on_threads(scan, total: int, chunks: int, workers: int | None = None) -> Non
         return
     import threading
 
-    # next() on a list iterator is atomic under the GIL: each range is taken once
+    # each range is taken once: next() under a lock (a list iterator's next() is atomic
+    # only under the GIL, not on a free-threaded build)
     ranges = iter([(total * c // chunks, total * (c + 1) // chunks) for c in range(chunks)])
+    taking = threading.Lock()
     errors: list[BaseException] = []
 
     def work() -> None:
         try:
-            for lo, hi in ranges:
-                if errors:  # another range failed: start no more
+            while not errors:  # another range failed: start no more
+                with taking:
+                    lohi = next(ranges, None)
+                if lohi is None:
                     return
-                scan(lo, hi)
+                scan(*lohi)
         except BaseException as exc:  # re-raised by the caller below
             errors.append(exc)
 
