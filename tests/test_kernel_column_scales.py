@@ -72,8 +72,8 @@ def _same(K: rescon.SafeKernel, L: rescon.SafeKernel) -> None:
 
 CLOUDS = [("gaussian", 2, 12, 2), ("sphere", 2, 15, 3), ("gaussian", 3, 16, 2),
           ("cube", 3, 20, 3), ("gaussian", 4, 20, 2), ("integer", 4, 20, 3),
-          ("nearsame", 4, 20, 2), ("cell24", 4, 28, 4), ("gaussian", 5, 14, 1),
-          ("sphere", 5, 14, 1)]
+          ("nearsame", 4, 20, 2), ("cell24", 4, 28, 4), ("flat", 4, 20, 2),
+          ("gaussian", 5, 14, 1), ("sphere", 5, 14, 1)]
 
 
 @pytest.mark.parametrize("exps", POW2, ids=["16", "600", "mixed"])
