@@ -532,31 +532,33 @@ HOSTILE = [("planes", 3, 30, 4), ("planes", 4, 20, 3), ("planes", 5, 13, 2),
            ("doubled_integers", 3, 30, 4), ("doubled_integers", 4, 20, 2),
            ("doubled_integers", 5, 13, 2), ("far_converged", 3, 30, 3),
            ("far_converged", 4, 20, 2), ("far_converged", 5, 13, 1), ("stretched", 4, 20, 2),
-           ("stretched", 5, 13, 1)]
+           ("stretched", 5, 13, 1),
+           # columns 1e-150..1e150: certified since kernel._clip_rows shifts the columns
+           # to one magnitude (issue 13; the fast path declined them before)
+           ("anisotropic", 3, 30, 3),
+           pytest.param("anisotropic", 4, 20, 2, marks=pytest.mark.slow),
+           pytest.param("anisotropic", 5, 13, 1, marks=pytest.mark.slow)]
 
 
 @pytest.mark.parametrize("kind,d,n,F", HOSTILE)
 def test_hostile_kernels_certified_and_identical_to_the_exact_clipping(kind, d, n, F,
                                                                       monkeypatch):
     """Points on three common hyperplanes, pairs 1e-15 apart near 1, every integer
-    point twice, clouds converged at 1e200, columns scaled 1e-4..1e4: the fast path
-    certifies, and every output equals the exact clipping's."""
+    point twice, clouds converged at 1e200, columns scaled 1e-4..1e4 or
+    1e-150..1e150: the fast path certifies, and every output equals the exact clipping's."""
     certified = _fast_path_calls(monkeypatch)
     _same_as_clipping(_hostile(kind, d, n, F), F, monkeypatch)
     assert certified[0]
 
 
 @pytest.mark.parametrize("kind,d,n,F", [
-    ("mixed", 3, 30, 2), ("mixed", 4, 10, 1), ("simplex", 3, 4, 0), ("simplex", 5, 6, 0),
-    ("anisotropic", 3, 30, 3),
-    pytest.param("anisotropic", 4, 20, 2, marks=pytest.mark.slow),
-    pytest.param("anisotropic", 5, 13, 1, marks=pytest.mark.slow)])
+    ("mixed", 3, 30, 2), ("mixed", 4, 10, 1), ("simplex", 3, 4, 0), ("simplex", 5, 6, 0)])
 def test_kernels_the_fast_path_declines_identical_to_the_exact_clipping(kind, d, n, F,
                                                                         monkeypatch):
-    """Rows of magnitudes 1e-300..1e300 mixed, n = d + 1, columns scaled 1e-150..1e150
-    (the fast path is not tried — too few halfspaces — or finds no proposal: a float
-    row's norm is 0, or the Chebyshev LP on unit rows finds no ball in a kernel
-    1e-10 as thin as it is wide)."""
+    """Rows of magnitudes 1e-300..1e300 mixed, n = d + 1 (the fast path is not tried —
+    too few halfspaces — or finds no proposal: a float row's norm is 0). (Columns
+    scaled 1e-150..1e150, declined here before issue 13, are certified now:
+    test_hostile_kernels_certified_and_identical_to_the_exact_clipping.)"""
     certified = _fast_path_calls(monkeypatch)
     _same_as_clipping(_hostile(kind, d, n, F), F, monkeypatch)
     assert not any(certified)
