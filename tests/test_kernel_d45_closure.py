@@ -246,8 +246,17 @@ def test_octahedral_pyramid_without_a_base_vertex_is_refused(gone):
 def test_the_double_description_where_the_check_defers(kind, d, n, F, monkeypatch):
     """With the check deferring at every non-simple vertex (none defers on these clouds
     otherwise), their double descriptions give the same kernel as the exact clipping."""
+    deferred = defer_non_simple(monkeypatch)
+    _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
+    assert deferred and deferred[-1] > 0
+
+
+def defer_non_simple(monkeypatch) -> list[int]:
+    """Make the closure's combinatorial check defer at every non-simple vertex (more
+    than k tight rows), so the integer double description decides them; returns the
+    list to which each check appends how many it deferred."""
     real = _closure.combinatorial_rays
-    deferred = []
+    deferred: list[int] = []
 
     def deferring(tight, normals, k, pairs=None):
         ok, ends = real(tight, normals, k, pairs)
@@ -256,5 +265,4 @@ def test_the_double_description_where_the_check_defers(kind, d, n, F, monkeypatc
         return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
 
     monkeypatch.setattr(_closure, "combinatorial_rays", deferring)
-    _same_as_clipping(_cloud(kind, d, n, F), F, monkeypatch)
-    assert deferred and deferred[-1] > 0
+    return deferred

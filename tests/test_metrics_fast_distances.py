@@ -104,6 +104,24 @@ def test_no_n_by_h_work_outside_a_10000_gon(monkeypatch):
     assert np.array_equal(got[sample], mon.edge_distances(S[sample])[0])
 
 
+def _initial_and_states(rng, d: int, kind: str, m: int):
+    """70 initial rows at m distinct points of ``kind`` (:func:`_few_points`) at a
+    random magnitude 1e-300 … 1e300, and states: inside, a few ulps off, on a line
+    through two of the points beyond them, far outside and at other magnitudes."""
+    scale = 1.0 if kind == "subnormal" else float(
+        rng.choice([1e-300, 2.0**-1000, 1e-5, 1.0, 1e100, 1e300]))
+    B = _few_points(rng, d, kind, m) * scale
+    X0 = B[np.r_[np.arange(m), rng.integers(0, m, 70 - m)]]
+    i, j = rng.integers(0, m, 2)
+    S = np.vstack([rng.dirichlet(np.ones(m), size=2) @ B,
+                   B[rng.integers(0, m, 3)] * rng.uniform(0.5, 1.5, (3, 1)),
+                   B[i] + 2 * (B[j] - B[i]), 2 * B[i] - B[j],
+                   rng.standard_normal((3, d)) * scale,
+                   B[:1] + np.spacing(B[:1]) * rng.integers(-2, 3, (1, d)),
+                   rng.standard_normal((1, d)) * float(rng.choice([1e-320, 1e-300, 1e300]))])
+    return X0, S[np.isfinite(S).all(axis=1)]
+
+
 @pytest.mark.parametrize("seed", range(24))
 def test_small_polygons_through_the_tree_agree_with_brute_force(monkeypatch, seed):
     """The tree forced on small polygons (INNER_FACETS = 3): 70 initial rows at 6–12
@@ -113,21 +131,9 @@ def test_small_polygons_through_the_tree_agree_with_brute_force(monkeypatch, see
     force (0 iff inside, else within the fast bound)."""
     monkeypatch.setattr(metrics, "INNER_FACETS", 3)
     rng = np.random.default_rng(seed)
-    kind = ("gauss", "ulps", "subnormal", "line")[seed % 4]
-    scale = 1.0 if kind == "subnormal" else float(
-        rng.choice([1e-300, 2.0**-1000, 1e-5, 1.0, 1e100, 1e300]))
-    m = int(rng.integers(6, 13))
-    B = _few_points(rng, 2, kind, m) * scale
-    X0 = B[np.r_[np.arange(m), rng.integers(0, m, 70 - m)]]
+    X0, S = _initial_and_states(rng, 2, ("gauss", "ulps", "subnormal", "line")[seed % 4],
+                                int(rng.integers(6, 13)))
     mon = ValidityMonitor(X0)
-    i, j = rng.integers(0, m, 2)
-    S = np.vstack([rng.dirichlet(np.ones(m), size=2) @ B,
-                   B[rng.integers(0, m, 3)] * rng.uniform(0.5, 1.5, (3, 1)),
-                   B[i] + 2 * (B[j] - B[i]), 2 * B[i] - B[j],
-                   rng.standard_normal((3, 2)) * scale,
-                   B[:1] + np.spacing(B[:1]) * rng.integers(-2, 3, (1, 2)),
-                   rng.standard_normal((1, 2)) * float(rng.choice([1e-320, 1e-300, 1e300]))])
-    S = S[np.isfinite(S).all(axis=1)]
     if mon._edge_tree is not None:
         fast, dist = mon._nearest_edges(S)
         assert np.array_equal(dist[fast], mon.edge_distances(S[fast])[0])
@@ -237,21 +243,9 @@ def test_small_polytopes_through_the_tree_agree_with_brute_force(seed):
     states inside, a few ulps off, on a line through two corners beyond them, far
     outside and at other magnitudes: every distance as the Fractions brute force."""
     rng = np.random.default_rng(100 + seed)
-    kind = ("gauss", "ulps", "subnormal")[seed % 3]
-    scale = 1.0 if kind == "subnormal" else float(
-        rng.choice([1e-300, 2.0**-1000, 1e-5, 1.0, 1e100, 1e300]))
-    m = int(rng.integers(4, 10))
-    B = _few_points(rng, 3, kind, m) * scale
-    X0 = B[np.r_[np.arange(m), rng.integers(0, m, 70 - m)]]
+    X0, S = _initial_and_states(rng, 3, ("gauss", "ulps", "subnormal")[seed % 3],
+                                int(rng.integers(4, 10)))
     mon = ValidityMonitor(X0)
-    i, j = rng.integers(0, m, 2)
-    S = np.vstack([rng.dirichlet(np.ones(m), size=2) @ B,
-                   B[rng.integers(0, m, 3)] * rng.uniform(0.5, 1.5, (3, 1)),
-                   B[i] + 2 * (B[j] - B[i]), 2 * B[i] - B[j],
-                   rng.standard_normal((3, 3)) * scale,
-                   B[:1] + np.spacing(B[:1]) * rng.integers(-2, 3, (1, 3)),
-                   rng.standard_normal((1, 3)) * float(rng.choice([1e-320, 1e-300, 1e300]))])
-    S = S[np.isfinite(S).all(axis=1)]
     if mon._tri_tree is not None:
         fast, known, dist = mon._nearest_triangles(S)
         want, err = mon.triangle_distances(S[known])

@@ -99,18 +99,9 @@ def test_the_double_descriptions_graph_is_exact(kind, d, n, F, monkeypatch):
     """With the combinatorial check deferring at every non-simple vertex, their
     neighbours come from the integer double description (_tangent_rays, _RayIndex):
     the walked graph is still exactly P_S's."""
-    from rescon.geometry import _closure
+    from tests.test_kernel_d45_closure import defer_non_simple
 
-    real = _closure.combinatorial_rays
-    deferred = []
-
-    def deferring(tight, normals, k, pairs=None):
-        ok, ends = real(tight, normals, k, pairs)
-        wide = np.array([t.bit_count() > k for t in tight], dtype=bool)
-        deferred.append(int(wide.sum()))
-        return ok & ~wide, [[] if w else us for w, us in zip(wide.tolist(), ends, strict=True)]
-
-    monkeypatch.setattr(_closure, "combinatorial_rays", deferring)
+    deferred = defer_non_simple(monkeypatch)
     got = _captured(_cloud(kind, d, n, F), F, monkeypatch)
     assert got["ok"] and deferred[-1] > 0
     assert [set(e) for e in got["edges"]] == _exact_graph(got)
