@@ -20,7 +20,7 @@ import pytest
 
 import rescon
 from rescon.geometry import kernel as km
-from tests.test_kernel_d45_around2 import _cloud
+from tests.test_kernel_d45_around2 import _cloud, assert_identical
 from tests.test_review_v17 import _fast_path_certifies, _hostile
 
 POW2 = [np.array([16, 0, -16, 8]), np.array([600, 0, -600, 300]),
@@ -59,15 +59,6 @@ def _certified(cert: dict) -> None:
     assert r.verdict == "valid" or (r.verdict == "unchecked" and "needs work" in str(r)), r
 
 
-def _same(K: rescon.SafeKernel, L: rescon.SafeKernel) -> None:
-    """Every output of the two kernels identical (floats bit for bit)."""
-    assert K.dim == L.dim and K.is_empty == L.is_empty
-    for name in ("vertices", "A", "b", "Aeq", "beq", "affine_basis"):
-        assert getattr(K, name).tobytes() == getattr(L, name).tobytes(), name
-    assert K.exact_vertices == L.exact_vertices
-    assert K._exact.constraints == L._exact.constraints
-    assert K._exact.facets == L._exact.facets
-    assert K.certificate == L.certificate
 
 
 CLOUDS = [("gaussian", 2, 12, 2), ("sphere", 2, 15, 3), ("gaussian", 3, 16, 2),
@@ -110,7 +101,7 @@ def test_mixed_units_equal_the_rows_clipped_as_given(kind, d, n, F, units, monke
     K = rescon.safe_kernel(Y, F)
     with _as_is(monkeypatch):
         L = rescon.safe_kernel(Y, F)
-    _same(K, L)
+    assert_identical(K, L)
     _certified(K.certificate)
 
 
@@ -126,7 +117,7 @@ def test_hostile_clouds_in_mixed_units(name, exps, monkeypatch):
     K = rescon.safe_kernel(Y, F)
     with _as_is(monkeypatch):
         L = rescon.safe_kernel(Y, F)
-    _same(K, L)
+    assert_identical(K, L)
     _certified(K.certificate)
 
 
@@ -235,7 +226,7 @@ def test_ordinary_clouds_are_untouched(kind, d, n, F, monkeypatch):
     assert all(not any(e) for e in shifts)
     with _as_is(monkeypatch):
         L = rescon.safe_kernel(X, F)
-    _same(K, L)
+    assert_identical(K, L)
 
 
 def test_column_shifts():

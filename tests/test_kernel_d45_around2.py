@@ -184,14 +184,19 @@ def _same_as_clipping(X: np.ndarray, F: int, monkeypatch) -> rescon.SafeKernel:
     with monkeypatch.context() as mp:
         mp.setattr(km, "certified_kernel", lambda *a: None)
         slow = rescon.safe_kernel(X, F)
-    assert fast.dim == slow.dim
-    for name in ("vertices", "A", "b", "Aeq", "beq", "affine_basis"):
-        assert getattr(fast, name).tobytes() == getattr(slow, name).tobytes(), name
-    assert fast.exact_vertices == slow.exact_vertices
-    assert fast._exact.constraints == slow._exact.constraints
-    assert fast._exact.facets == slow._exact.facets
-    assert fast.certificate == slow.certificate
+    assert_identical(fast, slow)
     return fast
+
+
+def assert_identical(K: rescon.SafeKernel, L: rescon.SafeKernel) -> None:
+    """Every output of the two kernels identical (floats bit for bit)."""
+    assert K.dim == L.dim and K.is_empty == L.is_empty
+    for name in ("vertices", "A", "b", "Aeq", "beq", "affine_basis"):
+        assert getattr(K, name).tobytes() == getattr(L, name).tobytes(), name
+    assert K.exact_vertices == L.exact_vertices
+    assert K._exact.constraints == L._exact.constraints
+    assert K._exact.facets == L._exact.facets
+    assert K.certificate == L.certificate
 
 
 KERNELS = [("gaussian", 4, 20, 2), ("cube", 4, 20, 3), ("sphere", 4, 20, 1),
