@@ -811,8 +811,11 @@ def _kernel_clouds(cfg: KernelConfig) -> list[tuple[Cloud, bool]]:
 
 def _kernel_warmup(rescon: Any, todo: list[tuple[Cloud, bool]], log: Any) -> None:
     """Compile numba (rescon's kernels) and load HiGHS / qhull before any timing: a
-    small cloud per dimension plus the first cloud of each (family, d) at its smallest
-    n. Failures here are not fatal (they show up as error rows later)."""
+    small cloud per dimension, the first cloud of each (family, d) at its smallest
+    n, and one cloud per dimension at its largest n (small inputs skip numba, so only
+    large ones load its compiled kernels: gaussian(2, 1000, 1), the first n = 1000
+    cloud, had been timed with numba's load, 1–4 s). Failures here are not fatal (they
+    show up as error rows later)."""
     t0 = time.perf_counter()
     warm: list[tuple[np.ndarray, int]] = []
     for d in sorted({c.d for c, _ in todo}):
@@ -824,6 +827,11 @@ def _kernel_warmup(rescon: Any, todo: list[tuple[Cloud, bool]], log: Any) -> Non
         if (c.family, c.d) not in seen and c.n <= 100:
             seen.add((c.family, c.d))
             warm.append((c.X, c.F))
+    largest: dict[int, Cloud] = {}
+    for c, _ in todo:
+        if c.d not in largest or c.n > largest[c.d].n:
+            largest[c.d] = c
+    warm += [(c.X, c.F) for c in largest.values() if c.n > 100]
     for X, F in warm:
         try:
             K = rescon.safe_kernel(X, F)
