@@ -17,7 +17,7 @@ import json
 import math
 import os
 import re
-from collections.abc import Callable, Hashable, Iterator
+from collections.abc import Callable, Hashable, Iterable, Iterator
 from fractions import Fraction
 from pathlib import Path
 from typing import Any, TextIO
@@ -365,10 +365,11 @@ def _data_lines(p: Path, *, inline_comments: bool = False,
 
 
 def _csv_rows(p: Path, error: type[InputError] = GraphFormatError) -> list[tuple[int, list[str]]]:
-    return [
-        (lineno, [c.strip() for c in next(csv.reader([line]))])
-        for lineno, line in _data_lines(p, error=error)
-    ]
+    return _csv_cells(_data_lines(p, error=error))
+
+
+def _csv_cells(lines: Iterable[tuple[int, str]]) -> list[tuple[int, list[str]]]:
+    return [(lineno, [c.strip() for c in next(csv.reader([line]))]) for lineno, line in lines]
 
 
 def _point_rows(p: Path) -> list[tuple[int, list[str]]]:
@@ -376,7 +377,7 @@ def _point_rows(p: Path) -> list[tuple[int, list[str]]]:
     whitespace-separated fields of each line."""
     lines = list(_data_lines(p, error=InputError))
     if any("," in line for _, line in lines):
-        return _csv_rows(p, error=InputError)
+        return _csv_cells(lines)
     return [(lineno, line.split()) for lineno, line in lines]
 
 
