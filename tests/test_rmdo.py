@@ -444,6 +444,25 @@ def test_overflowing_step_is_an_error():
         rmdo(sc, {v: "x1^2 + x2^2" for v in range(4)}, step_size=1e308, optimum=[0, 0])
 
 
+def test_a_diverging_run_says_so_and_suggests_a_smaller_step():
+    """Costs 1e10 x a quadratic under the paper's step size: the iterates run away until
+    the cost overflows; the error says the run diverged (it named only the point)."""
+    sc = Scenario(graph=nx.complete_graph(4), x0=[[0.0, 0.0], [1.0, 0.0], [2.0, 1.0],
+                                                  [3.0, 3.0]], F=0, steps=60,
+                  check_robustness=False)
+    with pytest.raises(InputError, match=r"agent \d at step \d+ .*point .*the iterates "
+                                         r"diverged \(max \|x\| = .*, 3 at the start\): "
+                                         r".*try a smaller step_size"):
+        rmdo(sc, {v: "1e10*((x1 - 1)^2 + x2^2)" for v in range(4)}, optimum=[1, 0])
+
+
+def test_an_error_near_the_start_has_no_divergence_hint():
+    sc = small()
+    with pytest.raises(InputError) as err:
+        rmdo(sc, {v: "x1^2 + x2^2" for v in range(4)}, step_size=1e308, optimum=[0, 0])
+    assert "overflows" in str(err.value) and "diverged" not in str(err.value)
+
+
 def test_bad_step_sizes_and_assumption5_warning():
     sc = small()
     costs = {v: "x1^2" for v in range(4)}
