@@ -408,7 +408,6 @@ def test_time_limit_reports_s_bounds(capsys, tmp_path):
 def _bad_files(tmp_path: Path) -> dict[str, Path]:
     files = {
         "malformed.edgelist": "1 2\n1 2 3\n",
-        "label.edgelist": "1 2\n2 x\n",
         "float.edgelist": "1 2\n2 3.5\n",
         "empty.edgelist": "",
         "comments.edgelist": "# nothing\n\n",
@@ -431,7 +430,7 @@ def _bad_files(tmp_path: Path) -> dict[str, Path]:
     return out
 
 
-@pytest.mark.parametrize("name", ["malformed.edgelist", "label.edgelist", "float.edgelist",
+@pytest.mark.parametrize("name", ["malformed.edgelist", "float.edgelist",
                                   "empty.edgelist", "comments.edgelist", "one.edgelist",
                                   "selfloop_only.edgelist", "ragged.csv", "nonsquare.csv",
                                   "negative.csv", "bad.json", "nolinks.json",
@@ -445,9 +444,9 @@ def test_bad_graph_files(capsys, tmp_path, name):
 
 def test_bad_file_messages_name_file_and_line(capsys, tmp_path):
     files = _bad_files(tmp_path)
-    code, out, err = run(["robustness", files["label.edgelist"]], capsys)
+    code, out, err = run(["robustness", files["float.edgelist"]], capsys)
     assert_clean_error(code, out, err)
-    assert "label.edgelist:2" in err and "'x'" in err
+    assert "float.edgelist:2" in err and "'3.5' is a number but not an integer" in err
     code, out, err = run(["robustness", files["malformed.edgelist"]], capsys)
     assert "malformed.edgelist:2" in err
 
@@ -487,7 +486,7 @@ def test_bad_arguments(capsys, tmp_path, args):
 def test_bad_input_subprocess(tmp_path):
     """The real process: exit 2, one line on stderr, no traceback."""
     bad = tmp_path / "bad.edgelist"
-    bad.write_text("1 2\n2 y\n")
+    bad.write_text("1 2\n2 0.5\n")
     for args in (["robustness", bad, "--json"], ["robustness", tmp_path / "missing"],
                  ["robustness", PAPER, "--r", "1", "--s", "99"],
                  ["robustness", PAPER, "--time-limit", "0"]):

@@ -42,10 +42,23 @@ def test_undirected_symmetrises_a_directed_file():
     assert G.number_of_edges() == 4
 
 
-def test_edge_list_non_integer_label_names_file_and_line():
-    pattern = r"bad_label\.edgelist:3: node label 'x' is not an integer"
-    with pytest.raises(GraphFormatError, match=pattern):
-        read_graph(DATA / "bad_label.edgelist")
+def test_edge_list_with_a_non_integer_label_reads_every_label_as_a_string(tmp_path):
+    G = read_graph(DATA / "mixed_labels.edgelist")  # it was refused ('x' not an integer)
+    assert list(G.nodes()) == ["1", "2", "x"]
+    assert sorted(G.edges()) == [("1", "2"), ("2", "x")]
+    named = read_graph(_write(tmp_path, "g.edgelist", "a b\nb c  # inline\nc a\nd\n"),
+                       undirected=True)
+    assert list(named.nodes()) == ["a", "b", "c", "d"] and named.number_of_edges() == 3
+
+
+def test_an_edge_list_with_string_labels_runs_through_the_cli(tmp_path, capsys):
+    from rescon.cli import main
+
+    p = _write(tmp_path, "g.edgelist", "a b\nb c\nc a\nc d\nd a\nb d\n")
+    assert main(["robustness", str(p), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["r_max"] == 1 and out["exact"]  # b and c have one in-neighbour each
+    assert set(out["witness"]["S1"] + out["witness"]["S2"]) <= {"a", "b", "c", "d"}
 
 
 def test_edge_list_three_fields_is_malformed(tmp_path):

@@ -31,6 +31,7 @@ from .errors import GraphFormatError, InputError
 __all__ = ["output_path", "read_graph", "read_points", "to_jsonable", "write_json"]
 
 _INT = re.compile(r"[+-]?\d+")
+_DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 # --------------------------------------------------------------------------- graphs
@@ -60,9 +61,12 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
         ``0..n-1``. The matrix must be square.
     anything else
         Edge list: ``u v`` per line is the edge :math:`u \\to v`; a line with a
-        single label declares a (possibly isolated) node. Labels must be
-        integers. ``#`` starts a comment; blank lines are ignored. Nodes are
-        sorted by label.
+        single label declares a (possibly isolated) node. Labels are integers
+        when every label in the file is a decimal integer, else strings (any
+        token without whitespace: ``a b``, ``1 a`` both give string labels); a
+        label that is a number but not an integer (``3.5``, ``1e3``) is an error.
+        ``#`` starts a comment; blank lines are ignored. Nodes are sorted by
+        label.
 
     Lines starting with ``#`` are comments in ``.csv`` files too.
 
@@ -117,8 +121,17 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
     return out
 
 
+def _check_label(p: Path, lineno: int, token: str) -> None:
+    """A label that reads as a number but not as an integer is refused (a weight or a
+    coordinate in the wrong place, more likely than a node named '3.5')."""
+    if _INT.fullmatch(token) or not _DECIMAL.fullmatch(token):
+        return
+    raise GraphFormatError(f"{p}:{lineno}: node label {token!r} is a number but not an "
+                           "integer (labels are integers or names)")
+
+
 def _read_edge_list(p: Path) -> nx.DiGraph:
-    G = nx.DiGraph()
+    rows: list[list[str]] = []
     for lineno, line in _data_lines(p, inline_comments=True):
         tokens = line.split()
         if len(tokens) > 2:
@@ -126,21 +139,23 @@ def _read_edge_list(p: Path) -> nx.DiGraph:
                 f"{p}:{lineno}: expected 'u v' (edge u -> v) or a single node 'u'; "
                 f"got {len(tokens)} fields"
             )
-        labels = [_int_label(p, lineno, t) for t in tokens]
-        if len(labels) == 1:
-            G.add_node(labels[0])
+        for t in tokens:
+            _check_label(p, lineno, t)
+        rows.append(tokens)
+    label: Callable[[str], Hashable] = str
+    if all(_INT.fullmatch(t) for tokens in rows for t in tokens):
+        label = int
+    G = nx.DiGraph()
+    for tokens in rows:
+        if len(tokens) == 1:
+            G.add_node(label(tokens[0]))
         else:
-            G.add_edge(labels[0], labels[1])
+            G.add_edge(label(tokens[0]), label(tokens[1]))
     H = nx.DiGraph()
     H.add_nodes_from(sorted(G.nodes()))
     H.add_edges_from(G.edges())
     return H
 
-
-def _int_label(p: Path, lineno: int, token: str) -> int:
-    if not _INT.fullmatch(token):
-        raise GraphFormatError(f"{p}:{lineno}: node label {token!r} is not an integer")
-    return int(token)
 
 
 def _read_adjacency_csv(p: Path) -> nx.DiGraph:
