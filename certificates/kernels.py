@@ -1219,6 +1219,88 @@ def _edge_directions(BE: list[list[int]], tight: list[list[int]], d: int) -> set
     return rays
 
 
+def _cone_rays(BE: list[list[int]], tight: list[list[int]], d: int,
+               meter: list[int], bits: int) -> dict[int, tuple[int, ...] | None]:
+    """The extreme rays of T = {y : BE·y = 0, a·y <= 0 for a in ``tight``} (pointed: the
+    rows have rank d; BE independent), {Z(r): r}: r primitive integer vectors — the set
+    :func:`_edge_directions` finds — and Z(r) the bitmask of the rows with a·r = 0 (bit i
+    for tight[i]), by the double description method (Motzkin et al.), output-sensitive.
+    Work is charged to ``meter`` (:func:`_charge`; ``bits``: the rows' bit size) before
+    it is spent; beyond meter[1] :class:`_OverBudget` is raised.
+
+    Let k = d − |BE| (the dimension of L = null(BE)).  Start: k rows S with [BE; S]
+    nonsingular; C_S = {y ∈ L : a·y <= 0, a ∈ S} is simplicial, its extreme rays are the
+    k null directions of BE plus S minus one row (signed to make that row negative).
+    Step (R = the extreme rays of the current pointed cone C, one per direction, Z(r) =
+    the added rows tight at r; add the row a):  the extreme rays of C ∩ {a·y <= 0} are
+    the r ∈ R with a·r <= 0 and, for each pair p, q ∈ R with a·p > 0 > a·q that is
+    adjacent in C, the ray (a·p)q − (a·q)p.  Proof: an extreme ray y of C' = C ∩ {a·y
+    <= 0} has tight rows of rank k − 1 (in L); if a·y < 0 or y is extreme in C it is an
+    r of the first kind; otherwise a·y = 0 and the rows of C tight at y have rank k − 2,
+    so y lies in the relative interior of a 2-face G = cone(p, q) of C (p, q adjacent),
+    and a·y = 0 with y not ∥ p, q forces a·p, a·q of opposite signs, so y is that
+    combination.  Conversely such a combination lies in relint G (tight rows of C: rank
+    k − 2) and on a·y = 0, where a is not constant 0 on span G (a·p ≠ 0): rank k − 1,
+    extreme in C'; distinct 2-faces give distinct directions, none ∥ an extreme ray of C.
+    Adjacency (combinatorial): the smallest face of C holding p and q is G = {y ∈ C :
+    a·y = 0 for the rows in Z(p) ∩ Z(q)}; its extreme rays are the r ∈ R with Z(r) ⊇
+    Z(p) ∩ Z(q), and G (pointed, dimension >= 2) is 2-dimensional, i.e. p and q are
+    adjacent, iff it has no extreme ray besides p and q.  (A 2-face has k − 2
+    independent tight rows: fewer in Z(p) ∩ Z(q) rules the pair out at once.)  After all
+    rows, C = T and R its extreme rays."""
+    k = d - len(BE)
+    if k <= 0:
+        return {}
+    _charge(meter, len(tight) * k * d, bits)  # choosing S
+    basis = _echelon(BE)
+    S: list[int] = []
+    for i, a in enumerate(tight):
+        if _extend(basis, a):
+            S.append(i)
+            if len(S) == k:
+                break
+    if len(S) < k:
+        raise ValueError("the tight rows do not have rank d")  # not reached: checked before
+    _charge(meter, k * (_normal_steps(d) + 2 * d), d * bits)
+    rays: list[list[int]] = []
+    Z: list[int] = []
+    for j in S:
+        y = _normal(BE + [tight[i] for i in S if i != j], d)
+        if _dot(tight[j], y) > 0:
+            y = [-t for t in y]
+        rays.append(list(_primitive(y)))
+        Z.append(sum(1 << i for i in S if i != j))
+    done = set(S)
+    for i, a in enumerate(tight):
+        if i in done or not rays:
+            continue
+        rbits = bits + max(x.bit_length() for r in rays for x in r)
+        _charge(meter, len(rays) * d, rbits)
+        s = [_dot(a, r) for r in rays]
+        pos = [t for t, x in enumerate(s) if x > 0]
+        bit = 1 << i
+        if not pos:
+            Z = [z | bit if x == 0 else z for z, x in zip(Z, s)]
+            continue
+        neg = [t for t, x in enumerate(s) if x < 0]
+        nrays = [r for r, x in zip(rays, s) if x <= 0]
+        nZ = [z | bit if x == 0 else z for z, x in zip(Z, s) if x <= 0]
+        _charge(meter, len(pos) * len(neg) * len(rays) // 8, 1)  # the adjacency tests
+        for p in pos:
+            zp, sp, rp = Z[p], s[p], rays[p]
+            for q in neg:
+                z = zp & Z[q]
+                if z.bit_count() < k - 2 or any(
+                        zr & z == z for t, zr in enumerate(Z) if t != p and t != q):
+                    continue
+                _charge(meter, 3 * d, rbits)
+                sq, rq = s[q], rays[q]
+                nrays.append(list(_primitive([sp * y - sq * x for x, y in zip(rp, rq)])))
+                nZ.append(z | bit)
+        rays, Z = nrays, nZ
+    return {z: tuple(r) for z, r in zip(Z, rays)}
+
+
 def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d: int,
               V: list[Vec], incidence: list[list[int]], adj: Any, ctx: Any) -> bool:
     """P = conv(V) from the vertex adjacency (``adjacency[i]``: the vertices joined to
@@ -1231,39 +1313,59 @@ def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d
     linear c, walking from v to such a w whenever c·y < 0 strictly decreases c on the
     finite V and stops at a v* with c >= 0 on T_{v*}, so min_P c = c·v* is attained in
     V: P is bounded and P = conv(V) (a point of P outside conv(V) would be separated by
-    some c).  Work: the local ray enumeration, sum over v of C(t_v, d − 1 − r_E) ×
-    (c_d + t_v) for t_v tight facets, bit-weighted; beyond MAX_POLY_WORK unchecked
-    (returns False); True when verified."""
+    some c).
+
+    The extreme rays of T_v: at a simple v (t_v = k = d − r_E tight facets, independent
+    modulo E as the tight rows have rank d) T_v is simplicial, its extreme rays are the
+    k directions u ≠ 0 in T_v on which exactly k − 1 tight facets vanish, one per facet
+    left nonzero — so a listed neighbour w is checked by the signs of a·(w − v) alone.
+    Otherwise :func:`_cone_rays` (double description) finds them.  Work, charged as it
+    runs, bit-weighted: t_v·d products per listed neighbour at a simple vertex, the
+    double description's elsewhere; beyond MAX_POLY_WORK unchecked (returns False); True
+    when verified."""
     _array(adj, "adjacency")
     if len(adj) != len(V):
         raise Invalid(f"adjacency has {len(adj)} entries, expected one per vertex ({len(V)})")
     BE = [a for a, _ in _basis_with_rhs(E, d)]
-    r1 = d - 1 - len(BE)
+    k = d - len(BE)
     bits = _bit_size([a + [b] for a, b in E + Fc])
-    steps = sum(math.comb(len(on), r1) * (_normal_steps(d) + len(on)) if r1 >= 0 else 0
-                for on in incidence)
-    work = _cost(steps, d * bits)
-    if work > MAX_POLY_WORK:
-        ctx.trust("vertex enumeration", f"adjacency: the edges at the {len(V)} vertices "
-                  f"({bits}-bit rows) need work {work} > {MAX_POLY_WORK}")
-        return False
-    for i, (v, on) in enumerate(zip(V, incidence)):
-        rays = _edge_directions(BE, [Fc[j][0] for j in on], d)
-        seen: dict[tuple[int, ...], int] = {}
-        for t, j in enumerate(_array(adj[i], f"adjacency[{i}]")):
-            j = _int(j, f"adjacency[{i}][{t}]", 0, len(V) - 1)
-            u = _primitive(_int_vector(tuple(a - b for a, b in zip(V[j], v))))
-            if u not in rays:
+    meter = [0, MAX_POLY_WORK]
+    onsets = [set(on) for on in incidence]
+    for i, on in enumerate(incidence):
+        nbrs = [_int(j, f"adjacency[{i}][{t}]", 0, len(V) - 1)
+                for t, j in enumerate(_array(adj[i], f"adjacency[{i}]"))]
+        rows = [Fc[j][0] for j in on]
+        try:
+            _charge(meter, len(on) * (len(nbrs) + 1), 1)  # the tight sets Z(w − v)
+            if len(on) == k:  # simple: T_v's rays have the Z sets "all but one facet"
+                full = (1 << k) - 1
+                rays: dict[int, tuple[int, ...] | None] = {full ^ (1 << t): None
+                                                           for t in range(k)}
+            else:
+                rays = _cone_rays(BE, rows, d, meter, bits)
+        except _OverBudget:
+            ctx.trust("vertex enumeration", f"adjacency: the edges at the {len(V)} vertices "
+                      f"({bits}-bit rows) need work > {MAX_POLY_WORK}")
+            return False
+        seen: dict[int, int] = {}
+        for j in nbrs:
+            z = sum(1 << t for t, f in enumerate(on) if f in onsets[j])
+            if z not in rays or j == i:
                 raise Invalid(f"adjacency[{i}] lists vertices[{j}], which is not joined to "
                               f"vertices[{i}] by an edge of P")
-            if u in seen:
-                raise Invalid(f"adjacency[{i}] lists vertices[{seen[u]}] and vertices[{j}] "
+            if z in seen:
+                raise Invalid(f"adjacency[{i}] lists vertices[{seen[z]}] and vertices[{j}] "
                               "along the same edge of P")
-            seen[u] = j
-        missing = rays - seen.keys()
+            seen[z] = j
+        missing = rays.keys() - seen.keys()
         if missing:
+            z = min(missing)
+            y = rays[z] or _primitive(_normal(BE + [a for t, a in enumerate(rows)
+                                                    if z >> t & 1], d))
+            if any(_dot(a, y) > 0 for a in rows):
+                y = tuple(-x for x in y)
             raise Invalid(f"adjacency[{i}]: no vertex listed along the edge of P at "
-                          f"vertices[{i}] in direction {_fmtv(min(missing))}")
+                          f"vertices[{i}] in direction {_fmtv(y)}")
     return True
 
 

@@ -1,0 +1,120 @@
+"""The checker's skeleton in d = 5 (issue 13 §4): the extreme rays of the tangent cones
+at degenerate vertices by the double description method (``kernels._cone_rays``)
+instead of the C(t, d − 1) enumeration of ``kernels._edge_directions``.
+
+Oracle: the brute force ``_edge_directions`` (every null direction of d − 1 rows) on
+cones over cubes, cross-polytopes, cyclic polytopes and random 0/±1 sets, with
+duplicated and redundant rows and with equalities — the ray sets must be identical."""
+
+from __future__ import annotations
+
+import itertools
+import random
+
+import pytest
+from rescon_certificates import kernels
+
+
+def _facets(points: list[list[int]], d: int) -> list[list[int]]:
+    """The facet normals a (a·p <= 0 on the points) of the cone over the points in R^d
+    (brute force over (d − 1)-subsets), primitive and distinct."""
+    out = set()
+    for sub in itertools.combinations(points, d - 1):
+        a = kernels._normal([list(p) for p in sub], d)
+        if not any(a):
+            continue
+        s = [kernels._dot(a, p) for p in points]
+        if max(s) <= 0:
+            out.add(kernels._primitive(a))
+        elif min(s) >= 0:
+            out.add(kernels._primitive([-t for t in a]))
+    return [list(a) for a in sorted(out)]
+
+
+def _base(kind: str, m: int, rng: random.Random) -> list[list[int]]:
+    """Points of a polytope in R^m (integer coordinates)."""
+    if kind == "cube":
+        return [list(p) for p in itertools.product((-1, 1), repeat=m)]
+    if kind == "cross":
+        return [[s * (i == j) for j in range(m)] for i in range(m) for s in (-1, 1)]
+    if kind == "cyclic":
+        ts = rng.sample(range(-4, 5), m + 3)
+        return [[t ** e for e in range(1, m + 1)] for t in ts]
+    if kind == "simplex":
+        return [[0] * m] + [[int(i == j) for j in range(m)] for i in range(m)]
+    assert kind == "random01"
+    pts = {tuple(rng.choice((-1, 0, 1)) for _ in range(m)) for _ in range(3 * m)}
+    return [list(p) for p in pts]
+
+
+def _cone(kind: str, d: int, rng: random.Random) -> list[list[int]]:
+    """The rows of a pointed cone in R^d: the facets of the cone over a polytope in
+    R^(d − 1) (its points get last coordinate 1), a random unimodular-ish change of
+    coordinates, duplicated rows, positive combinations of rows (redundant) and
+    shuffled."""
+    pts = [p + [1] for p in _base(kind, d - 1, rng)]
+    rows = _facets(pts, d)
+    if not rows or kernels._rank(rows) < d:
+        return []
+    U = [[int(i == j) for j in range(d)] for i in range(d)]
+    for _ in range(d):  # shear: a row operation keeps the cone's combinatorics
+        i, j = rng.sample(range(d), 2)
+        U[i] = [x + rng.choice((-1, 1)) * y for x, y in zip(U[i], U[j])]
+    rows = [[kernels._dot(a, col) for col in zip(*U)] for a in rows]
+    extra = [list(rng.choice(rows)) for _ in range(2)]
+    extra += [[2 * x + 3 * y for x, y in zip(*rng.sample(rows, 2))] for _ in range(2)]
+    rows = rows + extra
+    rng.shuffle(rows)
+    return rows
+
+
+def _check_same(BE: list[list[int]], rows: list[list[int]], d: int) -> None:
+    brute = kernels._edge_directions(BE, rows, d)
+    got = kernels._cone_rays(BE, rows, d, [0, 10 ** 12], 1)
+    assert set(got.values()) == brute
+    for z, r in got.items():  # the keys are the rows tight at each ray
+        assert z == sum(1 << i for i, a in enumerate(rows) if kernels._dot(a, r) == 0)
+
+
+@pytest.mark.parametrize("d", [3, 4, 5])
+@pytest.mark.parametrize("kind", ["cube", "cross", "cyclic", "simplex", "random01"])
+def test_double_description_matches_the_brute_force(kind, d):
+    rng = random.Random(f"{kind}-{d}")
+    done = 0
+    for _ in range(6):
+        rows = _cone(kind, d, rng)
+        if rows:
+            _check_same([], rows, d)
+            done += 1
+    assert done >= 3
+
+
+@pytest.mark.parametrize("d", [3, 4, 5])
+def test_double_description_with_equalities(d):
+    """T in R^(d + 1) with one equality: the cone of R^d embedded in a hyperplane."""
+    rng = random.Random(d)
+    for kind in ("cube", "cross", "cyclic", "random01"):
+        rows = _cone(kind, d, rng)
+        if not rows:
+            continue
+        e = [rng.randint(-2, 2) for _ in range(d)] + [1]  # y_(d+1) = −e'·y
+        BE = [e]
+        lifted = [a + [rng.randint(-3, 3)] for a in rows]
+        _check_same(BE, lifted, d + 1)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_double_description_on_random_rows(seed):
+    """Random small rows (often {0}, or a cone with few rays), rank d."""
+    rng = random.Random(seed)
+    d = rng.choice((3, 4, 5))
+    rows = [[rng.randint(-2, 2) for _ in range(d)] for _ in range(rng.randint(d, d + 8))]
+    if kernels._rank(rows) < d:
+        return
+    _check_same([], rows, d)
+
+
+def test_double_description_meter_stops_it():
+    rows = _cone("cube", 5, random.Random(1))
+    with pytest.raises(kernels._OverBudget):
+        kernels._cone_rays([], rows, 5, [0, 100], 1)
