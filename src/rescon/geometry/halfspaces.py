@@ -46,6 +46,10 @@ ILL_CONDITIONED = 1e-3
 #: integers: numba's start-up — ~0.5 s warm, ~10 s compiling on a cold cache — would
 #: dominate such inputs (a 12-point kernel in the plane needs 660 tests)
 SMALL_SCAN = 20_000
+#: the compiled scan's tables of all k-subsets of range(m) (:func:`_all_subsets`) are
+#: kept for the last few (m, k) of up to this many subsets
+SUBSET_CACHE_ROWS = 1_000_000
+_SUBSET_TABLES: dict[tuple[int, int], np.ndarray] = {}
 
 
 @dataclass
@@ -246,7 +250,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     if small:
         from ._scan_np import classify, cofactors, in_range, k_subsets
     else:
-        from ._candidates import ANGLE_ERR, classify, cofactors, k_subsets
+        from ._candidates import ANGLE_ERR, classify, cofactors
         from ._expansions import in_range
     bits = max(abs(v) for row in Yi for v in row).bit_length()
     # k = 1: the sign of a float difference is exact — of exact floats; k ≥ 2: small
@@ -271,7 +275,7 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
     # k + 1 of them underflows either
     floor = 0.0 if exact_floats else underflow_floor(k, float(np.abs(Y).max()))
     expansions = exact_view and in_range(Y)
-    subsets = k_subsets(m, k) if small else k_subsets(m, k, count)
+    subsets = k_subsets(m, k) if small else _all_subsets(m, k, count)
     if sweep:
         from ._candidates import sweep_pairs_2d
 
@@ -344,6 +348,24 @@ def valid_halfspaces(Y: np.ndarray, Yi: list[tuple[int, ...]], W: np.ndarray, F:
         hs = Halfspaces(Yi, through[keep], sign[keep], af[keep], bf[keep], af_abs[keep],
                         b_abs[keep], out[keep], c_err, box)
     return hs
+
+
+def _all_subsets(m: int, k: int, count: int) -> np.ndarray:
+    """The table of all count = C(m, k) k-subsets of range(m), in lexicographic order
+    (:func:`._candidates.k_subsets`), kept for the last 4 (m, k) of at most
+    SUBSET_CACHE_ROWS rows, so that repeated kernels of one size do not rebuild it
+    (1.8–4 ms for C(50, 4)). Shared and read-only by convention: every reader indexes
+    it (copies) or reads it."""
+    out = _SUBSET_TABLES.get((m, k))
+    if out is None:
+        from ._candidates import k_subsets
+
+        out = k_subsets(m, k, count)
+        if count <= SUBSET_CACHE_ROWS:
+            while len(_SUBSET_TABLES) >= 4:
+                _SUBSET_TABLES.pop(next(iter(_SUBSET_TABLES)), None)
+            _SUBSET_TABLES[(m, k)] = out
+    return out
 
 
 def _exact_normals3(Y: np.ndarray, Yi: list[tuple[int, ...]], triples: np.ndarray,
