@@ -772,22 +772,12 @@ def _through(E: np.ndarray, L: np.ndarray, others: np.ndarray, Q: np.ndarray) ->
     pairs, where = np.unique(others[:, :, None] * len(L) + Q[:, None, :],
                              return_inverse=True)
     Eh, Lp = E[pairs // len(L)], L[pairs % len(L)]
-    lam = cross_all(_column_dots(Eh, Lp)[where].reshape(*others.shape, Q.shape[1]))
+    brackets = Eh[:, 0] + (Eh[:, 1:] * Lp[:, 1:]).sum(axis=1)
+    lam = cross_all(brackets[where].reshape(*others.shape, Q.shape[1]))
     x = np.empty((len(Q), L.shape[1]), dtype=object)  # Σ_q λ_q (1, q)
     x[:, 0] = lam.sum(axis=1)
-    for j in range(1, L.shape[1]):  # column by column: 1-D object products, no matmul
-        x[:, j] = _column_dots(lam, Lq[:, :, j], first=0)
+    x[:, 1:] = np.matmul(lam[:, None, :], Lq[:, :, 1:])[:, 0]
     return x
-
-
-def _column_dots(U: np.ndarray, V: np.ndarray, first: int = 1) -> np.ndarray:
-    """Σ_{j ≥ first} U[:, j] · V[:, j] (plus U[:, 0] when first = 1: e_h·(1, q)) for
-    object arrays of Python ints, as sums of 1-D columns in order j = first, …: the same
-    integers as numpy's row sums, at half their cost (no per-row reduction)."""
-    acc = U[:, 0] if first else U[:, 0] * V[:, 0]
-    for j in range(1, U.shape[1]):
-        acc = acc + U[:, j] * V[:, j]
-    return acc
 
 
 def _object_rows(rows: list[tuple[int, ...]], width: int) -> np.ndarray:

@@ -428,14 +428,17 @@ def _scaled_floats(poly: ExactPolytope, scale: int) -> np.ndarray:
 
 
 def _lex_order(V: np.ndarray, exact: Callable[[int], tuple[Fraction, ...]],
-               rows: np.ndarray | None = None, col: int = 0) -> list[int]:
+               rows: np.ndarray | None = None, col: int = 0,
+               equal: Callable[[list[int], int], bool] | None = None) -> list[int]:
     """The indices of the rows of V (those in ``rows``, by default all) ordered as the
     exact points they round (``exact(i)``) in lexicographic order, V's columns before
     ``col`` being equal on them: correct rounding is monotone (fl(s) < fl(t) implies
     s < t), so the floats of column ``col`` order all rows but those that round alike
     there. A run of those whose exact values are equal too (entries ±1 of directions
     scaled by their largest |entry|) is ordered on the next column in the same way;
-    any other run is sorted exactly (by :func:`_lex_key`)."""
+    any other run is sorted exactly (by :func:`_lex_key`). ``equal(ids, col)``:
+    whether the exact values of column ``col`` are all equal on the rows ids, decided
+    without building them (default: by ``exact``)."""
     if rows is None:
         rows = np.arange(len(V))
     order = rows[np.argsort(V[rows, col], kind="stable")]
@@ -448,9 +451,12 @@ def _lex_order(V: np.ndarray, exact: Callable[[int], tuple[Fraction, ...]],
     starts = tie[np.r_[True, tie[1:] != tie[:-1] + 1]]
     ends = tie[np.r_[tie[1:] != tie[:-1] + 1, True]] + 2
     for lo, hi in zip(starts.tolist(), ends.tolist(), strict=True):
+        if equal is not None and col + 1 < V.shape[1] and equal(out[lo:hi], col):
+            out[lo:hi] = _lex_order(V, exact, order[lo:hi], col + 1, equal)
+            continue
         run = {i: exact(i) for i in out[lo:hi]}
         if col + 1 < V.shape[1] and len({x[col] for x in run.values()}) == 1:
-            out[lo:hi] = _lex_order(V, exact, order[lo:hi], col + 1)
+            out[lo:hi] = _lex_order(V, exact, order[lo:hi], col + 1, equal)
         else:
             out[lo:hi] = sorted(run, key=lambda i: _lex_key(run[i][col:]))
     return out
@@ -727,7 +733,12 @@ def _facet_order(poly: ExactPolytope, hull: AffineHull, ids: list[int], d: int
     tops = [max(map(abs, a)) for a in rows]
     D = np.array([[v / top for v in a] for a, top in zip(rows, tops, strict=True)],
                  dtype=np.float64).reshape(len(rows), d)
-    order = _lex_order(D, lambda i: tuple(Fraction(v, tops[i]) for v in rows[i]))
+    def equal(run: list[int], col: int) -> bool:  # a_i / t_i = a_0 / t_0, tops t > 0
+        a0, t0 = rows[run[0]][col], tops[run[0]]
+        return all(rows[i][col] * t0 == a0 * tops[i] for i in run)
+
+    order = _lex_order(D, lambda i: tuple(Fraction(v, tops[i]) for v in rows[i]),
+                       equal=equal)
     return [ids[i] for i in order], D[order], [tops[i] for i in order]
 
 
