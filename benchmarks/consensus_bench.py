@@ -124,7 +124,7 @@ def check_monitors(N: int, d: int, steps: int, shape: str = "box") -> None:
     diameter is the n² formula's float."""
     from unittest import mock
 
-    from rescon.consensus import metrics
+    from rescon.consensus import _initial_hull, metrics
 
     sc = dataclasses.replace(case(N, d, 1, steps, shape=shape), algorithm="mean",
                              adversaries={0: Constant([50.0] * d)})
@@ -132,7 +132,7 @@ def check_monitors(N: int, d: int, steps: int, shape: str = "box") -> None:
     if not tr.metrics["validity"].max() > 0:
         raise AssertionError("the check run never left the benign hull")
     mon = metrics.ValidityMonitor(tr.states[0, tr.benign])
-    with mock.patch.object(metrics, "PROPOSE_MIN", 10**9):
+    with mock.patch.object(_initial_hull, "PROPOSE_MIN", 10**9):
         ref = metrics.ValidityMonitor(tr.states[0, tr.benign])
     for X, got in zip(tr.states[:, tr.benign], tr.metrics["validity_per_agent"]):
         want = ref.distances(X)

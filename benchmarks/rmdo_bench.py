@@ -103,16 +103,16 @@ def sized_row(N: int, d: int, steps: int, naive_steps: int, distinct: int | None
     exact projection for every state outside the hull (its path before the edge
     distances), to measure what they save."""
     if exact_validity:
-        from rescon.consensus import metrics
+        from rescon.consensus import _validity_monitor as monitor
 
-        saved, metrics._polygon_edges = metrics._polygon_edges, lambda hull: None
+        saved, monitor._polygon_edges = monitor._polygon_edges, lambda hull: None
         try:
             return sized_row(N, d, steps, naive_steps, distinct, shift) | {
                 "case": f"N={N}, d={d}, F=1, {distinct} shared atom costs, X* outside the "
                         "initial hull, validity by exact projection (before)",
                 "target": "comparison", "met": None}
         finally:
-            metrics._polygon_edges = saved
+            monitor._polygon_edges = saved
     exprs, data = costs(N, d, distinct=distinct, shift=shift)
     sc = case(N, d, 1, steps)
     benign = [i for i, v in enumerate(sc.nodes) if v not in sc.adversaries]

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rescon import check_certificate
-from rescon.consensus import metrics
+from rescon.consensus import _initial_hull
 from rescon.consensus.metrics import ValidityMonitor, certified_hull
 from rescon.errors import InputError
 from rescon.geometry.kernel import safe_kernel
@@ -54,7 +54,7 @@ def planar_sets(draw) -> np.ndarray:
 def test_chain_hull_is_the_exact_hull(X, seed):
     """The monotone-chain hull is the exact polytope safe_kernel(X, 0): dimension,
     exact vertices, exact facets, exact membership and a valid certificate."""
-    assert_is_the_exact_hull(metrics._exact_polygon, X, seed)
+    assert_is_the_exact_hull(_initial_hull._exact_polygon, X, seed)
 
 
 def assert_is_the_exact_hull(build, X: np.ndarray, seed: int) -> None:
@@ -85,7 +85,7 @@ def test_circle_is_not_refused():
     every point, initial states at distance 0, states outside at their distance."""
     for n in (10_000, 2000):
         X = _circle(n)
-        with mock.patch.object(metrics, "safe_kernel", side_effect=AssertionError("kernel")):
+        with mock.patch.object(_initial_hull, "safe_kernel", side_effect=AssertionError("kernel")):
             mon = ValidityMonitor(X)
         assert mon.hull.dim == 2 and len(mon.hull.exact_vertices) == n
         assert set(mon.hull.exact_vertices) == {tuple(map(Fraction, x)) for x in X.tolist()}
@@ -117,7 +117,7 @@ def test_validity_distances_unchanged(seed):
         S = X[rng.integers(0, len(X), 80)] * rng.choice([0.3, 0.99, 1.0, 1.01, 2.0],
                                                         size=(80, 1))
         new = ValidityMonitor(X)
-        with mock.patch.object(metrics, "PROPOSE_MIN", 10**9):
+        with mock.patch.object(_initial_hull, "PROPOSE_MIN", 10**9):
             old = ValidityMonitor(X)
         assert _facet_set(new.hull) == _facet_set(old.hull)
         dist, before = new.distances(S), old.distances(S)

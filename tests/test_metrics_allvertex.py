@@ -16,8 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 
-from rescon.consensus import metrics
+from rescon.consensus import _hull_surface, _initial_hull, metrics
 from rescon.consensus.metrics import ValidityMonitor, certified_hull, diameter
+from rescon.geometry.exact import exact_points
 from rescon.geometry.kernel import safe_kernel
 from tests.test_hull_vertices import _facet_set, assert_is_the_exact_hull
 
@@ -56,17 +57,17 @@ def test_certified_surface_hull_is_the_exact_hull(X, seed):
     """The certified-surface hull is the exact polytope safe_kernel(X, 0): exact vertices,
     exact facets, exact membership, a certificate the checker accepts (or both refuse
     a facet whose float row overflows)."""
-    assert_is_the_exact_hull(metrics._exact_polytope, X, seed)
+    assert_is_the_exact_hull(_initial_hull._exact_polytope, X, seed)
 
 
 def test_flat_sets_are_left_to_the_kernel():
     """Coplanar states (no 3-D surface to certify) take the former path, same hull."""
     rng = np.random.default_rng(1)
     X = np.c_[rng.normal(size=(200, 2)), np.full(200, 3.0)]
-    assert metrics._exact_polytope(X) is None
+    assert _initial_hull._exact_polytope(X) is None
     hull = certified_hull(X)
     assert hull.dim == 2 and _facet_set(hull) == _facet_set(safe_kernel(X[
-        metrics._proposed_rows(X)], 0))
+        _initial_hull._proposed_rows(X)], 0))
 
 
 def _surface(U: np.ndarray) -> np.ndarray:
@@ -80,11 +81,11 @@ def test_certification_refuses_wrong_surfaces():
     outside (the hull of all but it); the true hull passes."""
     U = np.unique(_sphere(60, seed=3), axis=0)
     T = _surface(U)
-    assert metrics._certified_surface(U, T) is not None
-    assert metrics._certified_surface(U, T[1:]) is None
+    assert _hull_surface._certified_surface(U, T) is not None
+    assert _hull_surface._certified_surface(U, T[1:]) is None
     dented = U.copy()
     dented[T[0, 0]] *= 0.9
-    assert metrics._certified_surface(dented, T) is None
+    assert _hull_surface._certified_surface(dented, T) is None
     cube = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], float)
     outer = np.array([[3.0, 3, 3], [3, -3, -3], [-3, 3, -3], [-3, -3, 3]])
     nested = np.unique(np.r_[outer, outer / 3.0], axis=0)
@@ -92,12 +93,12 @@ def test_certification_refuses_wrong_surfaces():
     second = [np.flatnonzero((nested == r / 3.0).all(axis=1))[0] for r in outer]
     tets = np.array([[q[i] for i in face] for q in (first, second)
                      for face in ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3))])
-    assert metrics._certified_surface(nested, tets) is None
+    assert _hull_surface._certified_surface(nested, tets) is None
     U2 = np.unique(np.r_[cube, [[0.0, 0.0, 5.0]]], axis=0)
     far = np.flatnonzero((U2 == [0.0, 0.0, 5.0]).all(axis=1))[0]
     keep = np.delete(np.arange(len(U2)), far)
     partial = keep[_surface(U2[keep])]
-    assert metrics._certified_surface(U2, partial) is None
+    assert _hull_surface._certified_surface(U2, partial) is None
 
 
 @pytest.mark.parametrize("n", [1000, pytest.param(10_000, marks=pytest.mark.slow)])
@@ -106,7 +107,7 @@ def test_sphere_is_not_refused(n):
     refused), initial states at distance 0 without an exact test, states inside
     proven by the cone filter, states outside at their distance."""
     X = _sphere(n)
-    with mock.patch.object(metrics, "safe_kernel", side_effect=AssertionError("kernel")):
+    with mock.patch.object(_initial_hull, "safe_kernel", side_effect=AssertionError("kernel")):
         mon = ValidityMonitor(X)
     assert mon.hull.dim == 3 and len(mon.hull.exact_vertices) == n
     assert set(mon.hull.exact_vertices) == {tuple(map(Fraction, x)) for x in X.tolist()}
@@ -149,7 +150,7 @@ def test_validity_distances_unchanged_in_space(seed):
         S = X[rng.integers(0, len(X), 60)] * rng.choice([0.3, 0.99, 1.0, 1.01, 2.0],
                                                         size=(60, 1))
         new = ValidityMonitor(X)
-        with mock.patch.object(metrics, "PROPOSE_MIN", 10**9):
+        with mock.patch.object(_initial_hull, "PROPOSE_MIN", 10**9):
             old = ValidityMonitor(X)
         assert _facet_set(new.hull) == _facet_set(old.hull)
         dist, before = new.distances(S), old.distances(S)
@@ -178,7 +179,7 @@ def test_random_circle_diameter_compares_few_pairs():
 
 
 def _exact_sq_diameter(X: np.ndarray) -> Fraction:
-    P = metrics.exact_points(X)
+    P = exact_points(X)
     best = max(sum((a - b) ** 2 for a, b in zip(p, q)) for p in P.ints for q in P.ints)
     return Fraction(best, P.scale**2)
 
@@ -205,7 +206,7 @@ def test_caliper_pair_is_diametral(n, seed, kind, scale):
         X = np.c_[np.cos(t), np.sin(t)]
     K = np.unique(X * scale, axis=0)
     i, j = metrics._caliper_pair(K)
-    P = metrics.exact_points(K)
+    P = exact_points(K)
     pair = sum((a - b) ** 2 for a, b in zip(P.ints[i], P.ints[j]))
     assert Fraction(pair, P.scale**2) == _exact_sq_diameter(K)
 
@@ -236,7 +237,7 @@ def test_monitor_at_every_magnitude(scale):
     X = _sphere(120, scale, seed=2)
     X = np.r_[X, X[:30]]
     new = ValidityMonitor(X)
-    with mock.patch.object(metrics, "PROPOSE_MIN", 10**9):
+    with mock.patch.object(_initial_hull, "PROPOSE_MIN", 10**9):
         old = ValidityMonitor(X)
     assert _facet_set(new.hull) == _facet_set(old.hull)
     S = np.r_[np.zeros((4, 3)), np.repeat(X[:1] * 0.999, 4, axis=0), X[::7] * 1.5, X[40:60]]
@@ -249,8 +250,8 @@ def test_fallback_in_space_still_corrects_its_proposal():
     """When no surface is certified (here forced), R³ falls back to the safe kernel of
     Qhull's vertices, completed by the exact certification (a proposal of 4 rows)."""
     X = np.random.default_rng(4).normal(size=(120, 3))
-    with mock.patch.object(metrics, "_exact_polytope", return_value=None), \
-            mock.patch.object(metrics, "_proposed_rows", lambda X: np.arange(4)):
+    with mock.patch.object(_initial_hull, "_exact_polytope", return_value=None), \
+            mock.patch.object(_initial_hull, "_proposed_rows", lambda X: np.arange(4)):
         hull = certified_hull(X)
     assert "cones" not in hull._cache
-    assert _facet_set(hull) == _facet_set(metrics._exact_polytope(X))
+    assert _facet_set(hull) == _facet_set(_initial_hull._exact_polytope(X))

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from test_review_v13 import _close, _distance, _few_points
 
-from rescon.consensus import metrics
+from rescon.consensus import _distance_trees, _validity_monitor, metrics
 from rescon.consensus.metrics import ValidityMonitor, monitor_names
 from rescon.errors import InputError
 
@@ -91,13 +91,15 @@ def test_no_n_by_h_work_outside_a_10000_gon(monkeypatch):
     X0 = _circle(10_000)
     mon = ValidityMonitor(X0)
     S = X0 * (1 + 2.0**-20)
-    pairs = []
-    real_slacks, real_edges = metrics._slacks, metrics._edge_float
-    monkeypatch.setattr(metrics, "_slacks", lambda A, b, X: pairs.append(len(A) * len(X))
-                        or real_slacks(A, b, X))
-    monkeypatch.setattr(metrics, "_edge_float", lambda X, P, Q: pairs.append(
-        np.broadcast_shapes(X.shape, P.shape)[:-1]) or real_edges(X, P, Q))
+    pairs, seen = [], set()
+    real_slacks, real_edges = _validity_monitor._slacks, _validity_monitor._edge_float
+    monkeypatch.setattr(_validity_monitor, "_slacks", lambda A, b, X: seen.add("slacks") or
+                        pairs.append(len(A) * len(X)) or real_slacks(A, b, X))
+    monkeypatch.setattr(_validity_monitor, "_edge_float", lambda X, P, Q: seen.add("edges") or
+                        pairs.append(np.broadcast_shapes(X.shape, P.shape)[:-1])
+                        or real_edges(X, P, Q))
     got = mon.distances(S)
+    assert seen == {"slacks", "edges"}  # the spies sit where the monitor looks them up
     total = sum(int(np.prod(p)) for p in pairs)
     assert total < 200 * len(S), total
     sample = np.arange(0, 10_000, 97)
@@ -129,7 +131,7 @@ def test_small_polygons_through_the_tree_agree_with_brute_force(monkeypatch, see
     — at 1e-300 … 1e300; states inside, a few ulps off, on an edge's line beyond its
     end, far outside and at other magnitudes: every distance as the Fractions brute
     force (0 iff inside, else within the fast bound)."""
-    monkeypatch.setattr(metrics, "INNER_FACETS", 3)
+    monkeypatch.setattr(_validity_monitor, "INNER_FACETS", 3)
     rng = np.random.default_rng(seed)
     X0, S = _initial_and_states(rng, 2, ("gauss", "ulps", "subnormal", "line")[seed % 4],
                                 int(rng.integers(6, 13)))
@@ -228,10 +230,12 @@ def test_no_n_by_t_work_outside_a_sphere(monkeypatch):
     mon = ValidityMonitor(X0)
     S = X0 * (1 + 2.0**-20)
     pairs = []
-    real = metrics._closest_points
-    monkeypatch.setattr(metrics, "_closest_points", lambda x, A, B, C: pairs.append(
-        np.broadcast_shapes(x.shape, A.shape)[:-1]) or real(x, A, B, C))
+    real = _distance_trees._closest_points
+    for module in (_validity_monitor, _distance_trees):  # the tree's and the dense path's
+        monkeypatch.setattr(module, "_closest_points", lambda x, A, B, C: pairs.append(
+            np.broadcast_shapes(x.shape, A.shape)[:-1]) or real(x, A, B, C))
     got = mon.distances(S)
+    assert pairs  # the spy is where the monitor looks it up
     assert sum(int(np.prod(p)) for p in pairs) < 200 * len(S), pairs
     assert (got > 0).all()
 

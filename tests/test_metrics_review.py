@@ -185,7 +185,7 @@ def test_polygon_edges_of_a_large_polygon_are_found_by_their_float_slack():
     1000-gon at load 5, 32 s for 2000); now ~2 exact tests per facet, same edges."""
     import time
 
-    from rescon.consensus.metrics import _polygon_edges
+    from rescon.consensus._validity_monitor import _polygon_edges
 
     th = np.linspace(0, 2 * np.pi, 1000, endpoint=False)
     X = np.c_[np.cos(th), np.sin(th)]

@@ -162,9 +162,9 @@ def test_monitor_distances_in_space_equal_an_exact_oracle(kind, monkeypatch):
     at 2^40 + a grid of 1/8 (many-digit coordinates) and at 1e-300: 0 exactly for the
     states inside, and for the others within the monitor's own bound of the exact
     distance from the subset-free oracle above (hull facets by brute force)."""
-    from rescon.consensus import metrics
+    from rescon.consensus import _initial_hull, metrics
 
-    monkeypatch.setattr(metrics, "PROPOSE_MIN", 8)
+    monkeypatch.setattr(_initial_hull, "PROPOSE_MIN", 8)
     rng = np.random.default_rng(7)
     Z = rng.integers(-2, 3, size=(24, 3)).astype(float)
     X = {"sphere": rng.normal(size=(24, 3)), "grid": Z, "translated": 2.0**40 + Z / 8,

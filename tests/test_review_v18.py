@@ -19,9 +19,10 @@ from hypothesis import strategies as st
 from test_metrics_review import _seg2
 from test_review_v13 import _close
 
-from rescon.consensus import metrics
+from rescon.consensus import _distance_trees, _validity_monitor
+from rescon.consensus._validity_monitor import BLOCK
 from rescon.consensus.engine import simulate
-from rescon.consensus.metrics import BLOCK, ValidityMonitor
+from rescon.consensus.metrics import ValidityMonitor
 from rescon.consensus.scenario import Scenario
 
 
@@ -36,15 +37,17 @@ def _dense(mon: ValidityMonitor, S: np.ndarray) -> np.ndarray:
 
 
 def _spy(monkeypatch, name: str) -> list[int]:
-    """Record the number of broadcast (row, item) pairs of each call of metrics.<name>."""
+    """Record the number of broadcast (row, item) pairs of each call of <name> (the
+    validity monitor's, and the dense path's in _distance_trees)."""
     sizes: list[int] = []
-    real = getattr(metrics, name)
+    real = getattr(_distance_trees, name)
 
     def spy(X, P, *rest):
         sizes.append(int(np.prod(np.broadcast_shapes(X.shape, P.shape)[:-1])))
         return real(X, P, *rest)
 
-    monkeypatch.setattr(metrics, name, spy)
+    for module in (_validity_monitor, _distance_trees):
+        monkeypatch.setattr(module, name, spy)
     return sizes
 
 
@@ -307,8 +310,8 @@ def test_simulate_validity_is_the_same_with_the_trees_off(monkeypatch, d):
             return np.asarray(simulate(sc, metrics="validity").metrics["validity_per_agent"])
 
     got = run()
-    monkeypatch.setattr(metrics, "_edge_tree", lambda *a: None)
-    monkeypatch.setattr(metrics, "_triangle_tree", lambda *a: None)
+    monkeypatch.setattr(_validity_monitor, "_edge_tree", lambda *a: None)
+    monkeypatch.setattr(_validity_monitor, "_triangle_tree", lambda *a: None)
     assert ValidityMonitor(x0)._edge_tree is None and ValidityMonitor(x0)._tri_tree is None
     assert (got > 0).sum() > 100
     assert np.array_equal(got, run())

@@ -83,7 +83,7 @@ BEFORE = {
 def test_algorithm1_trajectories_are_bit_identical_to_before(case, monkeypatch):
     # the exact validity path of commit f22b181 (outside a polygon the monitor now uses
     # edge distances within their bound: tests/test_validity_monitor.py)
-    monkeypatch.setattr("rescon.consensus.metrics._polygon_edges", lambda hull: None)
+    monkeypatch.setattr("rescon.consensus._validity_monitor._polygon_edges", lambda hull: None)
     kw, expected = BEFORE[case]
     tr = simulate(Scenario.paper_example(check_robustness=False, steps=30, **kw))
     assert list(tr.metrics) == ["spread", "diameter", "validity", "validity_per_agent",

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rescon.consensus import engine, metrics
+from rescon.consensus import _initial_hull, engine, metrics
 from rescon.consensus.adversaries import FunctionOfTime
 from rescon.consensus.engine import simulate
 from rescon.consensus.metrics import ValidityMonitor, certified_hull, diameter
@@ -125,13 +125,13 @@ def test_certified_hull_is_the_exact_hull(X, seed):
     """Qhull proposes (here on every input, PROPOSE_MIN = 0), certification decides:
     the same exact polytope as the safe kernel of all rows with F = 0, and state
     distances / inside decisions equal to those of that exact hull."""
-    with mock.patch.object(metrics, "PROPOSE_MIN", 0):
+    with mock.patch.object(_initial_hull, "PROPOSE_MIN", 0):
         hull = certified_hull(X)
     exact = safe_kernel(X, 0)
     assert hull.dim == exact.dim and _vertex_set(hull) == _vertex_set(exact)
     rng = np.random.default_rng(seed)
     S = X[rng.integers(0, len(X), 6)] * rng.choice([0.5, 1.0, 1.5], size=(6, 1))
-    with mock.patch.object(metrics, "PROPOSE_MIN", 0):
+    with mock.patch.object(_initial_hull, "PROPOSE_MIN", 0):
         mon = ValidityMonitor(X)
     for x, dist in zip(S, mon.distances(S), strict=True):
         assert (dist == 0) == exact.contains(x)
@@ -181,8 +181,8 @@ def test_a_wrong_proposal_is_corrected():
     rng = np.random.default_rng(4)
     for d in (2, 3):
         X = rng.normal(size=(200, d))
-        right = safe_kernel(X[metrics._proposed_rows(X)], 0)
-        with mock.patch.object(metrics, "_proposed_rows", lambda X, d=d: np.arange(d + 1)):
+        right = safe_kernel(X[_initial_hull._proposed_rows(X)], 0)
+        with mock.patch.object(_initial_hull, "_proposed_rows", lambda X, d=d: np.arange(d + 1)):
             hull = certified_hull(X)
         assert _vertex_set(hull) == _vertex_set(right)
 
@@ -193,7 +193,7 @@ def test_validity_same_as_the_exact_monitor(d):
     monitor built from every initial state (the code before issue 13)."""
     sc = _case(150, d, steps=6, centre="box")
     fast = simulate(sc)
-    with mock.patch.object(metrics, "_proposed_rows", lambda X: np.arange(len(X))):
+    with mock.patch.object(_initial_hull, "_proposed_rows", lambda X: np.arange(len(X))):
         slow = simulate(sc)
     assert np.array_equal(fast.metrics["validity_per_agent"],
                           slow.metrics["validity_per_agent"])

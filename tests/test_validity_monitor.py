@@ -124,7 +124,7 @@ def test_run_leaving_the_hull_same_states_validity_within_bound(monkeypatch):
                                 policy="zero")
     fast = simulate(sc)
     mon = ValidityMonitor(fast.states[0, fast.benign])
-    monkeypatch.setattr("rescon.consensus.metrics._polygon_edges", lambda hull: None)
+    monkeypatch.setattr("rescon.consensus._validity_monitor._polygon_edges", lambda hull: None)
     exact = simulate(sc)
     assert np.array_equal(fast.states, exact.states)
     assert exact.metrics["validity"].max() > 1  # the case does leave the hull
