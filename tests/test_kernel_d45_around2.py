@@ -259,11 +259,35 @@ def test_d5_merged_proposal_falls_back_to_qhull_default_in_the_same_attempt(monk
     assert K.dim == 5
 
 
-def test_d4_merged_proposal_keeps_qhull_default(monkeypatch):
-    """In d = 4 the merged proposal is qhull's default alone (its chain is d ≥ 5)."""
+def test_d4_merged_proposal_is_qhull_default_without_the_outer_plane_pass(monkeypatch):
+    """In d = 4 the merged proposal is qhull's default with "Q5" alone (the chain of
+    options is d ≥ 5); the kernel is the clipping's."""
     used = _recorded_options(monkeypatch)
     _same_as_clipping(_cloud("gaussian", 4, 20, 2), 2, monkeypatch)
-    assert used and used[0] is None
+    assert used and used[0] == "Q5" == fastpath.MERGED_OPTIONS_4D[0]
+    assert None not in used
+
+
+@pytest.mark.parametrize(("kind", "n", "F"), [("gaussian", 20, 2), ("cube", 30, 3),
+                                               ("sphere", 30, 1), ("sphere", 50, 5)])
+def test_d4_q5_proposal_is_the_default_one_bit_for_bit(monkeypatch, kind, n, F):
+    """qhull with "Q5" returns the default's dual facets and intersections, bit for bit,
+    on the halfspaces the fast path gives it (the rows of its first round)."""
+    import scipy.spatial as sp
+
+    real, seen = sp.HalfspaceIntersection, []
+
+    def record(halfspaces, interior, qhull_options=None, **kw):
+        seen.append((halfspaces.copy(), interior.copy()))
+        return real(halfspaces, interior, qhull_options=qhull_options, **kw)
+
+    monkeypatch.setattr(sp, "HalfspaceIntersection", record)
+    rescon.safe_kernel(_cloud(kind, 4, n, F), F)
+    assert seen
+    for rows, interior in seen:
+        a, b = real(rows, interior), real(rows, interior, qhull_options="Q5")
+        assert a.dual_facets == b.dual_facets
+        assert a.intersections.tobytes() == b.intersections.tobytes()
 
 
 @pytest.mark.parametrize("seed", range(8))
