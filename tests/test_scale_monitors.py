@@ -4,6 +4,7 @@ chooses, Algorithm 1's vectorised filter step, N = 5000 in the plane."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tracemalloc
 import warnings
@@ -17,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rescon.consensus import _initial_hull, engine, metrics
-from rescon.consensus.adversaries import FunctionOfTime
+from rescon.consensus.adversaries import Constant, FunctionOfTime
 from rescon.consensus.engine import simulate
 from rescon.consensus.metrics import ValidityMonitor, certified_hull, diameter
 from rescon.consensus.scenario import Scenario
@@ -177,26 +178,48 @@ def test_initial_states_need_no_exact_test():
 
 def test_a_wrong_proposal_is_corrected():
     """A proposal that misses vertices (what Qhull's rounding could do) is completed by
-    the exact certification."""
+    the exact certification. PROPOSE_MIN off: past it the plane's exact chain and R³'s
+    certified surface take no proposal (the patched one was never called)."""
     rng = np.random.default_rng(4)
     for d in (2, 3):
         X = rng.normal(size=(200, d))
         right = safe_kernel(X[_initial_hull._proposed_rows(X)], 0)
-        with mock.patch.object(_initial_hull, "_proposed_rows", lambda X, d=d: np.arange(d + 1)):
+        wrong = mock.Mock(return_value=np.arange(d + 1))
+        with mock.patch.object(_initial_hull, "_proposed_rows", wrong), \
+                mock.patch.object(_initial_hull, "PROPOSE_MIN", 10**9):
             hull = certified_hull(X)
+        assert wrong.called
         assert _vertex_set(hull) == _vertex_set(right)
 
 
+@pytest.mark.parametrize("leaves", [False, True])
 @pytest.mark.parametrize("d", [2, 3])
-def test_validity_same_as_the_exact_monitor(d):
+def test_validity_same_as_the_exact_monitor(d, leaves):
     """A run of N = 150 (past PROPOSE_MIN): the validity distances equal those of the
-    monitor built from every initial state (the code before issue 13)."""
+    monitor built from every initial state (the code before issue 13; PROPOSE_MIN off,
+    else the exact chain / certified surface take no proposal); ``leaves``: the mean
+    filter and an adversary at 50 push states out of the hull (Algorithm 1 keeps every
+    distance 0: outside, the two monitors' floats agree within their certified bounds, as
+    in benchmarks/consensus_bench.py)."""
     sc = _case(150, d, steps=6, centre="box")
+    if leaves:
+        sc = dataclasses.replace(sc, algorithm="mean", adversaries={0: Constant([50.0] * d)})
     fast = simulate(sc)
-    with mock.patch.object(_initial_hull, "_proposed_rows", lambda X: np.arange(len(X))):
+    got = fast.metrics["validity_per_agent"]
+    assert (got > 0).any() == leaves
+    every = mock.Mock(side_effect=lambda X: np.arange(len(X)))
+    with mock.patch.object(_initial_hull, "_proposed_rows", every), \
+            mock.patch.object(_initial_hull, "PROPOSE_MIN", 10**9):
         slow = simulate(sc)
-    assert np.array_equal(fast.metrics["validity_per_agent"],
-                          slow.metrics["validity_per_agent"])
+        ref = ValidityMonitor(fast.states[0, fast.benign])
+    assert every.called and "edge_ends" not in ref.hull._cache and "cones" not in ref.hull._cache
+    want = slow.metrics["validity_per_agent"]
+    assert np.array_equal(got == 0, want == 0)
+    mon = ValidityMonitor(fast.states[0, fast.benign])
+    for X, g, w in zip(fast.states[:, fast.benign], got, want, strict=True):
+        err = (2 * mon.edge_error(X) if d == 2
+               else mon.triangle_distances(X)[1] + ref.triangle_distances(X)[1])
+        assert np.all(np.abs(g - w) <= err)
     assert np.array_equal(fast.states, slow.states)
 
 
