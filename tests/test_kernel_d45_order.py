@@ -80,3 +80,19 @@ def test_subset_table_is_kept_and_read_only_by_its_readers(monkeypatch):
     monkeypatch.setattr(hm, "SUBSET_CACHE_ROWS", 10)
     hm._all_subsets(12, 3, 220)
     assert (12, 3) not in hm._SUBSET_TABLES
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_margin_lp_row_selection_is_the_stable_sort_prefix(seed):
+    """_lp._smallest (a partition, then a stable sort of the entries up to the m-th
+    value) is np.argsort(v, kind="stable")[:m], ties by index, with NaN, ±inf and ±0."""
+    from rescon.geometry._lp import _smallest
+
+    rng = np.random.default_rng(seed)
+    for t in range(400):
+        n, m = int(rng.integers(0, 200)), int(rng.integers(1, 60))
+        v = (rng.integers(-4, 4, size=n).astype(float) if t % 2 else rng.normal(size=n))
+        for special in (np.nan, np.inf, -np.inf, -0.0, 0.0):
+            if n and rng.random() < 0.3:
+                v[rng.integers(0, n, size=max(1, n // 5))] = special
+        assert np.array_equal(_smallest(v, m), np.argsort(v, kind="stable")[:m])

@@ -79,7 +79,7 @@ def max_margin(A: np.ndarray, b: np.ndarray, w: np.ndarray, lo: np.ndarray,
 
     if centre is None:
         centre = (lo + hi) / 2.0
-    add(np.argsort((b - A @ centre) / w, kind="stable")[:FIRST_ROWS])
+    add(_smallest((b - A @ centre) / w, FIRST_ROWS))
     tol = VIOLATION * (1.0 + np.abs(b))
     while True:
         h.run()
@@ -92,9 +92,23 @@ def max_margin(A: np.ndarray, b: np.ndarray, w: np.ndarray, lo: np.ndarray,
         bad = np.flatnonzero((excess > tol) & ~in_lp)
         if not len(bad):
             break
-        add(bad[np.argsort(-excess[bad], kind="stable")[:ADD_ROWS]])
+        add(bad[_smallest(-excess[bad], ADD_ROWS)])
     solution = h.getSolution()
     duals = np.zeros(m)
     duals[np.concatenate(added)] = -np.array(solution.row_dual)
     boxed = bool(np.any(np.abs(np.array(solution.col_dual)[:k]) > 0.0))
     return Margin(z[:k], float(z[k]), np.maximum(duals, 0.0), boxed)
+
+
+def _smallest(v: np.ndarray, m: int) -> np.ndarray:
+    """np.argsort(v, kind="stable")[:m] — the indices of the m smallest entries, ties
+    by index — without sorting all of v: the entries ≤ the m-th smallest value (a
+    partition, O(len v)) are the only ones that can be among them, and their stable
+    sort orders them as the full one does. NaN (last in both) as the full sort."""
+    if len(v) <= m:
+        return np.argsort(v, kind="stable")
+    kth = np.partition(v, m - 1)[m - 1]
+    if np.isnan(kth):
+        return np.argsort(v, kind="stable")[:m]
+    near = np.flatnonzero(v <= kth)  # increasing: ties stay in index order
+    return near[np.argsort(v[near], kind="stable")[:m]]
