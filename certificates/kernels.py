@@ -609,7 +609,7 @@ def _in_kernel_halfspaces(pts: list[Vec], F: int, tests: list[Vec], names: list[
 
 
 def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[int]]],
-                   names: list[str], ctx: Any) -> str:
+                   names: list[str], ctx: Any, faces: list[list[int]] | None = None) -> str:
     """P = conv(V) ⊆ Psi for a full-dimensional polytope P in R^d, d >= 2 (vert(P) = V
     already proved; ``tight[i]``: the nonzero integer normals of the facets tight at V[i]), by
     the normal fan:
@@ -633,7 +633,16 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     facet once), plus the recursion's, charged as it runs, bit-weighted; beyond
     MAX_EVAL_WORK unchecked.  In d >= 4, where the products of generators can outgrow
     the C(u, d) enumeration on small inputs, a fan that spends FAN_OVER_ENUMERATION times
-    the work of (b) while (b) is within MAX_HALFSPACE_WORK hands over to (b)."""
+    the work of (b) while (b) is within MAX_HALFSPACE_WORK hands over to (b).
+
+    ``faces`` (from the checked adjacency, :func:`_skeleton`): faces[i][s] is the set
+    (bitmask) of the extreme rays y of the tangent cone T_v at V[i] with a·y = 0 for
+    a = tight[i][s].  N_v is the polar of T_v, so {w : w·y <= 0 for those y} is a
+    description of N_v by its facets; under it an extreme ray of N_v is tight on a set
+    that no other generator's strictly contains, and a generator that is not extreme (or
+    repeats a direction) lies in a face of dimension >= 2 whose extreme rays are tight on
+    strictly more (or the same) — so the tight normals are pruned to the extreme rays of
+    N_v, one per direction, and :func:`_cells_min` splits them by double description."""
     part = "vertices in the safe kernel (proof 'halfspaces', normal fan)"
     sp = _scaled_points(pts, ctx, part)
     if sp is None:
@@ -648,9 +657,15 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
     meter = [_cost(len(V) * len(P) * (d + 2), bits), budget]  # the signs / pairs
     cache: dict[tuple[int, ...], list[int]] = {}
     gbits = max((_bit_size(rows) for rows in tight), default=0)
-    for (X, e), rows, name in zip(T, tight, names):
+    for t, ((X, e), rows, name) in enumerate(zip(T, tight, names)):
         if meter[0] > meter[1]:
             break
+        zs = None
+        if faces is not None and d >= 3:
+            zf = faces[t]
+            keep = [s for s, z in enumerate(zf) if not any(
+                z2 & z == z and (z2 != z or s2 < s) for s2, z2 in enumerate(zf) if s2 != s)]
+            rows, zs = [rows[s] for s in keep], [zf[s] for s in keep]
         if d == 2:
             y1, y2 = _edge_directions([], rows, 2)
             w1, w2 = _inward_normal(y1, y2), _inward_normal(y2, y1)
@@ -664,7 +679,7 @@ def _fan_in_kernel(pts: list[Vec], F: int, V: list[Vec], tight: list[list[list[i
             try:
                 _charge(meter, len(P) * max(0, len(rows) - d), bits)  # slacks beyond d facets
                 base, signs = _crossing(P, X, e, rows, cache)
-                hit = _cells_min(base, signs, rows, d, F, meter, _bit_size(signs), gbits)
+                hit = _cells_min(base, signs, rows, d, F, meter, _bit_size(signs), gbits, zs)
             except _OverBudget:
                 break
             if hit is None:
@@ -803,6 +818,14 @@ def _split_cone(gens: list[list[int]], s: list[int]) -> list[list[int]]:
     return out
 
 
+def _split_cols(gens: list[list[int]], cols: list[tuple[int, int, int, int]]
+                ) -> list[list[int]]:
+    """The generators ti·g_j + tj·g_i named by ``cols`` (i, j, ti, tj) (as in
+    :func:`_cells_min`; (i, i, 0, 1) is g_i itself): those of :func:`_split_cone`, in its
+    order, when ``cols`` lists all its pairs."""
+    return [[ti * y + tj * x for x, y in zip(gens[i], gens[j])] for i, j, ti, tj in cols]
+
+
 def _ends(gens: list[list[int]]) -> tuple[int, int]:
     """The indices of two extreme rays of a pointed 2-dimensional cone(gens) (nonzero
     generators): the generators first and last in the orientation g <= h iff
@@ -832,7 +855,7 @@ def _ends(gens: list[list[int]]) -> tuple[int, int]:
 
 
 def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, bound: int,
-               meter: list[int], rbits: int, gbits: int
+               meter: list[int], rbits: int, gbits: int, zs: list[int] | None = None
                ) -> tuple[int, tuple[Fraction, ...]] | None:
     """(c, w) with c the smallest count ``base`` + #{q : q·w > 0} over the open cells of
     relint N (N = cone(gens), pointed, spanning a k-dimensional subspace L of R^d,
@@ -863,7 +886,17 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
     ``meter`` before it is spent, weighted by ``rbits`` and ``gbits`` (the bit sizes of
     the rows and of the generators; :func:`_cost`): per u, the classification of the
     rows on the new generators (only the two extreme rays when k = 3), the generators
-    and the next rows; beyond meter[1] :class:`_OverBudget` is raised."""
+    and the next rows; beyond meter[1] :class:`_OverBudget` is raised.
+
+    ``zs`` (optional): the gens are exactly the extreme rays of N, one per direction, and
+    zs[i] is the set (bitmask) of the inequalities y·w <= 0 of a fixed description of N
+    tight at gens[i].  Then N ∩ u^⊥ is generated by its extreme rays alone: the g with
+    u·g = 0 and the combinations of the pairs u·g_i > 0 > u·g_j adjacent in N — the
+    double description step, tested combinatorially as in :func:`_cone_rays` (no other
+    generator tight on zs[i] & zs[j]); the combination is tight exactly on zs[i] & zs[j]
+    (both terms are <= 0 on every y), and the same description restricted to u^⊥
+    describes N ∩ u^⊥.  Without it the generators of N ∩ u^⊥ are all the pairs, which
+    multiply at every level."""
     if base > bound:
         return None
     if not rows:
@@ -878,12 +911,22 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         zero = [i for i, t in enumerate(su) if t == 0]
         pos = [i for i, t in enumerate(su) if t > 0]
         cols = [(i, i, 0, 1) for i in zero]
-        cols += [(i, j, su[i], -t) for i in pos for j, t in enumerate(su) if t < 0]
+        if zs is None:
+            cols += [(i, j, su[i], -t) for i in pos for j, t in enumerate(su) if t < 0]
+        else:
+            neg = [j for j, t in enumerate(su) if t < 0]
+            _charge(meter, len(pos) * len(neg) * len(gens) // 8, 1)  # the adjacency tests
+            for i in pos:
+                for j in neg:
+                    z = zs[i] & zs[j]
+                    if z.bit_count() >= k - 2 and not any(
+                            zr & z == z for r, zr in enumerate(zs) if r != i and r != j):
+                        cols.append((i, j, su[i], -su[j]))
         i0 = pos[0]  # u·g_i0 > 0
         sub = None
         if k == 3 and len(cols) > 4:  # N ∩ u^⊥ = the cone over its two extreme rays
             _charge(meter, len(cols) * (2 * d + 4), rbits + gbits)  # the ends' products
-            sub = _split_cone(gens, su)
+            sub = _split_cols(gens, cols)
             c1, c2 = _ends(sub)
             cols, sub = [cols[c1], cols[c2]], [sub[c1], sub[c2]]
         _charge(meter, len(rows) * 2 * len(cols), rbits)
@@ -923,7 +966,7 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         # the generators (and their gcds or orientations) and the next rows
         _charge(meter, len(cols) * 3 * d + len(rest) * 2 * len(cols), rbits + gbits)
         if sub is None:
-            sub = _split_cone(gens, su)
+            sub = _split_cols(gens, cols)
         if k == 3:  # N ∩ u^⊥ is 2-dimensional: the arc between its extreme rays
             c1, c2 = _ends(sub) if len(sub) > 2 else (0, len(sub) - 1)
             (i1, j1, t1, u1), (i2, j2, t2, u2) = cols[c1], cols[c2]
@@ -938,8 +981,9 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
             nrows = [[cols[c][2] * r[cols[c][1]] + cols[c][3] * r[cols[c][0]] for c in keep]
                      for r in rest]
             ngens = [sub[c] for c in keep]
+            nzs = None if zs is None else [zs[cols[c][0]] & zs[cols[c][1]] for c in keep]
             hit = _cells_min(on, nrows, ngens, k - 1, bound - m, meter, _bit_size(nrows),
-                             _bit_size(ngens))
+                             _bit_size(ngens), nzs)
             if hit is not None:  # its count is <= bound - m
                 best = (m + hit[0], hit[1])
                 bound = best[0] - 1
@@ -1302,7 +1346,8 @@ def _cone_rays(BE: list[list[int]], tight: list[list[int]], d: int,
 
 
 def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d: int,
-              V: list[Vec], incidence: list[list[int]], adj: Any, ctx: Any) -> bool:
+              V: list[Vec], incidence: list[list[int]], adj: Any, ctx: Any,
+              keys: list[list[int]] | None = None) -> bool:
     """P = conv(V) from the vertex adjacency (``adjacency[i]``: the vertices joined to
     V[i] by an edge of P), given V ⊆ P with rank-d tight rows at each v (so the tangent
     cone T_v = {y : E·y = 0, a·y <= 0 for the facets tight at v} is pointed and generated
@@ -1366,6 +1411,8 @@ def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d
                 y = tuple(-x for x in y)
             raise Invalid(f"adjacency[{i}]: no vertex listed along the edge of P at "
                           f"vertices[{i}] in direction {_fmtv(y)}")
+        if keys is not None:
+            keys.append(list(rays))
     return True
 
 
@@ -1567,7 +1614,7 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
                   "checked (the enumeration relies on the vertex test)")
         spanned = False
     elif "adjacency" in c:
-        spanned = _skeleton(Ei, Fi, d, V, incidence, c["adjacency"], ctx)
+        spanned = _skeleton(Ei, Fi, d, V, incidence, c["adjacency"], ctx, rayz := [])
     else:
         spanned = _poly_enumeration(Ei, Fi, d, set(V), ctx)
     _check_dim(V, dim)
@@ -1583,8 +1630,13 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
     elif spanned and d == dim and d >= 2:
         # a zero normal (0·x <= b, tight when b = 0) adds nothing to N_v: dropped, as
         # the d = 3 sweep needs nonzero generators of N_v ∩ u^⊥
-        how = _fan_in_kernel(pts, F, V, [[Fi[j][0] for j in on if any(Fi[j][0])]
-                                         for on in incidence], names, ctx)
+        nz = [[s for s, j in enumerate(on) if any(Fi[j][0])] for on in incidence]
+        faces = None
+        if "adjacency" in c:  # per tight normal: the extreme rays of T_v it vanishes on
+            faces = [[sum(1 << r for r, z in enumerate(zv) if z >> s & 1) for s in ss]
+                     for ss, zv in zip(nz, rayz)]
+        how = _fan_in_kernel(pts, F, V, [[Fi[on[s]][0] for s in ss]
+                                         for ss, on in zip(nz, incidence)], names, ctx, faces)
     else:
         how = _in_kernel_halfspaces(pts, F, V, names, ctx, "vertices")
     nv = f"{len(V)} vertex" if len(V) == 1 else f"{len(V)} vertices"

@@ -118,3 +118,114 @@ def test_double_description_meter_stops_it():
     rows = _cone("cube", 5, random.Random(1))
     with pytest.raises(kernels._OverBudget):
         kernels._cone_rays([], rows, 5, [0, 100], 1)
+
+
+# --------------------------------------------------------------------------- #
+# whole certificates in d = 5
+# --------------------------------------------------------------------------- #
+
+
+def _bench(family: str, d: int, n: int, F: int) -> dict:
+    import rescon
+    from benchmarks.kernel_clouds import make_cloud
+
+    return rescon.safe_kernel(make_cloud(family, d, n, F).X, F).certificate
+
+
+@pytest.fixture(scope="module")
+def cert5() -> dict:
+    """gaussian(d = 5, n = 10, F = 1): 186 vertices, some degenerate (the adjacency was
+    beyond MAX_POLY_WORK by the C(t, 4) enumeration: "unchecked" before issue 13 §4)."""
+    return _bench("gaussian", 5, 10, 1)
+
+
+def _check(cert: dict):
+    import copy
+
+    from rescon_certificates.check import check
+
+    return check(copy.deepcopy(cert))
+
+
+def test_d5_bench_certificate_is_valid(cert5):
+    res = _check(cert5)
+    assert res.verdict == "valid", res.unchecked or res.reason
+    assert "normal fan" in res.reason
+
+
+def _simple_and_degenerate(cert: dict) -> tuple[int, int]:
+    """A vertex with d tight facets and one with more."""
+    from fractions import Fraction
+
+    d = len(cert["points"][0])
+    fac = [([Fraction(x) for x in f["a"]], Fraction(f["b"])) for f in cert["facets"]]
+    tight = [sum(sum(x * Fraction(y) for x, y in zip(a, v)) == b for a, b in fac)
+             for v in cert["vertices"]]
+    simple = next(i for i, t in enumerate(tight) if t == d)
+    degen = max(range(len(tight)), key=tight.__getitem__)
+    assert tight[degen] > d
+    return simple, degen
+
+
+@pytest.mark.parametrize("which", [0, 1])
+def test_d5_adjacency_tampering_is_refuted(cert5, which):
+    import copy
+
+    i = _simple_and_degenerate(cert5)[which]
+    adj = cert5["adjacency"]
+    # a neighbour removed
+    c = copy.deepcopy(cert5)
+    c["adjacency"][i] = adj[i][1:]
+    res = _check(c)
+    assert res.verdict == "invalid" and "no vertex listed along the edge" in res.reason
+    # a wrong neighbour (a vertex not joined to vertices[i]), or vertices[i] itself
+    far = next(j for j in range(len(adj)) if j != i and j not in adj[i])
+    for bad in (far, i):
+        c = copy.deepcopy(cert5)
+        c["adjacency"][i] = [bad] + adj[i][1:]
+        res = _check(c)
+        assert res.verdict == "invalid" and "not joined" in res.reason, res.reason
+    # a neighbour listed twice
+    c = copy.deepcopy(cert5)
+    c["adjacency"][i] = adj[i] + adj[i][:1]
+    res = _check(c)
+    assert res.verdict == "invalid" and "same edge" in res.reason, res.reason
+
+
+@pytest.mark.parametrize("which", [0, 1])
+def test_d5_missing_or_moved_vertex_is_refuted(cert5, which):
+    import copy
+    from fractions import Fraction
+
+    i = _simple_and_degenerate(cert5)[which]
+    # vertices[i] left out (its edges' other ends lose a neighbour)
+    c = copy.deepcopy(cert5)
+    del c["vertices"][i]
+    c["adjacency"] = [[j - (j > i) for j in a if j != i]
+                      for t, a in enumerate(cert5["adjacency"]) if t != i]
+    res = _check(c)
+    assert res.verdict == "invalid", res.reason
+    # vertices[i] moved a little
+    c = copy.deepcopy(cert5)
+    v = [Fraction(x) for x in c["vertices"][i]]
+    v[0] += Fraction(1, 10**40)
+    c["vertices"][i] = [str(x) for x in v]
+    res = _check(c)
+    assert res.verdict == "invalid", res.reason
+
+
+def test_d5_fan_pruning_agrees_with_the_enumeration(monkeypatch, cert5):
+    """The normal fan with its generators pruned to extreme rays (faces from the
+    adjacency) against (b), on the kernel and on a false claim (Ψ for F = 2)."""
+    import copy
+
+    from rescon_certificates.check import check
+
+    for cert, want in ((cert5, "valid"), ({**copy.deepcopy(cert5), "F": 2}, "invalid")):
+        assert _check(cert).verdict == want
+        with monkeypatch.context() as m:
+            m.setattr(kernels, "_fan_in_kernel",
+                      lambda pts, F, V, tight, names, ctx, *_:
+                      kernels._in_kernel_halfspaces(pts, F, V, names, ctx, "vertices"))
+            m.setattr(kernels, "MAX_HALFSPACE_WORK", 10**9)
+            assert check(copy.deepcopy(cert)).verdict == want

@@ -25,7 +25,7 @@ def _by_enumeration(monkeypatch, cert: dict):
     """check(cert) with V ⊆ Ψ decided by (b) instead of the normal fan."""
     with monkeypatch.context() as m:
         m.setattr(kernels, "_fan_in_kernel",
-                  lambda pts, F, V, tight, names, ctx:
+                  lambda pts, F, V, tight, names, ctx, *_:
                   kernels._in_kernel_halfspaces(pts, F, V, names, ctx, "vertices"))
         m.setattr(kernels, "MAX_HALFSPACE_WORK", 10**9)
         return check(copy.deepcopy(cert))

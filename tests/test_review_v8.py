@@ -331,7 +331,7 @@ def _by_enumeration(cert: dict):
 
     with pytest.MonkeyPatch.context() as m:
         m.setattr(kernels, "_fan_in_kernel",
-                  lambda pts, F, V, tight, names, ctx:
+                  lambda pts, F, V, tight, names, ctx, *_:
                   kernels._in_kernel_halfspaces(pts, F, V, names, ctx, "vertices"))
         m.setattr(kernels, "MAX_HALFSPACE_WORK", 10**9)
         return check(copy.deepcopy(cert))
