@@ -963,8 +963,10 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
         m = base + min(same, opposite)
         if m + on > bound:
             continue
-        # the generators (and their gcds or orientations) and the next rows
-        _charge(meter, len(cols) * 3 * d + len(rest) * 2 * len(cols), rbits + gbits)
+        # the generators (and their gcds or orientations) and the next rows: products of
+        # a row entry by a generator's or another row's entry (as the classification's
+        # products of two row entries above, charged at the larger operand)
+        _charge(meter, len(cols) * 3 * d + len(rest) * 2 * len(cols), max(rbits, gbits))
         if sub is None:
             sub = _split_cols(gens, cols)
         if k == 3:  # N ∩ u^⊥ is 2-dimensional: the arc between its extreme rays
@@ -1305,13 +1307,18 @@ def _cone_rays(BE: list[list[int]], tight: list[list[int]], d: int,
                 break
     if len(S) < k:
         raise ValueError("the tight rows do not have rank d")  # not reached: checked before
-    _charge(meter, k * (_normal_steps(d) + 2 * d), d * bits)
+    M = BE + [tight[i] for i in S]
+    _charge(meter, 3 * d ** 3, d * bits)  # the scaled inverse, and each ray's check
+    Dm, X = _scaled_inverse(M)
     rays: list[list[int]] = []
     Z: list[int] = []
-    for j in S:
-        y = _normal(BE + [tight[i] for i in S if i != j], d)
-        if _dot(tight[j], y) > 0:
-            y = [-t for t in y]
+    for t, j in enumerate(S):
+        # minus column |BE| + t of M^-1: zero on BE and on S but row j, negative on row j
+        y = [-x if Dm > 0 else x for x in (row[len(BE) + t] for row in X)]
+        if any(_dot(M[r], y) for r in range(d) if r != len(BE) + t) or _dot(tight[j], y) >= 0:
+            y = _normal(BE + [tight[i] for i in S if i != j], d)  # not reached
+            if _dot(tight[j], y) > 0:
+                y = [-x for x in y]
         rays.append(list(_primitive(y)))
         Z.append(sum(1 << i for i in S if i != j))
     done = set(S)
@@ -1343,6 +1350,25 @@ def _cone_rays(BE: list[list[int]], tight: list[list[int]], d: int,
                 nZ.append(z | bit)
         rays, Z = nrays, nZ
     return {z: tuple(r) for z, r in zip(Z, rays)}
+
+
+def _scaled_inverse(M: list[list[int]]) -> tuple[int, list[list[int]]]:
+    """(D, X) with M·X = D·I for a nonsingular square integer M, D = ±det M, by
+    fraction-free Gauss–Jordan elimination of [M | I] (Bareiss: every division is
+    exact); the caller checks what it uses (:func:`_cone_rays` checks each column)."""
+    m = len(M)
+    A = [list(r) + [int(i == j) for j in range(m)] for i, r in enumerate(M)]
+    prev = 1
+    for i in range(m):
+        p = next(r for r in range(i, m) if A[r][i])
+        A[i], A[p] = A[p], A[i]
+        Ai, piv = A[i], A[i][i]
+        for r in range(m):
+            if r != i:
+                Ar, f = A[r], A[r][i]
+                A[r] = [(piv * x - f * y) // prev for x, y in zip(Ar, Ai)]
+        prev = piv
+    return prev, [r[m:] for r in A]
 
 
 def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d: int,
