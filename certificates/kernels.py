@@ -1562,26 +1562,47 @@ def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], in
     at it have rank d (v is a vertex of P); returns, per vertex, the indices of the
     facets tight at it (the vertex–facet incidence).  Costs #V x #constraints products,
     weighted by bit size; beyond MAX_EVAL_WORK the part is recorded as unchecked and None
-    is returned (the vertex enumeration and the skeleton rely on it)."""
+    is returned (the vertex enumeration and the skeleton rely on it).  Beyond it with the
+    float filter on, the work is charged as it runs instead: d float steps per facet and
+    vertex (the filter), the exact products only for the slacks it leaves, and the rank."""
     SV = [(_int_vector(v), _den_lcm([v])) for v in V]
     bits = max(_bit_size([a + [b] for a, b in Ei + Fi]),
                _bit_size([X + [e] for X, e in SV]))
     work = _cost(len(V) * (len(Ei) + len(Fi) + d * d), 2 * bits)
-    if work > MAX_EVAL_WORK:
+    rows_f = _float_rows(Fi) if VERTEX_FILTERS else None
+    meter = [0, MAX_EVAL_WORK] if work > MAX_EVAL_WORK and rows_f is not None else None
+    if work > MAX_EVAL_WORK and meter is None:
         ctx.trust("vertex test", f"vertices: each a vertex of P ({len(V)} vertices, "
                   f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work {work} > "
                   f"{MAX_EVAL_WORK}")
         return None
-    rows_f = _float_rows(Fi) if VERTEX_FILTERS else None
     incidence: list[list[int]] = []
     for i, ((X, Dv), v) in enumerate(zip(SV, V)):
-        for j, (a, f) in enumerate(Ei):
-            if _dot(a, X) != f * Dv:
-                raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
+        over = False
+        if meter is not None:
+            try:  # the filter, the equalities and the rank
+                _charge(meter, len(Fi) * d, 1)
+                _charge(meter, len(Ei) + d * d, 2 * bits)
+            except _OverBudget:
+                over = True
+        if not over:
+            for j, (a, f) in enumerate(Ei):
+                if _dot(a, X) != f * Dv:
+                    raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
+            fv = _float_vertex(X, Dv) if rows_f is not None else None
+            # facets proved strictly slack by the filter are neither violated nor tight
+            inside = _surely_inside(rows_f, *fv) if fv is not None else [False] * len(Fi)
+            if meter is not None:
+                try:  # the exact slacks the filter leaves
+                    _charge(meter, inside.count(False), 2 * bits)
+                except _OverBudget:
+                    over = True
+        if over:
+            ctx.trust("vertex test", f"vertices: each a vertex of P ({len(V)} vertices, "
+                      f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work > "
+                      f"{MAX_EVAL_WORK}")
+            return None
         on: list[int] = []
-        fv = _float_vertex(X, Dv) if rows_f is not None else None
-        # facets proved strictly slack by the filter are neither violated nor tight
-        inside = _surely_inside(rows_f, *fv) if fv is not None else [False] * len(Fi)
         for j, (a, g) in enumerate(Fi):
             if inside[j]:
                 continue

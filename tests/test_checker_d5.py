@@ -229,3 +229,54 @@ def test_d5_fan_pruning_agrees_with_the_enumeration(monkeypatch, cert5):
                       kernels._in_kernel_halfspaces(pts, F, V, names, ctx, "vertices"))
             m.setattr(kernels, "MAX_HALFSPACE_WORK", 10**9)
             assert check(copy.deepcopy(cert)).verdict == want
+
+
+def _vertex_test_inputs(cert: dict):
+    from fractions import Fraction
+
+    d = len(cert["points"][0])
+    Ei = [kernels._int_constraint(tuple(Fraction(x) for x in e["a"]), Fraction(e["b"]))
+          for e in cert["equalities"]]
+    Fi = [kernels._int_constraint(tuple(Fraction(x) for x in f["a"]), Fraction(f["b"]))
+          for f in cert["facets"]]
+    V = [tuple(Fraction(x) for x in v) for v in cert["vertices"]]
+    return Ei, Fi, V, d
+
+
+class _Ctx:
+    def __init__(self) -> None:
+        self.parts: list[str] = []
+
+    def trust(self, name: str, part: str) -> None:
+        self.parts.append(part)
+
+
+@pytest.mark.slow
+def test_vertex_test_meter_runs_past_the_a_priori_estimate(monkeypatch):
+    """The vertex test beyond its a-priori estimate (#V x #constraints at the full bit
+    size): with the float filter it is charged as it runs and decides (unchecked
+    before: d = 5, n = 20, F = 2 needed 2.3·10^7 > 2·10^7 by the estimate); without the
+    filter, or with too small a limit, it stays unchecked; a moved vertex is refuted."""
+    from fractions import Fraction
+
+    Ei, Fi, V, d = _vertex_test_inputs(_bench("gaussian", 5, 20, 2))
+    monkeypatch.setattr(kernels, "MAX_EVAL_WORK", 10**9)
+    ref = kernels._vertices_of_p(Ei, Fi, V, d, _Ctx())
+    bits = max(kernels._bit_size([a + [b] for a, b in Ei + Fi]),
+               kernels._bit_size([kernels._int_vector(v) + [kernels._den_lcm([v])] for v in V]))
+    est = kernels._cost(len(V) * (len(Ei) + len(Fi) + d * d), 2 * bits)
+    assert est > 20_000_000  # the real limit
+    monkeypatch.setattr(kernels, "MAX_EVAL_WORK", 20_000_000)
+    ctx = _Ctx()
+    assert kernels._vertices_of_p(Ei, Fi, V, d, ctx) == ref and not ctx.parts
+    bad = list(V)
+    bad[3] = (bad[3][0] + Fraction(1, 10**30),) + bad[3][1:]
+    with pytest.raises(kernels.Invalid):
+        kernels._vertices_of_p(Ei, Fi, bad, d, _Ctx())
+    monkeypatch.setattr(kernels, "MAX_EVAL_WORK", est // 20)
+    ctx = _Ctx()
+    assert kernels._vertices_of_p(Ei, Fi, V, d, ctx) is None and ctx.parts
+    monkeypatch.setattr(kernels, "MAX_EVAL_WORK", 20_000_000)
+    monkeypatch.setattr(kernels, "VERTEX_FILTERS", False)
+    ctx = _Ctx()
+    assert kernels._vertices_of_p(Ei, Fi, V, d, ctx) is None and ctx.parts
