@@ -1386,14 +1386,19 @@ def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d
     V: P is bounded and P = conv(V) (a point of P outside conv(V) would be separated by
     some c).
 
-    The extreme rays of T_v: at a simple v (t_v = k = d − r_E tight facets, independent
-    modulo E as the tight rows have rank d) T_v is simplicial, its extreme rays are the
-    k directions u ≠ 0 in T_v on which exactly k − 1 tight facets vanish, one per facet
-    left nonzero — so a listed neighbour w is checked by the signs of a·(w − v) alone.
-    Otherwise :func:`_cone_rays` (double description) finds them.  Work, charged as it
-    runs, bit-weighted: t_v·d products per listed neighbour at a simple vertex, the
-    double description's elsewhere; beyond MAX_POLY_WORK unchecked (returns False); True
-    when verified."""
+    Matching by tight sets: an extreme ray y is named by Z(y), the tight facets with
+    a·y = 0 (rank k − 1 with E, k = d − r_E; its face {y' ∈ T_v : a·y' = 0 on Z(y)} is
+    the ray itself).  For a listed w ≠ v, w − v ∈ T_v (w ∈ P) and a·(w − v) = 0 iff the
+    tight facet a of v is tight at w too, so w − v is a positive multiple of y iff those
+    facets (the incidence of :func:`_vertices_of_p`, exact) are exactly Z(y): no
+    arithmetic.  The Z(y): at a simple v (t_v = k tight facets, independent modulo E as
+    the tight rows have rank d) T_v is simplicial and they are the k sets "all tight
+    facets but one"; otherwise :func:`_cone_rays` (double description) finds the rays
+    with their Z.  ``keys`` (if given) receives, per vertex, the Z(y) of its rays (as
+    bitmasks over the positions in ``incidence[i]``; the normal fan uses them).  Work,
+    charged as it runs: t_v per listed neighbour, the double description's at the
+    non-simple vertices; beyond MAX_POLY_WORK unchecked (returns False); True when
+    verified."""
     _array(adj, "adjacency")
     if len(adj) != len(V):
         raise Invalid(f"adjacency has {len(adj)} entries, expected one per vertex ({len(V)})")
