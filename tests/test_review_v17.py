@@ -165,12 +165,10 @@ def test_hostile_graphs_exact_and_kernels_equal_the_clipping(name, monkeypatch):
     assert [set(e) for e in got["edges"]] == _exact_graph(got)
     K = _same_as_clipping(X, F, monkeypatch)
     verdict = rescon.check_certificate(K.certificate).verdict
-    # 2^-1060-scaled data exceed the checker's bit-size limits, the d = 5 kernels' ~10³
-    # vertices its work limit, and so do the 1934-bit numbers at 2^±600 (mixed_columns_4:
-    # the fast path takes it since its columns are shifted to one magnitude, moved here
-    # from the test below): "unchecked" there, never "invalid"
-    assert verdict == ("unchecked" if name in ("subnormal_4", "mixed_columns_4")
-                       or name.endswith("5") else "valid")
+    # the 2^-1060-scaled data, the d = 5 kernels' ~10³ vertices and the 1934-bit numbers
+    # at 2^±600 (mixed_columns_4) were "unchecked" (the adjacency's C(t, d − 1) ray
+    # enumeration beyond its limit) before issue 13 §4's double description: valid now
+    assert verdict == "valid"
 
 
 @pytest.mark.parametrize("name", ["collapsed_4", "tiny_n5_F0_4", "tiny_n6_F1_4", "tiny_n7_F1_4",
