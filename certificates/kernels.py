@@ -49,7 +49,7 @@ MAX_EVAL_WORK = 20_000_000  # (#constraints) * n, evaluating constraints at the 
 MAX_RATIONAL_CHARS = 100_000  # longest "p/q" string (exact vertex means get long)
 #: C(u, k) * (u + #test points + normal cost) for (b); beyond: unchecked
 MAX_HALFSPACE_WORK = 4_000_000
-MAX_POLY_WORK = 3_000_000  # vertex / ray enumeration of P; beyond: unchecked
+MAX_POLY_WORK = 10_000_000  # vertex / ray enumeration of P; beyond: unchecked
 #: d >= 4: the normal fan's share, in multiples of (b)'s work, before (b) takes over
 FAN_OVER_ENUMERATION = 50
 MAX_NUMBER_BITS = 32_768  # numerator / denominator of one input rational; beyond: unchecked
@@ -806,23 +806,13 @@ def _charge(meter: list[int], steps: int, bits: int) -> None:
         raise _OverBudget
 
 
-def _split_cone(gens: list[list[int]], s: list[int]) -> list[list[int]]:
-    """Generators of cone(gens) ∩ u^⊥, given s = [u·g for g in gens] (u^⊥ through the
-    relative interior of the pointed cone): the g with u·g = 0 and (u·g_i)·g_j −
-    (u·g_j)·g_i for u·g_i > 0 > u·g_j (a point Σ λ_g g of u^⊥, λ >= 0, pairs its positive
-    and negative terms into such combinations)."""
-    out = [g for g, t in zip(gens, s) if t == 0]
-    pos = [(g, t) for g, t in zip(gens, s) if t > 0]
-    out += [[ti * y - tj * x for x, y in zip(gi, gj)]
-            for gi, ti in pos for gj, tj in zip(gens, s) if tj < 0]
-    return out
-
-
 def _split_cols(gens: list[list[int]], cols: list[tuple[int, int, int, int]]
                 ) -> list[list[int]]:
     """The generators ti·g_j + tj·g_i named by ``cols`` (i, j, ti, tj) (as in
-    :func:`_cells_min`; (i, i, 0, 1) is g_i itself): those of :func:`_split_cone`, in its
-    order, when ``cols`` lists all its pairs."""
+    :func:`_cells_min`; (i, i, 0, 1) is g_i itself).  With the g where u·g = 0 and every
+    pair ti = u·g_i > 0 > −tj = u·g_j they generate cone(gens) ∩ u^⊥ (u^⊥ through the
+    relative interior of the pointed cone): a point Σ λ_g g of u^⊥, λ >= 0, pairs its
+    positive and negative terms into such combinations."""
     return [[ti * y + tj * x for x, y in zip(gens[i], gens[j])] for i, j, ti, tj in cols]
 
 
@@ -869,7 +859,7 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
     interior of that facet lies in relint(N ∩ q^⊥) and meets no other hyperplane q'^⊥
     unless q' ∥ q on L, so it lies in one cell C' of the arrangement in relint(N ∩ q^⊥)
     cut by the other points, and C is the cell beside C' on its side.  So, for u = q:
-    N ∩ u^⊥ = cone(:func:`_split_cone`) spans L ∩ u^⊥ (dimension k − 1, as u^⊥ meets
+    N ∩ u^⊥ = cone(:func:`_split_cols`) spans L ∩ u^⊥ (dimension k − 1, as u^⊥ meets
     relint N); the points vanishing on it are ∥ u on L ("same" if they have u's sign on
     a generator g with u·g ≠ 0 — u itself is — else "opposite"), the others are
     classified on it again (counted on all of it, on none, or crossing), and the cells
@@ -906,7 +896,7 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
     for su in rows:
         if bound < base:
             break
-        # the generators of N ∩ u^⊥ (:func:`_split_cone`) as columns: q·g_i for u·g_i = 0,
+        # the generators of N ∩ u^⊥ (:func:`_split_cols`) as columns: q·g_i for u·g_i = 0,
         # ti·(q·g_j) + tj·(q·g_i) for ti = u·g_i > 0, tj = −u·g_j > 0
         zero = [i for i, t in enumerate(su) if t == 0]
         pos = [i for i, t in enumerate(su) if t > 0]

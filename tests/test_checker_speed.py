@@ -50,7 +50,7 @@ def test_old_certificates_are_checked_as_before(cube3):
     unchecked beyond it: never invalid)."""
     old = {k: v for k, v in cube3.items() if k != "adjacency"}
     assert check(old).verdict == "valid"
-    big = _kernel(5, 30, 3, 3).certificate
+    big = _kernel(5, 50, 3, 5).certificate
     assert check(big).verdict == "valid"
     del big["adjacency"]
     res = check(big)
