@@ -356,7 +356,7 @@ def test_correct_certificates_are_valid(name, d, F):
     for how, v in _variants(c):
         res = check(v)
         if (name, d, F, how) == ("mixed", 5, 1, "zero facet"):
-            assert res.verdict == "unchecked", res.reason
+            assert res.verdict in ("valid", "unchecked"), res.reason  # valid once fixed
             continue
         assert res.verdict == "valid", (how, res.verdict, res.reason, res.unchecked)
 
@@ -371,6 +371,20 @@ def test_zero_facet_keeps_simple_vertices_simple():
     c = _cert("mixed", 5, 1)
     d = len(c["points"][0])
     c["facets"] = c["facets"] + [{"a": ["0"] * d, "b": "0"}]
+    res = check(c)
+    assert res.verdict == "valid", res.unchecked
+
+
+@pytest.mark.xfail(strict=True, reason="V19: kernels._int_constraint clears denominators "
+                   "but keeps a common factor, so facets written as 2^3000·(a, b) (the "
+                   "same halfspaces) make the fan's generators 3000-bit (gbits): cube(5) "
+                   "F = 4 goes valid (1.1 CPU-s) -> 'unchecked' (fan work > 2·10^7); "
+                   "divide each integer row (a, b) by the gcd of its entries there")
+def test_facets_with_a_common_factor_cost_nothing():
+    c = _cert("cube", 5, 4)
+    s = Fraction(2 ** 3000)
+    c["facets"] = [{"a": [str(Fraction(x) * s) for x in f["a"]], "b": str(Fraction(f["b"]) * s)}
+                   for f in c["facets"]]
     res = check(c)
     assert res.verdict == "valid", res.unchecked
 
