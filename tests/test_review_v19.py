@@ -389,6 +389,21 @@ def test_facets_with_a_common_factor_cost_nothing():
     assert res.verdict == "valid", res.unchecked
 
 
+@pytest.mark.xfail(strict=True, reason="V19: kernels._cells_min tries every crossing row "
+                   "as the hyperplane u, duplicates included, and each copy repeats the "
+                   "same subproblem at every level: cube(5) doubled (n = 64, F = 9, the "
+                   "kernel of cube(5), F = 4, valid in ~1 CPU-s) runs out of the fan's "
+                   "2·10^7 -> 'unchecked'; skip a u whose primitive row was already "
+                   "split (same hyperplane on L; measured valid in 1.3 CPU-s, tripled 1.7)")
+def test_duplicated_points_do_not_multiply_the_fan():
+    import rescon
+
+    cube = np.array(list(itertools.product((-1, 1), repeat=5)), float)
+    c = rescon.safe_kernel(np.vstack([cube, cube]), 9).certificate
+    res = check(c)
+    assert res.verdict == "valid", res.unchecked
+
+
 def _by_enumeration(cert: dict, monkeypatch) -> str:
     with monkeypatch.context() as m:
         m.setattr(kernels, "_fan_in_kernel", lambda pts, F, V, tight, names, ctx, *_:
