@@ -264,9 +264,13 @@ def _scaled(vectors: list[Vec], D: int) -> list[list[int]]:
 
 
 def _int_constraint(a: Vec, b: Fraction) -> tuple[list[int], int]:
-    """(A, B) = s * (a, b) with integer entries, s > 0: same halfspace / hyperplane."""
+    """(A, B) = s * (a, b) with coprime integer entries, s > 0: the same halfspace /
+    hyperplane (a common factor would only inflate every product that uses the row)."""
     s = _den_lcm([a + (b,)])
     row = _scaled([a + (b,)], s)[0]
+    g = math.gcd(*row)
+    if g > 1:
+        row = [x // g for x in row]
     return row[:-1], row[-1]
 
 
@@ -886,16 +890,26 @@ def _cells_min(base: int, rows: list[list[int]], gens: list[list[int]], k: int, 
     generator tight on zs[i] & zs[j]); the combination is tight exactly on zs[i] & zs[j]
     (both terms are <= 0 on every y), and the same description restricted to u^⊥
     describes N ∩ u^⊥.  Without it the generators of N ∩ u^⊥ are all the pairs, which
-    multiply at every level."""
+    multiply at every level.
+
+    A row that is a positive multiple of one already split (a repeated point, or points
+    on one ray from v) names the same hyperplane u^⊥ ∩ L and the same cells beside it:
+    it is skipped (each copy would repeat the whole subproblem)."""
     if base > bound:
         return None
     if not rows:
         return base, tuple(Fraction(sum(col)) for col in zip(*gens))
     d = len(gens[0])
     best: tuple[int, tuple[Fraction, ...]] | None = None
+    split: set[tuple[int, ...]] = set()
     for su in rows:
         if bound < base:
             break
+        _charge(meter, len(su), rbits)  # the row's primitive form
+        key = _primitive(su)
+        if key in split:
+            continue
+        split.add(key)
         # the generators of N ∩ u^⊥ (:func:`_split_cols`) as columns: q·g_i for u·g_i = 0,
         # ti·(q·g_j) + tj·(q·g_i) for ti = u·g_i > 0, tj = −u·g_j > 0
         zero = [i for i, t in enumerate(su) if t == 0]
@@ -1262,7 +1276,8 @@ def _cone_rays(BE: list[list[int]], tight: list[list[int]], d: int,
     :func:`_edge_directions` finds — and Z(r) the bitmask of the rows with a·r = 0 (bit i
     for tight[i]), by the double description method (Motzkin et al.), output-sensitive.
     Work is charged to ``meter`` (:func:`_charge`; ``bits``: the rows' bit size) before
-    it is spent; beyond meter[1] :class:`_OverBudget` is raised.
+    it is spent — each adjacency scan as far as it went, when it stops (one scan of the
+    rays at most beyond the budget); beyond meter[1] :class:`_OverBudget` is raised.
 
     Let k = d − |BE| (the dimension of L = null(BE)).  Start: k rows S with [BE; S]
     nonsingular; C_S = {y ∈ L : a·y <= 0, a ∈ S} is simplicial, its extreme rays are the
@@ -1326,13 +1341,18 @@ def _cone_rays(BE: list[list[int]], tight: list[list[int]], d: int,
         neg = [t for t, x in enumerate(s) if x < 0]
         nrays = [r for r, x in zip(rays, s) if x <= 0]
         nZ = [z | bit if x == 0 else z for z, x in zip(Z, s) if x <= 0]
-        _charge(meter, len(pos) * len(neg) * len(rays) // 8, 1)  # the adjacency tests
+        _charge(meter, len(pos) * len(neg) // 8 + 1, 1)  # the pairs' rank filter
         for p in pos:
             zp, sp, rp = Z[p], s[p], rays[p]
             for q in neg:
                 z = zp & Z[q]
-                if z.bit_count() < k - 2 or any(
-                        zr & z == z for t, zr in enumerate(Z) if t != p and t != q):
+                if z.bit_count() < k - 2:
+                    continue
+                # the adjacency test: a third ray tight on z? (charged as far as it scans)
+                hit = next((t for t, zr in enumerate(Z) if zr & z == z and t != p and t != q),
+                           None)
+                _charge(meter, (len(Z) if hit is None else hit + 1) // 8 + 1, 1)
+                if hit is not None:
                     continue
                 _charge(meter, 3 * d, rbits)
                 sq, rq = s[q], rays[q]
@@ -1381,11 +1401,13 @@ def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d
     the ray itself).  For a listed w ≠ v, w − v ∈ T_v (w ∈ P) and a·(w − v) = 0 iff the
     tight facet a of v is tight at w too, so w − v is a positive multiple of y iff those
     facets (the incidence of :func:`_vertices_of_p`, exact) are exactly Z(y): no
-    arithmetic.  The Z(y): at a simple v (t_v = k tight facets, independent modulo E as
-    the tight rows have rank d) T_v is simplicial and they are the k sets "all tight
-    facets but one"; otherwise :func:`_cone_rays` (double description) finds the rays
-    with their Z.  ``keys`` (if given) receives, per vertex, the Z(y) of its rays (as
-    bitmasks over the positions in ``incidence[i]``; the normal fan uses them).  Work,
+    arithmetic.  The Z(y): at a simple v (k distinct nonzero tight rows — rows are
+    primitive, so a repeated halfspace is an equal row, and a zero row is tight on every
+    y — independent modulo E as the tight rows have rank d) T_v is simplicial and they
+    are the k sets "all tight facets but the copies of one row"; otherwise
+    :func:`_cone_rays` (double description) finds the rays with their Z.  ``keys`` (if
+    given) receives, per vertex, the Z(y) of its rays (as bitmasks over the positions in
+    ``incidence[i]``; the normal fan uses them).  Work,
     charged as it runs: t_v per listed neighbour, the double description's at the
     non-simple vertices; beyond MAX_POLY_WORK unchecked (returns False); True when
     verified."""
@@ -1403,10 +1425,14 @@ def _skeleton(E: list[tuple[list[int], int]], Fc: list[tuple[list[int], int]], d
         rows = [Fc[j][0] for j in on]
         try:
             _charge(meter, len(on) * (len(nbrs) + 1), 1)  # the tight sets Z(w − v)
-            if len(on) == k:  # simple: T_v's rays have the Z sets "all but one facet"
-                full = (1 << k) - 1
-                rays: dict[int, tuple[int, ...] | None] = {full ^ (1 << t): None
-                                                           for t in range(k)}
+            copies: dict[tuple[int, ...], int] = {}
+            for t, a in enumerate(rows):
+                if any(a):
+                    copies[tuple(a)] = copies.get(tuple(a), 0) | 1 << t
+            if len(copies) == k:  # simple: T_v's rays have the Z sets "all but one row"
+                full = (1 << len(on)) - 1
+                rays: dict[int, tuple[int, ...] | None] = {full ^ z: None
+                                                           for z in copies.values()}
             else:
                 rays = _cone_rays(BE, rows, d, meter, bits)
         except _OverBudget:

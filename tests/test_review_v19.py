@@ -202,13 +202,9 @@ def test_cone_rays_many_rays_correct_and_metered():
     assert time.process_time() - t0 < 20
 
 
-@pytest.mark.xfail(strict=True, reason="V19: _cone_rays charges every pos×neg pair the "
-                   "full len(rays)/8 scan although the bit_count filter and the early "
-                   "exit of any() make the real scan 28–66× smaller: T_v with 40 tight "
-                   "facets in d = 5 (740 rays, ~0.1 CPU-s, 5·10^5 rays scanned) is "
-                   "charged 1.4·10^7 > MAX_POLY_WORK -> 'unchecked'; charge the rays "
-                   "actually scanned, per pair that passes the filter")
 def test_cone_rays_charge_is_not_far_above_the_real_work():
+    """V19: every pos × neg pair was charged a full scan of the rays (28–66× the scan
+    done): 40 tight facets in d = 5 (740 rays, ~0.1 CPU-s) were 'unchecked'."""
     rows = _cyclic_polar(40)
     meter = [0, kernels.MAX_POLY_WORK]
     got = kernels._cone_rays([], rows, 5, meter, kernels._bit_size(rows))
@@ -361,13 +357,9 @@ def test_correct_certificates_are_valid(name, d, F):
         assert res.verdict == "valid", (how, res.verdict, res.reason, res.unchecked)
 
 
-@pytest.mark.xfail(strict=True, reason="V19: a facet 0·x <= 0 (tight at every vertex, "
-                   "adds nothing to T_v) makes every vertex non-simple in "
-                   "kernels._skeleton (len(on) == k fails), so the double description "
-                   "runs at all 210 vertices on 2228-bit rows: > MAX_POLY_WORK, "
-                   "'unchecked' for a certificate that is valid without it; drop zero "
-                   "(and repeated) rows from `rows`/`on` before the simple test")
 def test_zero_facet_keeps_simple_vertices_simple():
+    """V19: a facet 0·x <= 0 made every vertex non-simple (double description at all of
+    them: 'unchecked')."""
     c = _cert("mixed", 5, 1)
     d = len(c["points"][0])
     c["facets"] = c["facets"] + [{"a": ["0"] * d, "b": "0"}]
@@ -375,12 +367,9 @@ def test_zero_facet_keeps_simple_vertices_simple():
     assert res.verdict == "valid", res.unchecked
 
 
-@pytest.mark.xfail(strict=True, reason="V19: kernels._int_constraint clears denominators "
-                   "but keeps a common factor, so facets written as 2^3000·(a, b) (the "
-                   "same halfspaces) make the fan's generators 3000-bit (gbits): cube(5) "
-                   "F = 4 goes valid (1.1 CPU-s) -> 'unchecked' (fan work > 2·10^7); "
-                   "divide each integer row (a, b) by the gcd of its entries there")
 def test_facets_with_a_common_factor_cost_nothing():
+    """V19: facets written as 2^3000·(a, b) kept the factor (3000-bit fan generators:
+    'unchecked')."""
     c = _cert("cube", 5, 4)
     s = Fraction(2 ** 3000)
     c["facets"] = [{"a": [str(Fraction(x) * s) for x in f["a"]], "b": str(Fraction(f["b"]) * s)}
@@ -389,13 +378,9 @@ def test_facets_with_a_common_factor_cost_nothing():
     assert res.verdict == "valid", res.unchecked
 
 
-@pytest.mark.xfail(strict=True, reason="V19: kernels._cells_min tries every crossing row "
-                   "as the hyperplane u, duplicates included, and each copy repeats the "
-                   "same subproblem at every level: cube(5) doubled (n = 64, F = 9, the "
-                   "kernel of cube(5), F = 4, valid in ~1 CPU-s) runs out of the fan's "
-                   "2·10^7 -> 'unchecked'; skip a u whose primitive row was already "
-                   "split (same hyperplane on L; measured valid in 1.3 CPU-s, tripled 1.7)")
 def test_duplicated_points_do_not_multiply_the_fan():
+    """V19: the fan split along every copy of a repeated point (cube(5) doubled, F = 9:
+    'unchecked'; cube(5), F = 4, the same kernel, valid in ~1 s)."""
     import rescon
 
     cube = np.array(list(itertools.product((-1, 1), repeat=5)), float)
