@@ -666,3 +666,18 @@ def test_no_divergence_hint_for_a_steady_run_towards_a_far_minimiser():
                      step_size=0.1, optimum=[4e6])
     assert "ValueError: outside the cost's domain" in msg
     assert "diverged" not in msg
+
+
+def test_cli_rmdo_with_named_costs_and_adversary(tmp_path, capsys):
+    names = ["alice", "bob", "carol", "dave", "zoë", "東京", "eve"]
+    p = _named_scenario(tmp_path, names)
+    costs = "".join(f'{json.dumps(v)} = "(x1 - 1)^2 + {k + 1}*(x2 + 1)^2"\n'
+                    for k, v in enumerate(names[:-1]))
+    p.write_text(p.read_text(encoding="utf-8").replace("steps = 12", "steps = 60")
+                 + "[costs]\n" + costs, encoding="utf-8")
+    code, out, err = _cli(["rmdo", p, "--json", "-q", "--out", tmp_path / "o"], capsys)
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["optimum"]["point"] == [1.0, -1.0] and data["final_distance_to_optimum"] < 0.1
+    traj = json.loads((tmp_path / "o" / "trajectory.json").read_text(encoding="utf-8"))
+    assert traj["benign"] == sorted(names[:-1])
