@@ -681,3 +681,11 @@ def test_cli_rmdo_with_named_costs_and_adversary(tmp_path, capsys):
     assert data["optimum"]["point"] == [1.0, -1.0] and data["final_distance_to_optimum"] < 0.1
     traj = json.loads((tmp_path / "o" / "trajectory.json").read_text(encoding="utf-8"))
     assert traj["benign"] == sorted(names[:-1])
+
+
+def test_an_error_while_computing_x_star_has_no_hint_and_keeps_its_reason():
+    """No optimum given: Nelder–Mead from the benign mean (0) steps past the cost's
+    domain while computing X*: the error says so, with the cost's reason, no hint."""
+    msg = _run_error([[0.0]] * 4, {v: _domain_cost(0.5) for v in range(4)}, step_size=0.1)
+    assert "while computing X*" in msg and "ValueError: outside the cost's domain" in msg
+    assert "diverged" not in msg
