@@ -689,3 +689,20 @@ def test_an_error_while_computing_x_star_has_no_hint_and_keeps_its_reason():
     msg = _run_error([[0.0]] * 4, {v: _domain_cost(0.5) for v in range(4)}, step_size=0.1)
     assert "while computing X*" in msg and "ValueError: outside the cost's domain" in msg
     assert "diverged" not in msg
+
+
+def test_dos_links_name_agents_and_an_unknown_name_is_one_line(tmp_path, capsys):
+    names = ["alice", "bob", "carol", "dave", "zoë", "eve"]
+    p = _named_scenario(tmp_path, names)
+    dos = ('[[dos]]\nname = "D1"\nlinks = [["alice", "bob"], ["zoë", "carol"]]\n'
+           '[dos.schedule]\nkind = "periodic"\nperiod = 4.0\nduration = 1.5\n')
+    p.write_text(p.read_text(encoding="utf-8") + dos, encoding="utf-8")
+    code, out, err = _cli(["simulate", p, "--json", "-q", "--out", tmp_path / "o"], capsys)
+    assert code == 0, err
+    traj = json.loads((tmp_path / "o" / "trajectory.json").read_text(encoding="utf-8"))
+    assert traj["metrics"]["blocked_links"][:4] == [2.0, 2.0, 2.0, 0.0]
+    p.write_text(p.read_text(encoding="utf-8").replace('"carol"]]', '"mallory"]]'),
+                 encoding="utf-8")
+    code, out, err = _cli(["simulate", p, "--json", "-q"], capsys)
+    _assert_one_line_error(code, out, err)
+    assert "mallory" in err
