@@ -721,3 +721,18 @@ def test_cli_simulate_on_a_csv_graph_with_int_and_name_header(tmp_path, capsys):
         '1 = [0.0, 0.0]\na = [1.0, 0.0]\nb = [0.0, 1.0]\n2 = [1.0, 1.0]\n')
     code, out, err = _cli(["simulate", tmp_path / "s.toml", "--json", "-q"], capsys)
     assert code == 0 and "witness" in err, err
+
+
+@pytest.mark.xfail(strict=True, reason="V20: a BOM inside an edge list (files concatenated, "
+                   "each saved with a BOM) makes an invisible extra node and string labels")
+def test_a_byte_order_mark_inside_the_file_is_not_part_of_a_label(tmp_path):
+    """`cat a.edgelist b.edgelist` of two BOM-marked files: utf-8-sig strips only the
+    first BOM, the second stays in '\\ufeff3', so node 3 is doubled and every label
+    becomes a string ('\\ufeff3' is not an integer). Either strip it or say so."""
+    p = tmp_path / "g.edgelist"
+    p.write_bytes(b"\xef\xbb\xbf1 2\n2 3\n" + b"\xef\xbb\xbf3 1\n")
+    try:
+        G = read_graph(p)
+    except GraphFormatError:
+        return
+    assert list(G.nodes()) == [1, 2, 3] and set(G.edges()) == {(1, 2), (2, 3), (3, 1)}
