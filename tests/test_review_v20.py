@@ -335,7 +335,8 @@ def test_int_file_and_named_file_of_one_graph_agree(tmp_path, capsys):
         n = rng.randint(4, 8)
         G = _random_digraph(rng, n)
         names = {v: f"{NAMES[(v * 5) % len(NAMES)][:8]}_{v}" for v in G}
-        lines = [str(v) for v in G] + [f"{u} {v}" for u, v in G.edges()]
+        lines = [str(7 * v - 20) for v in G] + [f"{7 * u - 20} {7 * v - 20}"
+                                                for u, v in G.edges()]  # negative ints too
         named = [names[v] for v in G] + [f"{names[u]} {names[v]}" for u, v in G.edges()]
         outs = []
         for tag, text in (("i", lines), ("s", named)):
@@ -351,6 +352,11 @@ def test_int_file_and_named_file_of_one_graph_agree(tmp_path, capsys):
             inv = {s: v for v, s in names.items()}
             back = ([inv[x] for x in b["witness"]["S1"]], [inv[x] for x in b["witness"]["S2"]])
             assert _violates(G, back, b["r_max"] + 1, 1)
+        if a["witness"] is not None:
+            back = ([(x + 20) // 7 for x in a["witness"]["S1"]],
+                    [(x + 20) // 7 for x in a["witness"]["S2"]])
+            assert all(isinstance(x, int) for x in back[0] + back[1])
+            assert _violates(G, back, a["r_max"] + 1, 1)
 
 
 @pytest.fixture(scope="module")
