@@ -626,17 +626,20 @@ def test_to_dict_round_trip_of_a_named_graph_with_a_digit_name():
     assert list(back.nodes) == names
 
 
-def test_serial_sweep_of_a_named_graph_file(tmp_path, capsys, named_graph):
-    """A robustness grid over a named edge list (--workers 0): ρ, s* as the brute force,
-    the in-cell certificate valid."""
+@pytest.mark.parametrize("workers", [0, pytest.param(1, marks=pytest.mark.slow)])
+def test_sweep_of_a_named_graph_file(tmp_path, capsys, named_graph, workers):
+    """A robustness grid over a named edge list (--workers 0, and 1 on a LocalCluster):
+    ρ, s* as the brute force, the in-cell certificate valid."""
     pd = pytest.importorskip("pandas")
+    if workers:
+        pytest.importorskip("distributed")
     (tmp_path / "g.edgelist").write_text(
         "".join(f"{u} {v}\n" for u, v in named_graph.edges()), encoding="utf-8")
     (tmp_path / "grid.toml").write_text(
         '[run]\nkind = "robustness"\n[base.graph]\nedgelist = "g.edgelist"\n'
         '[axes]\n"robustness.method" = ["auto", "dp"]\n', encoding="utf-8")
     code, out, err = _cli(["sweep", tmp_path / "grid.toml", "--out", tmp_path / "sw",
-                           "--workers", 0, "--json", "-q"], capsys)
+                           "--workers", workers, "--json", "-q"], capsys)
     assert code == 0, err
     assert json.loads(out)["ok"] == 2
     df = pd.read_parquet(tmp_path / "sw" / "results.parquet")
