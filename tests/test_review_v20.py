@@ -484,6 +484,9 @@ def test_simulate_names_agents_adversaries_and_outputs(tmp_path, capsys):
     assert list(sc.nodes) == sorted(names) and list(sc.adversaries) == ["eve"]
     code, out, err = _cli(["simulate", p, "--json", "--out", tmp_path / "out", "-q"], capsys)
     assert code == 0, err
+    assert set(json.loads(out)) == {"steps", "N", "d", "F", "algorithm", "policy",
+                                    "final_diameter", "max_validity",
+                                    "assumptions_violated", "seconds", "out"}  # README
     traj = json.loads((tmp_path / "out" / "trajectory.json").read_text(encoding="utf-8"))
     assert traj["nodes"] == sorted(names) and "eve" not in traj["benign"]
     assert len(traj["benign"]) == len(names) - 1
