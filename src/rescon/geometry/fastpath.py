@@ -51,6 +51,7 @@ from math import gcd
 import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
+from ._lazy_vertices import LazyVertices
 from .exact import cross_all
 from .polytope import PRIME, ExactPolytope, _bits, members_of, tight_pairs
 
@@ -247,20 +248,16 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     S = np.asarray(S_set, dtype=np.int64)
     Ts = _basis_array(H, flat, sizes, k)  # (proposals, k): rows of H
     solved = _one_per_point(H, Ts, k) if pieces else np.arange(len(Ts))
-    X = _solve_rows(H, Ts[solved], k)
-    # x_0 = 0: k dependent rows (a zero-volume piece of a triangulated non-simple
-    # vertex), the other proposals or the closure decide
-    met = X[:, 0] != 0
-    kept = np.asarray(solved, dtype=np.int64)[met]
-    if not len(kept):
+    # the proposals' points (exact, solved when read) and their correctly rounded
+    # floats y / (w · unit): the floats of the vertices, and the key on which equal
+    # points are merged
+    found = _proposed_points(H, Ts, np.asarray(solved, dtype=np.int64), S, k, scale)
+    if found is None:
         return None
-    W = X[met]
-    # the correctly rounded floats y / (w · unit) of each proposal's point (int / int):
-    # the floats of the vertices, and the key on which equal points are merged
-    Vx = (W[:, 1:] / (W[:, :1] * scale)).astype(np.float64)
+    W, Vx, kept = found
     of_proposal, firsts = _distinct_points(W, Vx)
-    W, Vx = W[firsts], Vx[firsts]
-    verts = list(map(tuple, W.tolist()))
+    W, Vx = W.select(firsts), Vx[firsts]
+    verts = W
     T_kept = Ts[kept]
     # per vertex: k independent rows tight at it (positions in S), its first proposal's
     basis = np.searchsorted(S, T_kept[firsts]).tolist()
@@ -307,6 +304,52 @@ def _certify(H, k: int, scale: int, sel: np.ndarray, facets: list[list[int]],
     return P
 
 
+def _proposed_points(H, Ts: np.ndarray, solved: np.ndarray, S: np.ndarray, k: int,
+                     scale: int) -> tuple[LazyVertices, np.ndarray, np.ndarray] | None:
+    """The points of the proposals ``solved`` (rows Ts[solved], all in S) that are single
+    points: their exact homogeneous (w, y) as a :class:`._lazy_vertices.LazyVertices`
+    (each solved by :func:`_solve_rows` when first read), their correctly rounded
+    floats y / (w · scale) and the proposals kept; None if none is a point.
+
+    The floats are proven correctly rounded without the exact solve where
+    :func:`._vertex_floats.rounded_points` can (it also proves det A_T ≠ 0: such a
+    proposal is a point); the others are solved now, as before: their floats are
+    int / int, and x_0 = 0 (k dependent rows: a zero-volume piece of a triangulated
+    non-simple vertex) leaves the proposal out — the other proposals or the closure
+    decide. Correct rounding is a function of the point, so the floats are those the
+    exact vertices give, and the exact vertices, solved from the same rows by the same
+    code, are those the eager solve gave."""
+    from ._lazy_vertices import RowsOf
+    from ._vertex_floats import rounded_points
+
+    T = Ts[solved]
+    if not len(T):
+        return None
+    _, at, E = _row_table(H, T, k)
+    Vx, met = rounded_points(E, at, scale, k)
+    late = np.flatnonzero(~met)
+    rows_late: list = []
+    if len(late):
+        X = _solve_rows(H, T[late], k)
+        point = X[:, 0] != 0
+        late, X = late[point], X[point]
+        met[late] = True
+        if len(late):
+            Vx[late] = (X[:, 1:] / (X[:, :1] * scale)).astype(np.float64)
+            rows_late = X.tolist()
+    kept = np.flatnonzero(met)
+    if not len(kept):
+        return None
+    position = np.cumsum(met) - 1  # a kept proposal's index among the kept
+    known = {int(position[j]): tuple(row)
+             for j, row in zip(late.tolist(), rows_late, strict=True)}
+    Sl = S.tolist()
+    ab = [H.exact(h) for h in Sl]
+    rows = RowsOf([a for a, _ in ab], [b for _, b in ab], H.through[S], H.Yi)
+    W = LazyVertices(rows, np.searchsorted(S, T[kept]), k, known)
+    return W, Vx[kept], solved[kept]
+
+
 def _decided_pairs(H, scale: int, verts: list[tuple[int, ...]], W: np.ndarray,
                    basis: np.ndarray, rows: np.ndarray, Vx: np.ndarray, coarse: np.ndarray,
                    c: float, floor: float, known: np.ndarray, n_props: int, k: int
@@ -332,12 +375,13 @@ def _decided_pairs(H, scale: int, verts: list[tuple[int, ...]], W: np.ndarray,
     # decided on the integers
     on = _tight_through(H, basis, hs, near_v, k)
     rest = np.flatnonzero(~on)
-    slacks = _int64_slacks(H, scale, verts, hs[rest], near_v[rest])
+    Wr = W[near_v[rest]]  # the exact vertices of these pairs (solved now if lazy)
+    slacks = _int64_slacks(H, scale, Wr, hs[rest])
     if slacks is None:  # in Python integers: a·y − b·w, all pairs at once
         used, at = np.unique(hs[rest], return_inverse=True)
         H.exact_all(used.tolist())
         E = _homogeneous(H, used.tolist(), k)[at.ravel()]  # (−b, a), each row built once
-        slacks = (E * W[near_v[rest]]).sum(axis=1) if len(rest) else np.zeros(0, dtype=object)
+        slacks = (E * Wr).sum(axis=1) if len(rest) else np.zeros(0, dtype=object)
     if (slacks > 0).any():
         return None
     on[rest] = slacks == 0
@@ -547,21 +591,21 @@ def _tight_through(H, basis: np.ndarray, hs: np.ndarray, vs: np.ndarray, k: int)
                          np.asarray(hs, dtype=np.int64), np.asarray(vs, dtype=np.int64))
 
 
-def _int64_slacks(H, scale: int, verts: list[tuple[int, ...]], hs: np.ndarray,
-                  vs: np.ndarray) -> np.ndarray | None:
-    """a_h·y − b_h·w for the pairs (hs[i], vs[i]) in int64 — when the float normals are
-    exact integers (integer data, exact float arithmetic: c_err = 0, scale 1) and every
-    term provably fits — else None (the caller works in Python integers)."""
+def _int64_slacks(H, scale: int, V: np.ndarray, hs: np.ndarray) -> np.ndarray | None:
+    """a_h·y − b_h·w for the pairs (hs[i], V[i]) (V: the vertices (w, y), an object
+    array) in int64 — when the float normals are exact integers (integer data, exact
+    float arithmetic: c_err = 0, scale 1) and every term provably fits — else None (the
+    caller works in Python integers)."""
     if H.c_err != 0.0 or scale != 1 or not len(hs):
         return None
     A, b = H.af[hs], H.bf[hs]
     if not (np.all(A == np.round(A)) and np.all(b == np.round(b))):
         return None
-    top = max(max(abs(c) for c in v) for v in verts)
+    top = max(abs(c) for v in V.tolist() for c in v)
     reach = (np.abs(A).sum(axis=1).max() + np.abs(b).max()) * float(top)
     if not reach < 2.0**62:
         return None
-    V = np.array(verts, dtype=np.int64)[vs]
+    V = V.astype(np.int64)
     return (A.astype(np.int64) * V[:, 1:]).sum(axis=1) - b.astype(np.int64) * V[:, 0]
 
 

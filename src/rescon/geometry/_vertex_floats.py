@@ -1,0 +1,257 @@
+"""Correctly rounded floats of the fast path's vertices, proven without the exact solve.
+
+For a proposal of k rows h with exact integer rows a_h·x = b_h (x in scaled integer
+coordinates; the public floats are z = x / scale, scale a power of two), the rows are
+divided by 2^{t_h} (t_h: the bit length of the row's largest |entry|), so the system
+is A z = b' with A_{hj} = a_{hj} / 2^{t_h}, b'_h = b_h / (scale · 2^{t_h}), |A| ≤ 1.
+Floats: Af = fl(A) (each entry int / int, correctly rounded, |A − Af| ≤ u|Af|, u =
+2^-53, in the normal range checked below), R ≈ Af⁻¹ and z0 ≈ Af⁻¹ fl(b'). Then:
+
+1. The residual r = b' − A z0 in doubled precision (:func:`_residual`: A and b' as
+   hi + lo pairs, the products by error-free transformations, the sum by Sum2) with a
+   rigorous bound ρ ≥ |r − rf|, both scaled by 2^σ (σ per proposal, so that
+   max |2^σ rf| ∈ [1/2, 1)): rs = 2^σ rf, ρ_s = 2^σ ρ, |2^σ r − rs| ≤ ρ_s.
+2. β_i ≥ Σ_j |I − R A|_{ij}: |I − RA| ≤ |I − C| + |C − R Af| + |R| |A − Af| with
+   C = fl(R Af), |C − R Af| ≤ γ_k |R||Af| (γ_k = ku / (1 − ku); any summation order,
+   with or without fused multiply-adds), so, with sD = fl(row sums of fl|I − C|) and
+   sN = fl(row sums of fl(|R| |Af|)), β_i ≤ (1 + (k+3)u)(sD_i + (k+2)u sN_i) (k ≤ 10:
+   each computed nonnegative sum of m terms is ≥ (1 − γ_m) times its value, and
+   |x| ≤ (1 + 2u)|fl(x)| for the subtraction); evaluated with the constants 2(k+2)u
+   and 2(k+8)u, which also cover the rounding of that evaluation. β = max_i β_i ≤ 1/2
+   is required: then RA is invertible, hence A, and e = z − z0 = A⁻¹ r.
+3. With e_s = 2^σ e: e_s = R r_s + (I − RA) e_s (r_s = 2^σ r), so ‖e_s‖∞ ≤
+   ‖|R||r_s|‖∞ / (1 − β) ≤ 2 ‖|R|(|rs| + ρ_s)‖∞ and, δ_s = fl(R rs),
+   |e_s − δ_s|_i ≤ β_i ‖e_s‖∞ + (|R| ρ_s)_i + γ_k (|R||rs|)_i
+   ≤ 2.5 β max(G + H) + 2 H_i + 2(k+2)u G_i with G = fl(|R| |rs|), H = fl(|R| ρ_s)
+   (the true products are ≤ (1 + (k+1)u) times these); evaluated in floats and
+   multiplied by 1 + 8u (four roundings) — the bound E_s,i —
+   then E_i = E_s,i / 2^σ and δ = δ_s / 2^σ (exact: see the range checks).
+4. f = fl(z0 + δ) and t = z0 + δ − f exactly (TwoSum: exact in binary floating point,
+   whatever the magnitudes), so |z − f| ≤ E + |t|. If (E + |t|)(1 + 4u) (covering the
+   two roundings of that evaluation) is **strictly** below half the distance from f to
+   each neighbouring float (exact for normal f: a power of two), f is the float
+   nearest to z and no other float is as near — the correctly rounded z whatever the
+   tie rule, i.e. what y / (w · scale) (Python's int / int) gives for the exact vertex.
+
+Range checks (else the proposal is left to the exact solve): every entry of Af, its
+lo parts, R, z0, δ_s and rs is 0 or of magnitude in [2^-400, 2^400] (a product with a
+factor 0 is an exact 0), every |f| in [2^-400, 2^400], |σ| ≤ 400, bound terms floored at 2^-300
+(inflating a bound keeps it one) and E_s ≤ 2^300. Then every product of two factors
+lies in [2^-800, 2^800]: no overflow and no underflow anywhere (sums of normal numbers
+that fall below the normal range are exact), so the relative bounds above hold;
+δ_s / 2^σ and E_s / 2^σ are exact (normal, ≥ 2^-900). The doubled-precision residual
+also needs its rows' lo parts 0 or normal with an exact or normal remainder, and
+2^σ T, 2^σ Q (:func:`_residual`) 0 or in [2^-400, 2^400]. Anything non-finite fails
+every comparison (NaN) or the range checks (inf): not certified.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._rounding import UNIT_ROUNDOFF as _U
+
+__all__ = ["rounded_points"]
+
+#: factors of every product below lie in [2^-LIMIT, 2^LIMIT] (module docstring)
+LIMIT = 400
+#: the floor of the bound terms (β_i, E_s)
+FLOOR = 2.0**-300
+
+_bit_length = np.frompyfunc(int.bit_length, 1, 1)
+
+
+def _in_range(x: np.ndarray, zero_ok: bool) -> np.ndarray:
+    """Per leading index, whether every entry of x has |x| in [2^-LIMIT, 2^LIMIT]
+    (or is 0, with ``zero_ok``); NaN fails."""
+    a = np.abs(x)
+    ok = (a >= 2.0**-LIMIT) & (a <= 2.0**LIMIT)
+    if zero_ok:
+        ok |= a == 0.0
+    return ok.reshape(len(x), -1).all(axis=1)
+
+
+def rounded_points(E: np.ndarray, at: np.ndarray, scale: int, k: int,
+                   slack: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """For each proposal p (``at[p]``: its k rows, positions in E, the object array of
+    homogeneous integer rows (−b_h, a_h)), the floats fl(z) of the point z = x / scale
+    where its rows meet, and whether they are proven correctly rounded (module
+    docstring); entries not proven are NaN. ``slack`` multiplies the bound E (1: the
+    proven bound; tests pass < 1 to show a weakened bound is caught)."""
+    P = len(at)
+    out = np.full((P, k), np.nan)
+    ok = np.zeros(P, dtype=np.bool_)
+    if not P or scale <= 0 or scale & (scale - 1):
+        return out, ok
+    with np.errstate(all="ignore"):
+        _rounded(E, at, scale, k, slack, out, ok)
+    return out, ok
+
+
+def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
+             out: np.ndarray, ok: np.ndarray, exact_residual: bool = False) -> None:
+    """:func:`rounded_points`, writing into ``out`` and ``ok``."""
+    Ahi, Alo, bhi, blo, t, split = _row_floats(E, scale, k)
+    Af = Ahi[at]  # (P, k, k)
+    R = _inverses(Af)
+    z0 = (R @ (bhi[at] + blo[at])[:, :, None])[:, :, 0]
+    good = (split[at].all(axis=1) & _in_range(Af, True) & _in_range(Alo[at], True)
+            & _in_range(R, True) & _in_range(z0, True))
+    if not good.any():
+        return
+    idx = np.flatnonzero(good)
+    Af, R, z0, at = Af[idx], R[idx], z0[idx], at[idx]
+    # 1. the residual with its error bound, scaled by 2^σ
+    if exact_residual:
+        rf, T, Q = _residual_exact(E, t, at, scale, z0), np.zeros(z0.shape), np.zeros(z0.shape)
+    else:
+        rf, T, Q = _residual(Af, Alo[at], bhi[at], blo[at], z0)
+    top = np.abs(rf).max(axis=1)
+    sigma = np.where(top > 0.0, -np.frexp(top)[1], 0).astype(np.int64)
+    rs = np.ldexp(rf, sigma[:, None])
+    Ts, Qs = np.ldexp(T, sigma[:, None]), np.ldexp(Q, sigma[:, None])
+    n = 3 * k + 2
+    rho = (2.0 * _U * np.abs(rs) + 2.0 * n * n * _U * _U * Ts + 3.0 * _U * Qs) * (
+        1.0 + 4.0 * (k + 4) * _U)
+    good = ((np.abs(sigma) <= LIMIT) & _in_range(rs, True) & _in_range(Ts, True)
+            & _in_range(Qs, True))
+    # 2. β: the row sums of |I − RA|, bounded
+    C = R @ Af
+    D = np.abs(np.eye(k) - C)
+    absR = np.abs(R)
+    sN = (absR @ np.abs(Af)).sum(axis=2)
+    beta = (D.sum(axis=2) + 2.0 * (k + 2) * _U * sN) * (1.0 + 2.0 * (k + 8) * _U)
+    beta = np.maximum(beta, FLOOR).max(axis=1)
+    good &= beta <= 0.5
+    # 3. the correction and its bound, in units 2^-σ
+    ds = (R @ rs[:, :, None])[:, :, 0]
+    G = (absR @ np.abs(rs)[:, :, None])[:, :, 0]
+    Hr = (absR @ rho[:, :, None])[:, :, 0]
+    Es = (2.5 * beta * (G + Hr).max(axis=1))[:, None] + 2.0 * Hr + 2.0 * (k + 2) * _U * G
+    Es = np.maximum(Es, FLOOR) * (1.0 + 8.0 * _U) * slack
+    good &= _in_range(ds, True) & (Es <= 2.0**300).all(axis=1)
+    sig = np.where(good, sigma, 0)[:, None]
+    delta = np.ldexp(ds, -sig)
+    Eb = np.ldexp(Es, -sig)
+    # 4. f = fl(z0 + δ), t = z0 + δ − f (TwoSum), and the half gaps around f
+    f, tw = _two_sum(z0, delta)
+    gap = np.minimum(f - np.nextafter(f, -np.inf), np.nextafter(f, np.inf) - f) * 0.5
+    good &= _in_range(f, False) & ((Eb + np.abs(tw)) * (1.0 + 4.0 * _U) < gap).all(axis=1)
+    out[idx[good]] = f[good]
+    ok[idx[good]] = True
+
+
+def _row_floats(E: np.ndarray, scale: int, k: int):
+    """Per row (−b, a) of E (the last, the row at infinity, left out): t (the bit
+    length of its largest |entry|), A = a / 2^t and b' = b / (scale 2^t) as unevaluated
+    sums hi + lo (hi = fl(A), lo = fl(A − hi), both int / int correctly rounded, so
+    |A − hi − lo| ≤ u |lo| (1 + 2u) when lo is normal or the remainder is 0 — ``split``
+    False for a row where neither holds)."""
+    Ahi, Alo, bhi, blo, ts, split = [], [], [], [], [], []
+    tiny = 2.0**-1000
+    for row in E[:-1].tolist():
+        t = max(abs(v) for v in row).bit_length()
+        ts.append(t)
+        good = True
+        pairs = []
+        for j, v in enumerate(row):
+            den = (scale << t) if j == 0 else (1 << t)
+            num = -v if j == 0 else v
+            hi = num / den
+            n, d = hi.as_integer_ratio()
+            rem = num * d - n * den
+            lo = rem / (den * d) if rem else 0.0
+            if rem and not abs(lo) >= tiny:
+                good = False
+            pairs.append((hi, lo))
+        bhi.append(pairs[0][0])
+        blo.append(pairs[0][1])
+        Ahi.append([p[0] for p in pairs[1:]])
+        Alo.append([p[1] for p in pairs[1:]])
+        split.append(good)
+    return (np.array(Ahi, dtype=np.float64).reshape(-1, k),
+            np.array(Alo, dtype=np.float64).reshape(-1, k), np.array(bhi, dtype=np.float64),
+            np.array(blo, dtype=np.float64), np.array(ts, dtype=np.int64),
+            np.array(split, dtype=np.bool_))
+
+
+def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """s = fl(a + b) and the exact error a + b − s (Knuth's TwoSum: exact in binary
+    floating point with rounding to nearest, barring overflow)."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+def _two_product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """p = fl(a b) and the exact error a b − p (Dekker's product with Veltkamp's
+    split: exact when no partial product leaves the normal range and |a|, |b| < 2^995
+    — the callers' range checks)."""
+    p = a * b
+    c = 134217729.0 * a
+    ah = c - (c - a)
+    al = a - ah
+    c = 134217729.0 * b
+    bh = c - (c - b)
+    bl = b - bh
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+def _residual(Ahi: np.ndarray, Alo: np.ndarray, bhi: np.ndarray, blo: np.ndarray,
+              z0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """rf ≈ r = b' − A z0 for A = Ahi + Alo (+ its rounding), b' = bhi + blo (+ its
+    rounding): the n = 3k + 2 terms bhi, blo, −p_j, −e_j (Ahi_j z0_j = p_j + e_j,
+    :func:`_two_product`) and −q_j = −fl(Alo_j z0_j), summed by Sum2 (Ogita, Rump and
+    Oishi 2005: a cascade of TwoSums, |res − s| ≤ u|s| + γ_{n−1}² Σ|terms| — additions
+    err only relatively, as an addition whose result is subnormal is exact). With
+    T = Σ|terms| and Q = |blo| + Σ_j |q_j| (as computed) the total error is
+    |r − rf| ≤ (1 + 2u)(u|rf| + γ_{n−1}² (1 + γ_n) T + 2u(1 + 2u)(1 + γ_n) Q)
+    (the roundings of A and b', |ΔA| ≤ u|Alo|(1 + 2u), and of the q_j added), which
+    :func:`_rounded` bounds by ρ = (2u|rf| + 2n²u² T + 3u Q)(1 + 4(k + 4)u)."""
+    p, e = _two_product(Ahi, z0[:, None, :])
+    q = Alo * z0[:, None, :]
+    terms = [bhi, blo] + [-p[:, :, j] for j in range(p.shape[2])] + [
+        -e[:, :, j] for j in range(p.shape[2])] + [-q[:, :, j] for j in range(p.shape[2])]
+    s = terms[0]
+    err = np.zeros_like(s)
+    T = np.abs(terms[0])
+    for x in terms[1:]:
+        s, d = _two_sum(s, x)
+        err = err + d
+        T = T + np.abs(x)
+    Q = np.abs(blo) + np.abs(q).sum(axis=2)
+    return s + err, T, Q
+
+
+def _residual_exact(E: np.ndarray, t: np.ndarray, at: np.ndarray, scale: int,
+                    z0: np.ndarray) -> np.ndarray:
+    """fl(b' − A z0), the residual computed exactly in Python integers and rounded
+    once (a reference for the tests of :func:`_residual`)."""
+    s = scale.bit_length() - 1
+    mant, ex = np.frexp(z0)
+    Mi = (mant * 2.0**53).astype(np.int64)
+    sh = ex.astype(np.int64) - 53
+    Ex = np.maximum(0, (-sh).max(axis=1))  # z0_j = M_j / 2^Ex
+    M = np.left_shift(Mi.astype(object), (sh + Ex[:, None]).astype(object))
+    rows = E[at]
+    S = (rows[:, :, 1:] * M[:, None, :]).sum(axis=2)
+    N = np.left_shift(-rows[:, :, 0], Ex[:, None].astype(object)) - scale * S
+    den = np.left_shift(1, (s + t[at] + Ex[:, None]).astype(object))
+    return (N / den).astype(np.float64)
+
+
+def _inverses(Af: np.ndarray) -> np.ndarray:
+    """Approximate inverses of the (P, k, k) float matrices (NaN where numpy finds one
+    singular): only a guess, which the bound β of :func:`rounded_points` checks."""
+    with np.errstate(all="ignore"):
+        try:
+            return np.linalg.inv(Af)
+        except np.linalg.LinAlgError:
+            pass
+        R = np.full(Af.shape, np.nan)
+        for p in range(len(Af)):
+            try:
+                R[p] = np.linalg.inv(Af[p])
+            except np.linalg.LinAlgError:
+                pass
+        return R
