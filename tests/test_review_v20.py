@@ -221,8 +221,6 @@ def test_not_utf8_is_a_one_line_error(tmp_path, capsys):
 # --------------------------------------------------------------------------- reader: bugs
 
 
-@pytest.mark.xfail(strict=True, reason="V20: '1 01' / '+1 1' / '-0 0' / '٣ 3' / '１ 1' "
-                   "collapse to one int node: an edge silently becomes a dropped self-loop")
 @pytest.mark.parametrize("a,b", [("1", "01"), ("+1", "1"), ("-0", "0"), ("٣", "3"),
                                  ("１", "1"), ("007", "7")])
 def test_two_spellings_of_one_integer_are_not_silently_merged(tmp_path, a, b):
@@ -270,8 +268,6 @@ def _huge_graph_file(tmp_path: Path, fmt: str) -> Path:
     return tmp_path / "big.graphml"
 
 
-@pytest.mark.xfail(strict=True, reason="V20: an integer label beyond Python's 4300-digit "
-                   "int-string limit raises a bare ValueError (traceback from the CLI)")
 @pytest.mark.parametrize("fmt", ["edgelist", "csv", "graphml"])
 def test_integer_label_beyond_the_digit_limit_is_read_or_refused_in_one_line(tmp_path, fmt):
     p = _huge_graph_file(tmp_path, fmt)
@@ -282,8 +278,6 @@ def test_integer_label_beyond_the_digit_limit_is_read_or_refused_in_one_line(tmp
     assert G.number_of_nodes() == 3
 
 
-@pytest.mark.xfail(strict=True, reason="V20: rescon robustness on a graph file with a "
-                   "5000-digit integer label: traceback (ValueError), not exit 2")
 def test_cli_integer_label_beyond_the_digit_limit(tmp_path, capsys):
     p = _huge_graph_file(tmp_path, "edgelist")
     code, out, err = _cli(["robustness", p, "--json"], capsys)
@@ -512,8 +506,6 @@ def test_rmdo_with_named_agents():
     assert tr.metrics["distance_to_optimum"][-1] < 0.05
 
 
-@pytest.mark.xfail(strict=True, reason="V20: a named graph's node '1' cannot be given a "
-                   "state/attack in TOML: the key '1' is read as int 1 (not a node)")
 def test_toml_keys_name_a_digit_node_of_a_named_graph(tmp_path):
     """Labels are strings when any label is a name, so the node written `1` in the file
     is the string '1'; scenario._label turns the TOML key "1" into int 1 ('x0 has states
@@ -585,8 +577,6 @@ def test_a_run_that_really_diverges_says_so(x0):
     assert "the iterates diverged" in msg and "try a smaller step_size" in msg
 
 
-@pytest.mark.xfail(strict=True, reason="V20: zero or ~1e-300 initial states make every "
-                   "later failure 'diverged' (the hint's scale is the start's max-norm)")
 @pytest.mark.parametrize("x0", [[[0.0]] * 4, [[1e-300], [0.0], [0.0], [0.0]]],
                          ids=["zero", "1e-300"])
 def test_no_divergence_hint_for_a_steady_run_from_zero_states(x0):
@@ -604,8 +594,6 @@ _MIXED_EDGES = [(1, "a"), ("a", 1), ("a", "b"), ("b", 1), (1, "b"), ("b", "a"), 
                 (1, 2), ("a", 2), ("b", 2)]
 
 
-@pytest.mark.xfail(strict=True, reason="V20: a scenario whose labels mix ints and strings "
-                   "(TOML edges [[1, \"a\"], ...]) crashes in warn(): sorted() of the witness")
 def test_scenario_with_mixed_int_and_string_labels_warns_instead_of_crashing():
     """README: [graph] edges = [[u, v], ...] with integer or string labels. The graph is
     3-robust, not the (d+1)F+1 = 4 the theorems need: the warning's witness is sorted
@@ -623,8 +611,6 @@ def test_scenario_with_mixed_labels_runs_when_robustness_is_not_checked():
     assert list(tr.nodes) == [1, "a", "b", 2] and tr.states.shape == (4, 4, 2)
 
 
-@pytest.mark.xfail(strict=True, reason="V20: Scenario.to_dict() -> from_dict() loses a "
-                   "string node '1' (its key '1' comes back as int 1)")
 def test_to_dict_round_trip_of_a_named_graph_with_a_digit_name():
     names = ["alice", "bob", "carol", "1"]
     sc = Scenario(graph=nx.complete_graph(names).to_directed(), x0=np.zeros((4, 1)), F=0,
@@ -672,8 +658,6 @@ def test_int_and_string_labels_agree_up_to_n12_with_the_exhaustive_dp():
                 assert _violates(H, rep.s_witness, rep.r_max, rep.s_max + 1)
 
 
-@pytest.mark.xfail(strict=True, reason="V20: a steady run towards a far minimiser (1e7, "
-                   "states in [0, 1]) is called 'diverged' once it passes 2^20 x the start")
 def test_no_divergence_hint_for_a_steady_run_towards_a_far_minimiser():
     """x ← 0.8 x + 2·10^6 (β = 0.1, f = (x1 − 10^7)^2): 2e6, 3.6e6, 4.9e6, then 5.9e6
     leaves the cost's domain x1 ≤ 5e6. The iterates approach X* monotonically; the
@@ -725,8 +709,6 @@ def test_dos_links_name_agents_and_an_unknown_name_is_one_line(tmp_path, capsys)
     assert "mallory" in err
 
 
-@pytest.mark.xfail(strict=True, reason="V20: rescon simulate on a CSV graph whose header "
-                   "is '1,a,b,2' (labels 1, 'a', 'b', 2) ends in a TypeError traceback")
 def test_cli_simulate_on_a_csv_graph_with_int_and_name_header(tmp_path, capsys):
     """The CSV reader turns integer header cells into ints and keeps the others as strings
     (the edge list makes every label a string then), so the labels mix types; the
@@ -740,8 +722,6 @@ def test_cli_simulate_on_a_csv_graph_with_int_and_name_header(tmp_path, capsys):
     assert code == 0 and "witness" in err, err
 
 
-@pytest.mark.xfail(strict=True, reason="V20: a BOM inside an edge list (files concatenated, "
-                   "each saved with a BOM) makes an invisible extra node and string labels")
 def test_a_byte_order_mark_inside_the_file_is_not_part_of_a_label(tmp_path):
     """`cat a.edgelist b.edgelist` of two BOM-marked files: utf-8-sig strips only the
     first BOM, the second stays in '\\ufeff3', so node 3 is doubled and every label
@@ -755,8 +735,6 @@ def test_a_byte_order_mark_inside_the_file_is_not_part_of_a_label(tmp_path):
     assert list(G.nodes()) == [1, 2, 3] and set(G.edges()) == {(1, 2), (2, 3), (3, 1)}
 
 
-@pytest.mark.xfail(strict=True, reason="V20: error line numbers count form feeds / U+2028 / "
-                   "U+0085 as line breaks (str.splitlines), so they disagree with editors")
 def test_error_line_numbers_count_newlines_only(tmp_path):
     """A page-break line (a lone form feed, GNU style) before a bad line 3: the message
     says line 4 (splitlines also breaks at \\x0c, \\x1c-\\x1e, \\x85, \\u2028-9; after

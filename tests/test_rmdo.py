@@ -451,7 +451,8 @@ def test_a_diverging_run_says_so_and_suggests_a_smaller_step():
                                                   [3.0, 3.0]], F=0, steps=60,
                   check_robustness=False)
     with pytest.raises(InputError, match=r"agent \d at step \d+ .*point .*the iterates "
-                                         r"diverged \(max \|x\| = .*, 3 at the start\): "
+                                         r"diverged \(max \|x\| = .*; the initial states "
+                                         r"and X\* lie within 3\): "
                                          r".*try a smaller step_size"):
         rmdo(sc, {v: "1e10*((x1 - 1)^2 + x2^2)" for v in range(4)}, optimum=[1, 0])
 

@@ -18,22 +18,19 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from ._labels import sorted_labels
 from .errors import InputError, RESCONError, TimeLimitReached
 
 __all__ = ["main"]
 
 
-def _sorted(labels: Any) -> list[Any]:
-    """Node labels in natural order: numbers first by value, then the rest by text."""
-    return sorted(labels, key=lambda v: (0, v, "") if isinstance(v, (int, float)) and
-                  not isinstance(v, bool) else (1, 0, str(v)))
 
 
 def _pair_json(pair: Any) -> dict[str, list[Any]] | None:
     if pair is None:
         return None
     S1, S2 = pair
-    return {"S1": _sorted(S1), "S2": _sorted(S2)}
+    return {"S1": sorted_labels(S1), "S2": sorted_labels(S2)}
 
 
 def _output(path: str | None, what: str, *, directory: bool = False) -> Path | None:
@@ -103,8 +100,8 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
             lines.append(f"time limit reached: {rep.r_lower} <= rho(G) <= {rep.r_upper}")
         if rep.witness is not None:
             lines.append(f"witness that G is not {rep.r_upper + 1}-robust: "
-                         f"S1 = {_sorted(rep.witness[0])}, "
-                         f"S2 = {_sorted(rep.witness[1])}")
+                         f"S1 = {sorted_labels(rep.witness[0])}, "
+                         f"S2 = {sorted_labels(rep.witness[1])}")
         lines.append(f"method: {rep.method}, {rep.seconds:.3f} s")
         _emit(out, args.json, lines)
         return 0
@@ -124,8 +121,8 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
         verdict = {True: "is", False: "is NOT", None: "undecided (time limit):"}[res.holds]
         lines = [f"G {verdict} ({args.r}, {args.s})-robust"]
     if res.witness is not None:
-        lines.append(f"witness: S1 = {_sorted(res.witness[0])}, "
-                     f"S2 = {_sorted(res.witness[1])}")
+        lines.append(f"witness: S1 = {sorted_labels(res.witness[0])}, "
+                     f"S2 = {sorted_labels(res.witness[1])}")
     _emit(out, args.json, lines)
     return 0
 
@@ -323,18 +320,19 @@ def _cmd_redundancy(args: argparse.Namespace) -> int:
     _write_certificate(rep.certificate, cert_path)
     out = {"holds": rep.holds, "exact": rep.exact, "r": args.r, "N": len(costs),
            "gap": _finite_or_none(rep.gap),
-           "unbounded": [_sorted(S) for S in rep.unbounded], "witness": _json_safe(rep.witness),
-           "seconds": round(seconds, 6), "unbounded_agents": _sorted(rep.unbounded_agents),
+           "unbounded": [sorted_labels(S) for S in rep.unbounded],
+           "witness": _json_safe(rep.witness), "seconds": round(seconds, 6),
+           "unbounded_agents": sorted_labels(rep.unbounded_agents),
            "tolerance": rep.tolerance}
     how = "exact" if rep.exact else f"numerical, tolerance {rep.tolerance:.1e}"
     lines = [(f"N = {len(costs)} costs in d = {d} {'ARE' if rep.holds else 'are NOT'} "
               f"{args.r}-redundant ({how}); largest argmin gap {rep.gap:.3e}")]
     if rep.witness is not None:
         S1, S2 = rep.witness["subsets"]
-        lines.append(f"witness: argmin over {_sorted(S1)} differs from argmin over "
-                     f"{_sorted(S2)} ({rep.witness.get('reason', '')})")
+        lines.append(f"witness: argmin over {sorted_labels(S1)} differs from argmin over "
+                     f"{sorted_labels(S2)} ({rep.witness.get('reason', '')})")
     if rep.unbounded_agents:
-        lines.append(f"unbounded below alone: agents {_sorted(rep.unbounded_agents)}")
+        lines.append(f"unbounded below alone: agents {sorted_labels(rep.unbounded_agents)}")
     lines.append(f"{seconds:.3f} s")
     _emit(out, args.json, lines)
     return 0

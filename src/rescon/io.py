@@ -17,6 +17,7 @@ import json
 import math
 import os
 import re
+import sys
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from fractions import Fraction
 from pathlib import Path
@@ -30,8 +31,11 @@ from .errors import GraphFormatError, InputError
 
 __all__ = ["output_path", "read_graph", "read_points", "to_jsonable", "write_json"]
 
-_INT = re.compile(r"[+-]?\d+")
-_DECIMAL = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+#: an integer label as Python writes it (ASCII digits, no "+", no leading zeros, not
+#: "-0"): only these become ints, so two spellings of one number ("1", "01") stay two nodes
+_INT = re.compile(r"0|-?[1-9][0-9]*")
+_DECIMAL = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
+_INTEGER_SPELLING = re.compile(r"[+-]?[0-9]+")
 
 
 # --------------------------------------------------------------------------- graphs
@@ -45,8 +49,8 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
     ``.graphml`` / ``.gml``
         Read with networkx. GML nodes are named by their ``label`` attributes
         when all are distinct strings, else by their ids. Node names that are
-        all decimal integers become ``int``. An undirected file counts each edge
-        both ways.
+        all integers (written as Python writes them) become ``int``. An
+        undirected file counts each edge both ways.
     ``.json``
         networkx node-link data: ``{"directed": bool, "nodes": [{"id": ...}, ...],
         "links": [{"source": u, "target": v}, ...]}``; the edge list may also be
@@ -57,16 +61,19 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
         :math:`i \\to j`. Entries are nonnegative finite numbers (0/1 usually).
         An optional first row holds the node labels; it is recognised when it
         contains a non-number, or when the file has one more row than columns
-        and the first row holds distinct integers. Without it the nodes are
-        ``0..n-1``. The matrix must be square.
+        and the first row holds distinct integers. Its labels are ints or
+        strings by the edge list's rule. Without it the nodes are ``0..n-1``.
+        The matrix must be square.
     anything else
         Edge list: ``u v`` per line is the edge :math:`u \\to v`; a line with a
         single label declares a (possibly isolated) node. Labels are integers
-        when every label in the file is a decimal integer, else strings (any
-        token without whitespace: ``a b``, ``1 a`` both give string labels); a
-        label that is a number but not an integer (``3.5``, ``1e3``) is an error.
-        ``#`` starts a comment; blank lines are ignored. Nodes are sorted by
-        label.
+        when every label in the file is an integer written as Python writes
+        one (``0``, ``-3``, ``42``), else strings as spelled (any token without
+        whitespace: ``a b``, ``1 a`` and ``1 01`` all give string labels, so two
+        spellings of one number stay two nodes); a label that is a number but not
+        an integer (``3.5``, ``1e3``) is an error. ``#`` starts a comment; blank
+        lines and a byte-order mark starting a line are ignored. Nodes are sorted
+        by label.
 
     Lines starting with ``#`` are comments in ``.csv`` files too.
 
@@ -124,7 +131,7 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
 def _check_label(p: Path, lineno: int, token: str) -> None:
     """A label that reads as a number but not as an integer is refused (a weight or a
     coordinate in the wrong place, more likely than a node named '3.5')."""
-    if _INT.fullmatch(token) or not _DECIMAL.fullmatch(token):
+    if _INTEGER_SPELLING.fullmatch(token) or not _DECIMAL.fullmatch(token):
         return
     raise GraphFormatError(f"{p}:{lineno}: node label {token!r} is a number but not an "
                            "integer (labels are integers or names)")
@@ -142,9 +149,8 @@ def _read_edge_list(p: Path) -> nx.DiGraph:
         for t in tokens:
             _check_label(p, lineno, t)
         rows.append(tokens)
-    label: Callable[[str], Hashable] = str
-    if all(_INT.fullmatch(t) for tokens in rows for t in tokens):
-        label = int
+    ints = _as_ints(p, [t for tokens in rows for t in tokens])
+    label: Callable[[str], Hashable] = str if ints is None else ints.__getitem__
     G = nx.DiGraph()
     for tokens in rows:
         if len(tokens) == 1:
@@ -166,9 +172,12 @@ def _read_adjacency_csv(p: Path) -> nx.DiGraph:
     first_line, first = rows[0]
     width = len(first)
     if any(_number(c) is None for c in first) or (
-        len(rows) == width + 1 and all(_INT.fullmatch(c) for c in first)
+        len(rows) == width + 1 and all(_INTEGER_SPELLING.fullmatch(c) for c in first)
     ):
-        labels = [_header_label(p, first_line, c) for c in first]
+        if not all(first):
+            raise GraphFormatError(f"{p}:{first_line}: header has an empty node label")
+        ints = _as_ints(p, first)
+        labels = list(first) if ints is None else [ints[c] for c in first]
         if len(set(labels)) != len(labels):
             raise GraphFormatError(f"{p}:{first_line}: header labels are not distinct")
         rows = rows[1:]
@@ -194,10 +203,19 @@ def _read_adjacency_csv(p: Path) -> nx.DiGraph:
     return G
 
 
-def _header_label(p: Path, lineno: int, cell: str) -> Hashable:
-    if not cell:
-        raise GraphFormatError(f"{p}:{lineno}: header has an empty node label")
-    return int(cell) if _INT.fullmatch(cell) else cell
+def _as_ints(p: Path, labels: list[str]) -> dict[str, int] | None:
+    """Each label's int when every label is an integer as Python writes it (:data:`_INT`),
+    else None: the labels stay strings, spelled as given. An integer longer than
+    Python's int–string limit (``sys.get_int_max_str_digits()``) is refused."""
+    if not all(_INT.fullmatch(t) for t in labels):
+        return None
+    try:
+        return {t: int(t) for t in labels}
+    except ValueError:  # only the digit limit: the spelling is checked above
+        digits = max(len(t.lstrip("-")) for t in labels)
+        raise GraphFormatError(
+            f"{p}: a node label is an integer of {digits} digits, beyond Python's limit of "
+            f"{sys.get_int_max_str_digits()} (sys.set_int_max_str_digits raises it)") from None
 
 
 def _read_node_link(p: Path) -> nx.Graph:
@@ -258,11 +276,8 @@ def _read_networkx(p: Path, read: Callable[[Path], nx.Graph]) -> nx.Graph:
     except (nx.NetworkXError, ValueError, KeyError, TypeError) as exc:
         raise GraphFormatError(f"{p}: cannot read as {p.suffix[1:]}: {exc}") from exc
     labels = list(G.nodes())
-    if all(isinstance(v, str) and _INT.fullmatch(v) for v in labels) and len(
-        {int(v) for v in labels}
-    ) == len(labels):
-        G = nx.relabel_nodes(G, {v: int(v) for v in labels})
-    return G
+    ints = _as_ints(p, labels) if all(isinstance(v, str) for v in labels) else None
+    return G if ints is None else nx.relabel_nodes(G, ints)
 
 
 def _read_gml_file(p: Path) -> nx.Graph:
@@ -372,7 +387,12 @@ def _read_text(p: Path, error: type[InputError]) -> str:
 
 def _data_lines(p: Path, *, inline_comments: bool = False,
                 error: type[InputError] = GraphFormatError) -> Iterator[tuple[int, str]]:
-    for lineno, raw in enumerate(_read_text(p, error).splitlines(), start=1):
+    # after universal-newline decoding only "\n" ends a line (str.splitlines would also
+    # break at form feeds, U+0085, U+2028 …, and the line numbers would disagree with
+    # editors); a byte-order mark starting a line (files saved with one, concatenated)
+    # is not part of its first field
+    for lineno, raw in enumerate(_read_text(p, error).split("\n"), start=1):
+        raw = raw.removeprefix("\ufeff")
         line = raw.split("#", 1)[0] if inline_comments else raw
         line = line.strip()
         if line and not line.startswith("#"):

@@ -13,12 +13,13 @@ because showing what happens then is the point.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import re
 import tomllib
 import warnings
-from collections.abc import Callable, Hashable, Mapping
+from collections.abc import Callable, Collection, Hashable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +27,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from .._labels import sorted_labels
 from .._validate import integer, positive, real
 from ..errors import InputError
 from ..geometry._budget import require
@@ -358,7 +360,8 @@ class Scenario:
         elif res.holds:
             return []
         return [(f"the graph is not {need} as the theorems need for the F-{self.model} "
-                 f"model; witness S1 = {sorted(witness[0])}, S2 = {sorted(witness[1])}")]
+                 f"model; witness S1 = {sorted_labels(witness[0])}, "
+                 f"S2 = {sorted_labels(witness[1])}")]
 
     def _dos_problems(self) -> list[str]:
         """Assumption 3 for some T_d > 1, μ_d > 0 (it holds iff the long-run blocked
@@ -524,9 +527,21 @@ def _keys(d: Mapping, allowed: set[str], where: str) -> None:
         raise InputError(f"{where}: unknown keys {extra} (allowed: {sorted(allowed)})")
 
 
-def _label(text: str) -> Hashable:
-    """A TOML key as a node label: decimal digits (ASCII, optional minus) are an int."""
-    return int(text) if re.fullmatch(r"-?[0-9]+", text) else text
+def _label(text: str, nodes: Collection[Hashable] | None = None) -> Hashable:
+    """A TOML key (always a string) as a node label. With the graph's ``nodes``: the
+    node spelled so — the string itself when it is a node (a named graph's node "1"),
+    else the int it spells (decimal digits, ASCII, optional minus); a graph with both
+    is ambiguous (refused). Without them: the int when the key spells one."""
+    number: int | None = None
+    if re.fullmatch(r"-?[0-9]+", text):
+        with contextlib.suppress(ValueError):  # beyond Python's int-string limit: a name
+            number = int(text)
+    if nodes is None or number is None:
+        return text if number is None else number
+    if text in nodes and number in nodes:
+        raise InputError(f"key {text!r} names two nodes of the graph, the string {text!r} "
+                         f"and the integer {number}: give the graph labels of one kind")
+    return text if text in nodes else number
 
 
 def _table(data: Mapping, key: str, where: str) -> dict:
@@ -568,8 +583,6 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
     _keys(data, _TOP, where)
     sc = dict(_table(data, "scenario", where))
     _keys(sc, _SCENARIO, f"{where} [scenario]")
-    if isinstance(sc.get("alpha"), Mapping):  # TOML keys are strings; labels as in [initial]
-        sc["alpha"] = {_label(k): v for k, v in sc["alpha"].items()}
     if _flag(sc, "paper_example", f"{where} [scenario]"):
         del sc["paper_example"]
         given = [f"[{k}]" for k in ("graph", "initial", "adversaries") if k in data]
@@ -577,22 +590,34 @@ def _from_dict(data: Mapping, base: Path, where: str) -> Scenario:
         if given:
             raise InputError(f"{where}: paper_example = true takes the paper's graph, "
                              f"states, adversaries and DoS attacks; remove {', '.join(given)}")
-        return Scenario.paper_example(**sc)
+        return Scenario.paper_example(**_alpha_by_label(sc, None, where))
     sc.pop("paper_example", None)
     if "graph" not in data or "initial" not in data or "F" not in sc:
         raise InputError(f"{where}: needs [graph], [initial] and scenario.F "
                          "(or scenario.paper_example = true)")
+    seed = integer(f"{where} [scenario] seed", sc.get("seed", 0), low=0)
+    G = _graph(_table(data, "graph", where), base, f"{where} [graph]", seed)
+    nodes = set(G)
     adversaries = {}
     for k, v in _table(data, "adversaries", where).items():
         try:
-            adversaries[_label(k)] = behaviour_from_dict(v)
+            adversaries[_label(k, nodes)] = behaviour_from_dict(v)
         except InputError as exc:
             raise InputError(f"{where} [adversaries.{k}]: {exc}") from None
-    seed = integer(f"{where} [scenario] seed", sc.get("seed", 0), low=0)
-    G = _graph(_table(data, "graph", where), base, f"{where} [graph]", seed)
     return Scenario(graph=G, x0=_initial(_table(data, "initial", where), base,
                                          f"{where} [initial]", list(G), seed),
-                    adversaries=adversaries, dos=_dos(data.get("dos", []), where), **sc)
+                    adversaries=adversaries, dos=_dos(data.get("dos", []), where),
+                    **_alpha_by_label(sc, nodes, where))
+
+
+def _alpha_by_label(sc: dict, nodes: set[Hashable] | None, where: str) -> dict:
+    """[scenario] with a table ``alpha`` keyed by node labels (:func:`_label`)."""
+    if isinstance(sc.get("alpha"), Mapping):  # TOML keys are strings
+        try:
+            sc["alpha"] = {_label(k, nodes): v for k, v in sc["alpha"].items()}
+        except InputError as exc:
+            raise InputError(f"{where} [scenario] alpha: {exc}") from None
+    return sc
 
 
 def _graph(g: Mapping, base: Path, where: str, seed: int) -> nx.DiGraph:
@@ -654,7 +679,12 @@ def _initial(init: Mapping, base: Path, where: str, nodes: list[Hashable],
         from ..io import read_points
 
         return read_points(_path(init, "file", base, where))
-    return {_label(k): _state(f"{where} {k}", v) for k, v in init.items()}
+    names = set(nodes)
+    try:
+        labels = {k: _label(k, names) for k in init}
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+    return {labels[k]: _state(f"{where} {k}", v) for k, v in init.items()}
 
 
 def _random_states(box: Mapping, n: int, seed: int, where: str) -> np.ndarray:

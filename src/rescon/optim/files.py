@@ -145,7 +145,11 @@ def _costs(table: Mapping[str, Any], p: Path, d: int | None, nodes: Any = None
     table = {k: v for k, v in table.items() if k != "algorithm"}
     if "paper" in table or "f7" in table:
         return _paper(table, where)
-    specs: dict[Hashable, Any] = {_label(k): v for k, v in table.items() if k not in _RESERVED}
+    try:
+        specs: dict[Hashable, Any] = {_label(k, None if nodes is None else set(nodes)): v
+                                      for k, v in table.items() if k not in _RESERVED}
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
     if "module" in table:
         for v, spec in _module(table["module"], p.parent, where).items():
             if v in specs:

@@ -107,9 +107,9 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
     F = GlobalCost(groups, sc.d)
     x0 = sc.x0[[sc.nodes.index(v) for v in benign]]
     opt = Optimum.find(groups, F, sc.d, optimum, x0)
-    start = float(np.abs(x0).max(initial=0.0))
-    rule = SubgradientStep(groups, len(sc.nodes), betas, sc.nodes, start)
-    monitor = CostMonitor(F, sc.steps, sc.T, len(benign), opt, start)
+    reach = _reach(x0, opt)
+    rule = SubgradientStep(groups, len(sc.nodes), betas, sc.nodes, reach)
+    monitor = CostMonitor(F, sc.steps, sc.T, len(benign), opt, reach)
     info = {"assumptions_violated": problems, "update": "rmdo", "step_size": repr(beta),
             "assumption5_violated": violated, "oracles": len(groups), "optimum": opt.info}
     return run(sc, rule, monitors=[ConsensusMonitor(sc, metrics), monitor], progress=progress,
@@ -152,10 +152,10 @@ def _groups(sc: Scenario, costs: Any) -> list[_Group]:
 
 
 def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hashable],
-          where: str, start: float | None = None) -> np.ndarray:
+          where: str, reach: float | None = None) -> np.ndarray:
     """``oracle.<method>(Z)`` (checked by the oracle); on failure an InputError naming
     the agent ``who(r)`` of the first row r that fails on its own, ``where`` (the step)
-    and the point (with :func:`_divergence_hint` against ``start``)."""
+    and the point (with :func:`_divergence_hint` against ``reach``)."""
     try:
         with np.errstate(over="ignore", invalid="ignore"):  # NaN/inf answers are checked
             return getattr(oracle, method)(Z)
@@ -163,26 +163,38 @@ def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hasha
         r = next((r for r in range(len(Z)) if not _works(oracle, method, Z[r:r + 1])), 0)
         why = str(exc) if isinstance(exc, InputError) else f"{type(exc).__name__}: {exc}"
         raise InputError(f"{method} of the cost of agent {who(r)!r} {where}, point "
-                         f"{Z[r].tolist()}: {why}{_divergence_hint(Z[r], start)}") from exc
+                         f"{Z[r].tolist()}: {why}{_divergence_hint(Z[r], reach)}") from exc
 
 
-#: a failing point this many times farther out than every initial state is reported as
-#: a diverging run (only the wording of the error depends on it)
+#: a failing point this many times farther out than every initial state and X* is
+#: reported as a diverging run (only the wording of the error depends on it)
 DIVERGED = 2.0**20
 
 
-def _divergence_hint(point: np.ndarray, start: float | None) -> str:
-    """A hint for an error at ``point`` during a run whose benign initial states have
-    max-norm ``start``: when the point is more than DIVERGED times farther out, the
-    iterates have run away (Algorithm 2 stays near the initial hull when β_k·‖∂f‖ is
-    small against it), so the step size is too large for the costs' scale."""
-    if start is None:
+def _reach(x0: np.ndarray, opt: Optimum) -> float:
+    """The largest |coordinate| of the benign initial states and of X*'s point (when
+    known): where a converging run stays within a bounded factor (Algorithm 2 moves
+    from the initial hull towards X*), the scale of :func:`_divergence_hint`."""
+    reach = float(np.abs(x0).max(initial=0.0))
+    if opt.known:
+        reach = max(reach, float(np.abs(opt.point).max(initial=0.0)))
+    return reach
+
+
+def _divergence_hint(point: np.ndarray, reach: float | None) -> str:
+    """A hint for an error at ``point`` during a run whose initial states and X* lie
+    within max-norm ``reach`` (:func:`_reach`): when the point is more than DIVERGED
+    times farther out, the iterates have run away (Algorithm 2 stays between the
+    initial hull and X* when β_k·‖∂f‖ is small against them), so the step size is too
+    large for the costs' scale. No hint when ``reach`` is 0 (nothing to compare with)."""
+    if not reach:
         return ""
     size = float(np.max(np.abs(point), initial=0.0))
-    if not size > DIVERGED * max(start, np.finfo(float).tiny):
+    if not size > DIVERGED * reach:
         return ""
-    return (f" — the iterates diverged (max |x| = {size:.3g}, {start:.3g} at the start): "
-            "the step size is too large for these costs; try a smaller step_size")
+    return (f" — the iterates diverged (max |x| = {size:.3g}; the initial states and X* "
+            f"lie within {reach:.3g}): the step size is too large for these costs; try a "
+            "smaller step_size")
 
 
 def _works(oracle: Oracle, method: str, Z: np.ndarray) -> bool:
@@ -202,14 +214,14 @@ class SubgradientStep:
     every other group is evaluated in one call of its oracle. A pack that answers
     NaN/inf is re-evaluated group by group through the oracles' checked calls, so that
     a subgradient that is not finite or of the wrong shape, or a step that overflows,
-    is an InputError naming the agent, the step and the point (``start``: the benign
-    initial states' max-norm, for :func:`_divergence_hint`)."""
+    is an InputError naming the agent, the step and the point (``reach``: the scale of
+    :func:`_divergence_hint`)."""
 
     name = "rmdo"
 
     def __init__(self, groups: list[_Group], n: int, betas: np.ndarray,
-                 nodes: list[Hashable], start: float | None = None) -> None:
-        self.groups, self.betas, self.nodes, self.start = groups, betas, nodes, start
+                 nodes: list[Hashable], reach: float | None = None) -> None:
+        self.groups, self.betas, self.nodes, self.reach = groups, betas, nodes, reach
         self.group_of = np.full(n, -1, dtype=np.int64)
         by_sig: dict[Hashable, list[int]] = {}
         for g, grp in enumerate(groups):
@@ -243,7 +255,7 @@ class SubgradientStep:
             raise InputError(f"the subgradient step of agent {self.nodes[agents[r]]!r} at step "
                              f"{k} (t = {t:g}) overflows: point {z[r].tolist()}, β = "
                              f"{self.betas[k]:g}, subgradient {D[r].tolist()}"
-                             f"{_divergence_hint(z[r], self.start)}")
+                             f"{_divergence_hint(z[r], self.reach)}")
         return new
 
     def _per_group(self, D: np.ndarray, k: int, t: float, z: np.ndarray, agents: np.ndarray,
@@ -254,7 +266,7 @@ class SubgradientStep:
             sel = rows[gid == g]
             D[sel] = _call(self.groups[g].oracle, "subgradient", z[sel],
                            lambda r, sel=sel: self.nodes[agents[sel[r]]], _at(k, t),
-                           self.start)
+                           self.reach)
 
 
 class CostMonitor:
@@ -264,8 +276,8 @@ class CostMonitor:
     evaluated once per step on all benign states and their mean (:class:`GlobalCost`)."""
 
     def __init__(self, F: GlobalCost, steps: int, T: float, n_benign: int,
-                 optimum: Optimum, start: float | None = None) -> None:
-        self.F, self.T, self.optimum, self.start = F, T, optimum, start
+                 optimum: Optimum, reach: float | None = None) -> None:
+        self.F, self.T, self.optimum, self.reach = F, T, optimum, reach
         K = steps
         self.metrics = {"cost": np.empty((K + 1, n_benign)), "cost_at_mean": np.empty(K + 1),
                         "cost_rate": np.full(K + 1, np.nan)}
@@ -275,7 +287,7 @@ class CostMonitor:
 
     def record(self, k: int, t: float, xb: np.ndarray) -> None:
         P = np.vstack([xb, xb.mean(axis=0)])
-        F = self.F(P, _at(k, t), self.start)
+        F = self.F(P, _at(k, t), self.reach)
         m = self.metrics
         m["cost"][k], m["cost_at_mean"][k] = F[:-1], F[-1]
         if k:
@@ -300,22 +312,22 @@ class GlobalCost:
         self.merged = atoms.Merged([(len(g.rows), g.oracle) for g in groups], d)
 
     def __call__(self, P: np.ndarray, where: str = "while computing X*",
-                 start: float | None = None) -> np.ndarray:
+                 reach: float | None = None) -> np.ndarray:
         try:
             return self.merged.value(P)
         except Exception:  # noqa: BLE001 (re-evaluated below, which names the agent)
-            return global_cost(self.groups, P, where, start)
+            return global_cost(self.groups, P, where, reach)
 
 
 def global_cost(groups: list[_Group], P: np.ndarray, where: str = "while computing X*",
-                start: float | None = None) -> np.ndarray:
+                reach: float | None = None) -> np.ndarray:
     """F(p) = Σ_{j∈B} f_j(p) at every row of ``P``: Σ over distinct oracles of
-    (number of agents sharing it) × its values (one checked call per oracle; ``start``
+    (number of agents sharing it) × its values (one checked call per oracle; ``reach``
     as in :func:`_call`)."""
     F = np.zeros(len(P))
     for grp in groups:
         F += len(grp.rows) * _call(grp.oracle, "value", P, lambda r, grp=grp: grp.labels[0],
-                                   where, start)
+                                   where, reach)
     return F
 
 
