@@ -92,11 +92,11 @@ def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
              out: np.ndarray, ok: np.ndarray, exact_residual: bool = False) -> None:
     """:func:`rounded_points`, writing into ``out`` and ``ok``."""
     Ahi, Alo, bhi, blo, t, split = _row_floats(E, scale, k)
+    split &= _in_range(Ahi, True) & _in_range(Alo, True)
     Af = Ahi[at]  # (P, k, k)
     R = _inverses(Af)
     z0 = (R @ (bhi[at] + blo[at])[:, :, None])[:, :, 0]
-    good = (split[at].all(axis=1) & _in_range(Af, True) & _in_range(Alo[at], True)
-            & _in_range(R, True) & _in_range(z0, True))
+    good = split[at].all(axis=1) & _in_range(R, True) & _in_range(z0, True)
     if not good.any():
         return
     idx = np.flatnonzero(good)
@@ -105,7 +105,9 @@ def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
     if exact_residual:
         rf, T, Q = _residual_exact(E, t, at, scale, z0), np.zeros(z0.shape), np.zeros(z0.shape)
     else:
-        rf, T, Q = _residual(Af, Alo[at], bhi[at], blo[at], z0)
+        ah, al = _split(Ahi.T)  # columns first: (k, P, k) gathers, each column contiguous
+        rf, T, Q = _residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at], bhi[at],
+                             blo[at], z0)
     top = np.abs(rf).max(axis=1)
     sigma = np.where(top > 0.0, -np.frexp(top)[1], 0).astype(np.int64)
     rs = np.ldexp(rf, sigma[:, None])
@@ -144,24 +146,46 @@ def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
 def _row_floats(E: np.ndarray, scale: int, k: int):
     """Per row (−b, a) of E (the last, the row at infinity, left out): t (the bit
     length of its largest |entry|), A = a / 2^t and b' = b / (scale 2^t) as unevaluated
-    sums hi + lo (hi = fl(A), lo = fl(A − hi), both int / int correctly rounded, so
-    |A − hi − lo| ≤ u |lo| (1 + 2u) when lo is normal or the remainder is 0 — ``split``
-    False for a row where neither holds)."""
-    Ahi, Alo, bhi, blo, ts, split = [], [], [], [], [], []
+    sums hi + lo — hi = fl(v) / 2^e, lo = fl(v − fl(v)) / 2^e for each integer entry v
+    (e = t, or s + t for b, scale = 2^s; float(int) is correctly rounded) — so hi is
+    the correctly rounded entry and |entry − hi − lo| ≤ u |lo| when both are 0 or
+    normal (``split`` False for a row where one is not: the division by 2^e is then
+    not exact)."""
+    rows = E[:-1]
+    t = np.array([max(map(abs, row)).bit_length() for row in rows.tolist()],
+                 dtype=np.int64)
+    try:
+        hi = rows.astype(np.float64)
+    except OverflowError:  # an entry beyond the float range: row by row
+        return _row_floats_slow(rows, t, scale, k)
+    lo = _remainder(rows).astype(np.float64)
+    e = np.repeat(-t[:, None], k + 1, axis=1)
+    e[:, 0] -= scale.bit_length() - 1
+    hi, lo = np.ldexp(hi, e), np.ldexp(lo, e)
     tiny = 2.0**-1000
-    for row in E[:-1].tolist():
-        t = max(abs(v) for v in row).bit_length()
-        ts.append(t)
+    split = ((hi == 0.0) | (np.abs(hi) >= tiny)) & ((lo == 0.0) | (np.abs(lo) >= tiny))
+    return hi[:, 1:], lo[:, 1:], -hi[:, 0], -lo[:, 0], t, split.all(axis=1)
+
+
+#: v − fl(v) rounded, for a Python int v (|v| < 2^1024)
+_remainder = np.frompyfunc(lambda v: float(v - int(float(v))), 1, 1)
+
+
+def _row_floats_slow(rows: np.ndarray, t: np.ndarray, scale: int, k: int):
+    """:func:`_row_floats` for rows with entries beyond the float range: int / int."""
+    Ahi, Alo, bhi, blo, split = [], [], [], [], []
+    tiny = 2.0**-1000
+    for row, th in zip(rows.tolist(), t.tolist(), strict=True):
         good = True
         pairs = []
         for j, v in enumerate(row):
-            den = (scale << t) if j == 0 else (1 << t)
+            den = (scale << th) if j == 0 else (1 << th)
             num = -v if j == 0 else v
             hi = num / den
             n, d = hi.as_integer_ratio()
             rem = num * d - n * den
             lo = rem / (den * d) if rem else 0.0
-            if rem and not abs(lo) >= tiny:
+            if (hi and not abs(hi) >= tiny) or (rem and not abs(lo) >= tiny):
                 good = False
             pairs.append((hi, lo))
         bhi.append(pairs[0][0])
@@ -171,8 +195,7 @@ def _row_floats(E: np.ndarray, scale: int, k: int):
         split.append(good)
     return (np.array(Ahi, dtype=np.float64).reshape(-1, k),
             np.array(Alo, dtype=np.float64).reshape(-1, k), np.array(bhi, dtype=np.float64),
-            np.array(blo, dtype=np.float64), np.array(ts, dtype=np.int64),
-            np.array(split, dtype=np.bool_))
+            np.array(blo, dtype=np.float64), t, np.array(split, dtype=np.bool_))
 
 
 def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -183,43 +206,41 @@ def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return s, (a - (s - bb)) + (b - bb)
 
 
-def _two_product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """p = fl(a b) and the exact error a b − p (Dekker's product with Veltkamp's
-    split: exact when no partial product leaves the normal range and |a|, |b| < 2^995
-    — the callers' range checks)."""
-    p = a * b
+def _split(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Veltkamp's split a = ah + al exactly, each half of at most 26 significant bits
+    (|a| < 2^995, no underflow: the callers' range checks)."""
     c = 134217729.0 * a
     ah = c - (c - a)
-    al = a - ah
-    c = 134217729.0 * b
-    bh = c - (c - b)
-    bl = b - bh
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return ah, a - ah
 
 
-def _residual(Ahi: np.ndarray, Alo: np.ndarray, bhi: np.ndarray, blo: np.ndarray,
-              z0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """rf ≈ r = b' − A z0 for A = Ahi + Alo (+ its rounding), b' = bhi + blo (+ its
-    rounding): the n = 3k + 2 terms bhi, blo, −p_j, −e_j (Ahi_j z0_j = p_j + e_j,
-    :func:`_two_product`) and −q_j = −fl(Alo_j z0_j), summed by Sum2 (Ogita, Rump and
-    Oishi 2005: a cascade of TwoSums, |res − s| ≤ u|s| + γ_{n−1}² Σ|terms| — additions
-    err only relatively, as an addition whose result is subnormal is exact). With
-    T = Σ|terms| and Q = |blo| + Σ_j |q_j| (as computed) the total error is
-    |r − rf| ≤ (1 + 2u)(u|rf| + γ_{n−1}² (1 + γ_n) T + 2u(1 + 2u)(1 + γ_n) Q)
+def _residual(Ahi: np.ndarray, ah: np.ndarray, al: np.ndarray, Alo: np.ndarray,
+              bhi: np.ndarray, blo: np.ndarray, z0: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """rf ≈ r = b' − A z0 for A = Ahi + Alo (+ its rounding; ah + al = Ahi, its split;
+    these four as (column, proposal, row) arrays),
+    b' = bhi + blo (+ its rounding): the n = 3k + 2 terms bhi, blo, −p_j, −e_j
+    (Ahi_j z0_j = p_j + e_j exactly: Dekker's product on the splits, exact as no
+    partial product leaves the normal range) and −q_j = −fl(Alo_j z0_j), summed by
+    Sum2 (Ogita, Rump and Oishi 2005: a cascade of TwoSums, |res − s| ≤ u|s| +
+    γ_{n−1}² Σ|terms| — additions err only relatively, as an addition whose result is
+    subnormal is exact). With T = Σ|terms| and Q = |blo| + Σ_j |q_j| (as computed) the
+    total error is |r − rf| ≤ (1 + 2u)(u|rf| + γ_{n−1}² (1 + γ_n) T + 2u(1 + 2u)(1 + γ_n) Q)
     (the roundings of A and b', |ΔA| ≤ u|Alo|(1 + 2u), and of the q_j added), which
     :func:`_rounded` bounds by ρ = (2u|rf| + 2n²u² T + 3u Q)(1 + 4(k + 4)u)."""
-    p, e = _two_product(Ahi, z0[:, None, :])
-    q = Alo * z0[:, None, :]
-    terms = [bhi, blo] + [-p[:, :, j] for j in range(p.shape[2])] + [
-        -e[:, :, j] for j in range(p.shape[2])] + [-q[:, :, j] for j in range(p.shape[2])]
-    s = terms[0]
+    z = z0.T[:, :, None]  # the arrays are (column j, proposal, row h)
+    p = Ahi * z
+    zh, zl = _split(z)
+    e = ((ah * zh - p) + ah * zl + al * zh) + al * zl
+    q = Alo * z
+    s = bhi
     err = np.zeros_like(s)
-    T = np.abs(terms[0])
-    for x in terms[1:]:
+    for x in (blo, *(-p), *(-e), *(-q)):
         s, d = _two_sum(s, x)
         err = err + d
-        T = T + np.abs(x)
-    Q = np.abs(blo) + np.abs(q).sum(axis=2)
+    aq = np.abs(q)
+    T = np.abs(bhi) + np.abs(blo) + (np.abs(p) + np.abs(e) + aq).sum(axis=0)
+    Q = np.abs(blo) + aq.sum(axis=0)
     return s + err, T, Q
 
 
