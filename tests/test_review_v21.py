@@ -19,11 +19,16 @@
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
+import rescon
 from rescon.geometry import _vertex_floats as vf
 
 U = 2.0**-53
@@ -443,3 +448,126 @@ def test_row_split_claim_when_b_underflows():
             (Fraction(E[h, j + 1], 2**th), Ahi[h, j], Alo[h, j]) for j in range(k)]
         for exact, hi, lo in entries:
             assert abs(exact - Fraction(hi) - Fraction(lo)) <= Fraction(U) * abs(Fraction(lo))
+
+
+# ------------------------------------------------------------------- end to end
+
+_DIGEST = r'''
+import itertools, json, sys
+import numpy as np
+import rescon
+from benchmarks.kernel_clouds import make_cloud
+
+
+def clouds():
+    for fam, d, n, F in [("gaussian", 4, 22, 2), ("sphere", 4, 20, 3), ("cube", 4, 20, 3),
+                         ("attack", 4, 18, 2), ("converged", 4, 22, 1), ("gaussian", 5, 14, 1),
+                         ("sphere", 5, 14, 1), ("cube", 5, 14, 1), ("duplicates", 4, 22, 2)]:
+        yield f"{fam}-{d}-{n}-{F}", make_cloud(fam, d, n, F).X, F
+    for d, n, F in [(4, 20, 2), (5, 14, 1)]:
+        Z = np.random.default_rng([21, d, n]).normal(size=(n, d))
+        c = np.random.default_rng([22, d]).normal(size=d)
+        yield f"conv13-{d}", c + 1e-13 * Z, F
+        yield f"big900-{d}", Z * 2.0**900, F
+        yield f"small900-{d}", Z * 2.0**-900, F
+        yield f"dup-{d}", np.vstack([Z[: n // 2], Z[: n // 2]]), F
+        yield f"aniso-{d}", Z * np.array([1e-8, 1.0, 1e8, 1e3, 1e-3][:d]), F
+        yield f"shift15-{d}", Z + 1e15, F
+        yield f"int-{d}", np.round(2 * Z), F
+        lat = np.array(list(itertools.product((0, 1, 2), repeat=d)), dtype=float)
+        yield f"lattice-{d}", lat[np.random.default_rng([d]).permutation(len(lat))[:n]], F
+
+
+def digest(K):
+    return {"dim": K.dim, "vertices": [[v.hex() for v in r] for r in K.vertices.tolist()],
+            "A": K.A.tobytes().hex(), "b": K.b.tobytes().hex(),
+            "exact": [[str(v) for v in r] for r in K.exact_vertices],
+            "constraints": str(K._exact.constraints), "facets": str(K._exact.facets),
+            "cert": json.dumps(K.certificate, sort_keys=True)}
+
+
+if __name__ == "__main__":
+    json.dump({name: digest(rescon.safe_kernel(X, F)) for name, X, F in clouds()},
+              sys.stdout)
+'''
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEFORE = "3322450^"  # the commit before the floats were proven (every vertex solved)
+
+
+def _digests(src: str, script: str) -> dict:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([src, ROOT])}
+    out = subprocess.run([sys.executable, script], env=env, cwd=ROOT, capture_output=True,
+                         text=True, timeout=900, check=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.slow
+def test_public_answers_identical_to_the_commit_before(tmp_path):
+    """25 kernels (benchmark families d = 4–5; hostile: states 1e-13 apart, 2^±900
+    scales, duplicates, anisotropic columns, translated by 1e15, integers, a lattice
+    with degenerate vertices) from the pre-change source (git archive, a subprocess)
+    and from this one: vertices bit for bit, their order, facets, constraints, exact
+    vertices and the certificate JSON identical."""
+    old = tmp_path / "old"
+    old.mkdir()
+    try:
+        tar = subprocess.run(["git", "-C", ROOT, "archive", BEFORE, "src"], capture_output=True,
+                             check=True, timeout=120).stdout
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("no git history here")
+    subprocess.run(["tar", "-x", "-C", str(old)], input=tar, check=True, timeout=120)
+    assert not (old / "src/rescon/geometry/_vertex_floats.py").exists()
+    script = tmp_path / "digest.py"
+    script.write_text(_DIGEST)
+    before = _digests(str(old / "src"), str(script))
+    now = _digests(os.path.join(ROOT, "src"), str(script))
+    assert len(now) == 25
+    for name in now:
+        assert now[name] == before[name], name
+
+
+def _module():
+    ns: dict = {}
+    exec(compile(_DIGEST, "digest", "exec"), ns)
+    return ns
+
+
+def _forced_eager(monkeypatch):
+    """rounded_points proving nothing: every proposal solved exactly at once."""
+    real = vf.rounded_points
+
+    def nothing(E, at, scale, k, slack=1.0):
+        out, ok = real(E, at, scale, k, slack)
+        return np.full(out.shape, np.nan), np.zeros_like(ok)
+
+    monkeypatch.setattr(vf, "rounded_points", nothing)
+
+
+@pytest.mark.slow
+def test_lazy_and_forced_eager_identical_and_certificates_valid(monkeypatch):
+    """In process: each kernel with the proof, and with it proving nothing, identical;
+    every certificate valid under certificates.check; and the proof ran (most
+    proposals proven) wherever the fast path certified."""
+    from certificates import check as check_certificate
+
+    ns = _module()
+    seen = []
+    real = vf.rounded_points
+
+    def spy(E, at, scale, k, slack=1.0):
+        out, ok = real(E, at, scale, k, slack)
+        seen.append((len(ok), int(ok.sum()), scale.bit_length() - 1))
+        return out, ok
+
+    for name, X, F in ns["clouds"]():
+        seen.clear()
+        with monkeypatch.context() as mp:
+            mp.setattr(vf, "rounded_points", spy)
+            lazy = ns["digest"](K := rescon.safe_kernel(X, F))
+        assert check_certificate(K.certificate).valid, name
+        if seen and seen[0][2] < 300:  # unit 2^902 (big900): coordinates out of range
+            assert sum(p for _, p, _ in seen) > 0.9 * sum(n for n, _, _ in seen), name
+        with monkeypatch.context() as mp:
+            _forced_eager(mp)
+            assert ns["digest"](rescon.safe_kernel(X, F)) == lazy, name
