@@ -38,6 +38,16 @@ rows were dependent, or a joggled proposal was not solved because its modular ke
 equalled another's: :func:`_one_per_point`) — returns None and the caller clips
 exactly (:mod:`.polytope`). Only the proposals' vertices are taken as V, so leaving a
 proposal out can lose a vertex of P_S but never add a point that is not one.
+
+The exact solves are off the critical path: each proposal's correctly rounded floats
+are proven from floats alone where possible (:mod:`._vertex_floats`: a residual in
+doubled precision and a Rump-style bound on the correction) — all that the float
+filters, the merge of equal points (correct rounding is a function of the point:
+distinct floats are distinct points) and the public floats read. A vertex is solved
+exactly (:func:`_solve_rows`, the same integers as an eager solve) only where read:
+floats that coincide, a pair the filters and the data points leave open, a proposal
+whose floats are not proven, or the first read of the exact vertices
+(:class:`._lazy_vertices.LazyVertices`).
 """
 
 from __future__ import annotations

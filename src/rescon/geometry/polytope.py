@@ -90,7 +90,9 @@ class ExactPolytope:
     k: int
     a: list[tuple[int, ...]] = field(default_factory=list)
     b: list[int] = field(default_factory=list)
-    verts: list[tuple[int, ...]] = field(default_factory=list)  # (w, y_1..y_k)
+    #: (w, y_1..y_k); the fast path's is a :class:`._lazy_vertices.LazyVertices` (a
+    #: sequence solving each vertex when first read; assigning a list replaces it)
+    verts: list[tuple[int, ...]] = field(default_factory=list)
     tight: list[int] = field(default_factory=list)
     farkas: Farkas | None = None  # set when a clip empties the polytope
     unit: int = 1  # a power of two: the float vertices are y / (w · unit)
