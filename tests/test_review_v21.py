@@ -785,3 +785,96 @@ def test_entries_at_the_float_overflow_boundary():
         assert wrong == 0
         checked += proven
     assert checked > 0
+
+
+def _instrumented(old: str = "", new: str = ""):
+    """A copy of ``_vertex_floats._rounded`` recording, per call, the proposals it
+    kept, z0, δ, the bound E, β and R (source unchanged but for the recording line and
+    the optional replacement ``old`` -> ``new``; skipped if the source no longer has
+    the anchors)."""
+    import inspect
+
+    src = inspect.getsource(vf._rounded)
+    anchor = "    # 4. f = fl(z0 + δ)"
+    if anchor not in src or old not in src:
+        pytest.skip("_rounded changed: no anchor for the instrumented copy")
+    src = src.replace(old, new) if old else src
+    seen: list = []
+    ns = dict(vars(vf))
+    ns["_seen"] = seen
+    exec(src.replace(anchor, "    _seen.append((idx, good.copy(), z0, delta, Eb, beta, R, at))\n"
+                     + anchor), ns)
+    return ns["_rounded"], seen
+
+
+def _bound_violations(name: str, k: int, slack: float = 1.0, old: str = "", new: str = ""):
+    """(checked, violations) of |z − (z0 + δ)| ≤ E, exactly, over a family."""
+    rounded, seen = _instrumented(old, new)
+    rng = np.random.default_rng([21, 9, k, FAMILIES.index(name)])
+    systems, scale = _family(name, rng, k, 150)
+    E, at = _table(systems, k)
+    out, ok = np.full((len(at), k), np.nan), np.zeros(len(at), dtype=np.bool_)
+    with np.errstate(all="ignore"):
+        rounded(E, at, scale, k, slack, out, ok)
+    idx, good, z0, delta, Eb, _, _, _ = seen[0]
+    checked = bad = 0
+    for q, p in enumerate(idx.tolist()):
+        if good[q]:
+            z = _solve(systems[p], scale)
+            checked += 1
+            bad += any(abs(z[j] - Fraction(float(z0[q, j])) - Fraction(float(delta[q, j])))
+                       > Fraction(float(Eb[q, j])) for j in range(k))
+    return checked, bad
+
+
+def test_weakened_bounds_violate_the_exact_inequality():
+    """The exact check of |z − (z0 + δ)| ≤ E can fail: the bound divided by 2^8 is
+    violated on random systems (the margin of E over the actual error is 2^5.6 at
+    least, ~2^11 typically), and with the β term dropped (β = 0) on nearly singular
+    ones (there the margin is ~2^34, all of it β's). Dropping ρ, or its Sum2 term,
+    the floors or the G/H terms one at a time is not violated on these families: the
+    remaining terms still cover the actual error."""
+    checked, bad = _bound_violations("random", 3)
+    assert checked > 100 and bad == 0
+    assert _bound_violations("random", 3, slack=2.0**-8)[1] > 0
+    assert _bound_violations("ill", 3)[1] == 0
+    beta = "beta = np.maximum(beta, FLOOR).max(axis=1)"
+    assert _bound_violations("ill", 3, old=beta, new=beta + " * 0.0")[1] > 0
+
+
+@pytest.mark.parametrize("name", ["random", "mid30", "powers", "ill", "exact", "beyond"])
+def test_the_bounds_beta_and_e_hold_exactly(name):
+    """The proof's inequalities themselves, exactly (Fractions), on every proposal that
+    passed steps 1–3: β ≥ max_i Σ_j |I − R A|_ij for the exact A = a / 2^t, and
+    |z − (z0 + δ)| ≤ E for the exact point z. The smallest ratio E / |z − z0 − δ|
+    (the bound's margin) is ≥ 1 (here it is ~2^10 or more)."""
+    rounded, seen = _instrumented()
+    rng = np.random.default_rng([21, 8, FAMILIES.index(name)])
+    k = 3
+    systems, scale = _family(name, rng, k, 80)
+    E, at = _table(systems, k)
+    out, ok = np.full((len(at), k), np.nan), np.zeros(len(at), dtype=np.bool_)
+    with np.errstate(all="ignore"):
+        rounded(E, at, scale, k, 1.0, out, ok)
+    if not seen:
+        return
+    idx, good, z0, delta, Eb, beta, R, _ = seen[0]
+    _, _, _, _, t, _ = vf._row_floats(E, scale, k)
+    checked = 0
+    for q, p in enumerate(idx.tolist()):
+        if not good[q]:
+            continue
+        rows = systems[p]
+        th = [int(t[at[p, i]]) for i in range(k)]
+        A = [[Fraction(rows[i][j + 1], 2**th[i]) for j in range(k)] for i in range(k)]
+        Rq = [[Fraction(float(v)) for v in r] for r in R[q].tolist()]
+        worst = max(sum(abs((i == j) - sum(Rq[i][m] * A[m][j] for m in range(k)))
+                        for j in range(k)) for i in range(k))
+        assert worst <= Fraction(float(beta[q]))
+        z = _solve(rows, scale)
+        for j in range(k):
+            err = abs(z[j] - Fraction(float(z0[q, j])) - Fraction(float(delta[q, j])))
+            assert err <= Fraction(float(Eb[q, j]))
+        checked += 1
+    if name in ("random", "mid30", "exact"):
+        assert checked > 20
