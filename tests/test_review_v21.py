@@ -448,22 +448,27 @@ def test_the_residual_bound_holds(name):
     assert checked > 10
 
 
-@pytest.mark.xfail(strict=True, reason="V21: _row_floats calls a row exact (split True) "
-                   "when its b' = b/(scale 2^t) underflows to 0 (hi = lo = 0, b != 0): "
-                   "'|entry - hi - lo| <= u|lo|' fails (harmless only thanks to FLOOR)")
+@pytest.mark.xfail(strict=True, reason="V21: _row_floats calls a row split when b' = "
+                   "b/(scale 2^t) or its remainder underflows to 0 (hi or lo = 0 for a nonzero "
+                   "value): '|entry - hi - lo| <= u|lo|' fails (harmless only thanks to FLOOR)")
 def test_row_split_claim_when_b_underflows():
     """_row_floats' docstring: split True ⇒ |entry − hi − lo| ≤ u|lo| for every entry.
     A row a = (2^1020, 0), b = 1 at scale 2^60: b' = 2^-1081 is flushed to hi = lo =
     0 and the row is still called split (its check accepts hi == 0 whatever the
-    integer). The proof survives only because the floors (2^-300 scaled, E ≥ 2^-700)
-    dwarf the lost 2^-1074 — an argument the docstring does not make. Fix: accept
-    hi == 0 only for a zero integer."""
+    integer); likewise b = 2^100 + 1 with t = 1016: lo = 2^-1076 is flushed to 0 (any
+    b ≥ 2^76 with a small remainder, t + s ≥ 1076). The proof survives only because
+    the value lost is below 2^-1075 in absolute terms, its effect on z at most
+    |R_ih| 2^-1075 ≤ 2^-1020 (β ≤ 1/2 bounds |R_ih| by ~2^52 for a row whose largest
+    entry is in A), far below the floors (E ≥ 2^-700) — an argument the docstring does
+    not make. Fix: accept hi == 0 / lo == 0 only for a zero integer / remainder (or
+    make the argument)."""
     k = 2
-    E = np.empty((3, 3), dtype=object)
-    E[:] = [(-1, 2**1020, 0), (-3, 0, 5), (1, 0, 0)]
+    E = np.empty((4, 3), dtype=object)
+    # b' = 2^-1081 flushed to 0; b' = (2^100 + 1)/2^1076: hi = 2^-976, lo = 2^-1076 -> 0
+    E[:] = [(-1, 2**1020, 0), (-(2**100 + 1), 2**1015, 0), (-3, 0, 5), (1, 0, 0)]
     scale = 2**60
     Ahi, Alo, bhi, blo, t, split = vf._row_floats(E, scale, k)
-    for h in range(2):
+    for h in range(3):
         if not split[h]:
             continue
         th = int(t[h])
