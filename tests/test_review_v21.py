@@ -883,3 +883,19 @@ def test_the_bounds_beta_and_e_hold_exactly(name):
         checked += 1
     if name in ("random", "mid30", "exact"):
         assert checked > 20
+
+
+def test_scales_that_are_not_powers_of_two_and_one_dimension():
+    """A scale that is not a positive power of two proves nothing; k = 1 (a line)
+    against the oracle too."""
+    rng = np.random.default_rng([21, 1])
+    systems = _fam_midpoints(rng, 2, 20, 3)[0]
+    E, at = _table(systems, 2)
+    for scale in (0, -2, 3, 6):
+        got, ok = vf.rounded_points(E, at, scale, 2)
+        assert not ok.any() and np.isnan(got).all()
+    got, ok = vf.rounded_points(E, at[:0], 1, 2)
+    assert got.shape == (0, 2) and not len(ok)
+    for name in ("random", "mid1", "mid70", "tie", "powers", "limits"):
+        systems, scale = _family(name, rng, 1, 100)
+        assert _check(systems, 1, scale)[1] == 0
