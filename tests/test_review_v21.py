@@ -448,10 +448,7 @@ def test_the_residual_bound_holds(name):
     assert checked > 10
 
 
-@pytest.mark.xfail(strict=True, reason="V21: _row_floats calls a row split when b' = "
-                   "b/(scale 2^t) or its remainder underflows to 0 (hi or lo = 0 for a nonzero "
-                   "value): '|entry - hi - lo| <= u|lo|' fails (harmless only thanks to FLOOR)")
-def test_row_split_claim_when_b_underflows():
+def test_row_split_claim_when_b_underflows():  # V21 finding, fixed: was a strict xfail
     """_row_floats' docstring: split True ⇒ |entry − hi − lo| ≤ u|lo| for every entry.
     A row a = (2^1020, 0), b = 1 at scale 2^60: b' = 2^-1081 is flushed to hi = lo =
     0 and the row is still called split (its check accepts hi == 0 whatever the

@@ -148,9 +148,9 @@ def _row_floats(E: np.ndarray, scale: int, k: int):
     length of its largest |entry|), A = a / 2^t and b' = b / (scale 2^t) as unevaluated
     sums hi + lo — hi = fl(v) / 2^e, lo = fl(v − fl(v)) / 2^e for each integer entry v
     (e = t, or s + t for b, scale = 2^s; float(int) is correctly rounded) — so hi is
-    the correctly rounded entry and |entry − hi − lo| ≤ u |lo| when both are 0 or
-    normal (``split`` False for a row where one is not: the division by 2^e is then
-    not exact)."""
+    the correctly rounded entry and |entry − hi − lo| ≤ u |lo| when each is normal or
+    0 for a zero integer / remainder (``split`` False for a row where one is not: the
+    division by 2^e is then not exact, e.g. flushed to 0)."""
     rows = E[:-1]
     t = np.array([max(map(abs, row)).bit_length() for row in rows.tolist()],
                  dtype=np.int64)
@@ -161,9 +161,12 @@ def _row_floats(E: np.ndarray, scale: int, k: int):
     lo = _remainder(rows).astype(np.float64)
     e = np.repeat(-t[:, None], k + 1, axis=1)
     e[:, 0] -= scale.bit_length() - 1
-    hi, lo = np.ldexp(hi, e), np.ldexp(lo, e)
     tiny = 2.0**-1000
-    split = ((hi == 0.0) | (np.abs(hi) >= tiny)) & ((lo == 0.0) | (np.abs(lo) >= tiny))
+    # 0 only for a zero entry / remainder (float(v) = 0 iff v = 0): a nonzero one
+    # scaled below the normal range (flushed to 0 or subnormal) is not split
+    ok_hi, ok_lo = hi == 0.0, lo == 0.0
+    hi, lo = np.ldexp(hi, e), np.ldexp(lo, e)
+    split = (ok_hi | (np.abs(hi) >= tiny)) & (ok_lo | (np.abs(lo) >= tiny))
     return hi[:, 1:], lo[:, 1:], -hi[:, 0], -lo[:, 0], t, split.all(axis=1)
 
 
@@ -185,7 +188,7 @@ def _row_floats_slow(rows: np.ndarray, t: np.ndarray, scale: int, k: int):
             n, d = hi.as_integer_ratio()
             rem = num * d - n * den
             lo = rem / (den * d) if rem else 0.0
-            if (hi and not abs(hi) >= tiny) or (rem and not abs(lo) >= tiny):
+            if (num and not abs(hi) >= tiny) or (rem and not abs(lo) >= tiny):
                 good = False
             pairs.append((hi, lo))
         bhi.append(pairs[0][0])
