@@ -46,10 +46,11 @@ class LazyVertices(Sequence):
 
     def __init__(self, rows: RowsOf | None, basis: np.ndarray, k: int,
                  known: dict[int, tuple[int, ...]] | None = None) -> None:
-        self._rows = rows
         self._basis = np.asarray(basis, dtype=np.int64).reshape(-1, k)
         self._k = k
         self._known: dict[int, tuple[int, ...]] = dict(known or {})
+        # the rows are kept only while a vertex is left to solve
+        self._rows = rows if len(self._known) < len(self._basis) else None
         self._lock = threading.Lock()
 
     def __len__(self) -> int:
