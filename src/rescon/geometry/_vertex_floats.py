@@ -89,9 +89,9 @@ def rounded_points(E: np.ndarray, at: np.ndarray, scale: int, k: int,
 
 
 def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
-             out: np.ndarray, ok: np.ndarray, exact_residual: bool = False) -> None:
+             out: np.ndarray, ok: np.ndarray) -> None:
     """:func:`rounded_points`, writing into ``out`` and ``ok``."""
-    Ahi, Alo, bhi, blo, t, split = _row_floats(E, scale, k)
+    Ahi, Alo, bhi, blo, _, split = _row_floats(E, scale, k)
     split &= _in_range(Ahi, True) & _in_range(Alo, True)
     Af = Ahi[at]  # (P, k, k)
     R = _inverses(Af)
@@ -102,12 +102,9 @@ def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
     idx = np.flatnonzero(good)
     Af, R, z0, at = Af[idx], R[idx], z0[idx], at[idx]
     # 1. the residual with its error bound, scaled by 2^σ
-    if exact_residual:
-        rf, T, Q = _residual_exact(E, t, at, scale, z0), np.zeros(z0.shape), np.zeros(z0.shape)
-    else:
-        ah, al = _split(Ahi.T)  # columns first: (k, P, k) gathers, each column contiguous
-        rf, T, Q = _residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at], bhi[at],
-                             blo[at], z0)
+    ah, al = _split(Ahi.T)  # columns first: (k, P, k) gathers, each column contiguous
+    rf, T, Q = _residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at], bhi[at],
+                         blo[at], z0)
     top = np.abs(rf).max(axis=1)
     sigma = np.where(top > 0.0, -np.frexp(top)[1], 0).astype(np.int64)
     rs = np.ldexp(rf, sigma[:, None])
@@ -245,23 +242,6 @@ def _residual(Ahi: np.ndarray, ah: np.ndarray, al: np.ndarray, Alo: np.ndarray,
     T = np.abs(bhi) + np.abs(blo) + (np.abs(p) + np.abs(e) + aq).sum(axis=0)
     Q = np.abs(blo) + aq.sum(axis=0)
     return s + err, T, Q
-
-
-def _residual_exact(E: np.ndarray, t: np.ndarray, at: np.ndarray, scale: int,
-                    z0: np.ndarray) -> np.ndarray:
-    """fl(b' − A z0), the residual computed exactly in Python integers and rounded
-    once (a reference for the tests of :func:`_residual`)."""
-    s = scale.bit_length() - 1
-    mant, ex = np.frexp(z0)
-    Mi = (mant * 2.0**53).astype(np.int64)
-    sh = ex.astype(np.int64) - 53
-    Ex = np.maximum(0, (-sh).max(axis=1))  # z0_j = M_j / 2^Ex
-    M = np.left_shift(Mi.astype(object), (sh + Ex[:, None]).astype(object))
-    rows = E[at]
-    S = (rows[:, :, 1:] * M[:, None, :]).sum(axis=2)
-    N = np.left_shift(-rows[:, :, 0], Ex[:, None].astype(object)) - scale * S
-    den = np.left_shift(1, (s + t[at] + Ex[:, None]).astype(object))
-    return (N / den).astype(np.float64)
 
 
 def _inverses(Af: np.ndarray) -> np.ndarray:

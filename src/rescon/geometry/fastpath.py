@@ -61,7 +61,7 @@ from math import gcd
 import numpy as np
 
 from .._rounding import UNIT_ROUNDOFF as _EPS
-from ._lazy_vertices import LazyVertices
+from ._lazy_vertices import LazyVertices, RowsOf
 from .exact import cross_all
 from .polytope import PRIME, ExactPolytope, _bits, members_of, tight_pairs
 
@@ -329,8 +329,7 @@ def _proposed_points(H, Ts: np.ndarray, solved: np.ndarray, S: np.ndarray, k: in
     decide. Correct rounding is a function of the point, so the floats are those the
     exact vertices give, and the exact vertices, solved from the same rows by the same
     code, are those the eager solve gave."""
-    from ._lazy_vertices import RowsOf
-    from ._vertex_floats import rounded_points
+    from ._vertex_floats import rounded_points  # looked up per call: tests replace it
 
     T = Ts[solved]
     if not len(T):
