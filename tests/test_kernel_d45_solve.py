@@ -136,9 +136,9 @@ def test_rows_violated_by_a_proposal_join_the_next_round(seed, monkeypatch):
     rounds = []
     propose = fastpath._propose
 
-    def spy(H_, sel, options=None):
+    def spy(H_, sel, *args):
         rounds.append(len(sel))
-        return propose(H_, sel, options)
+        return propose(H_, sel, *args)
 
     monkeypatch.setattr(fastpath, "_propose", spy)
     P = fastpath.certified_kernel(H, 4, unit, few)

@@ -71,6 +71,10 @@ WORK = 200_000
 #: for the simple vertices' pass (:func:`_simple_ends`; C(10, 4) = 210 keys at most in
 #: k = 5); a simple vertex sharing k − 1 rows with a larger one is left to the scan
 KEYED_ROWS = 10
+#: from this many vertices on, the closure's check runs on threads, CLOSURE_CHUNKS
+#: ranges of vertices (:func:`._candidates.on_threads`)
+CLOSURE_THREADS_MIN = 1000
+CLOSURE_CHUNKS = 8
 
 
 def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
@@ -94,42 +98,59 @@ def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
     if k >= 2 and len(normals) ** (k - 1) < 2**62:  # the keys fit int64
         _simple_ends(v_ptr, v_rows, h_ptr, h_verts, len(normals), k, KEYED_ROWS, pre,
                      pre_ends)
-    ptr, ends = _closures(v_ptr, v_rows, h_ptr, h_verts, residues.reshape(-1, k), k, ok,
-                          pre, pre_ends)
-    ends = ends.tolist()
-    return ok, [ends[a:b] for a, b in zip(ptr[:-1].tolist(), ptr[1:].tolist(), strict=True)]
+    from ._candidates import on_threads  # looked up per call: tests replace it
+
+    n = len(tight)
+    chunks = CLOSURE_CHUNKS if n >= CLOSURE_THREADS_MIN else 1
+    parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+    R = residues.reshape(-1, k)
+
+    def scan(lo: int, hi: int) -> None:
+        parts[lo, hi] = _closures(v_ptr, v_rows, h_ptr, h_verts, R, k, ok, pre, pre_ends,
+                                  lo, hi)
+
+    on_threads(scan, n, chunks)
+    out: list[list[int]] = []
+    for lohi in sorted(parts):  # the ranges in order (empty ones add nothing)
+        ptr, ends = parts[lohi]
+        ends = ends.tolist()
+        out.extend(ends[a:b] for a, b in zip(ptr[:-1].tolist(), ptr[1:].tolist(), strict=True))
+    return ok, out
 
 
 @njit(cache=True, nogil=True)
-def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok, pre, pre_ends):
-    """:func:`combinatorial_rays` on the incidences in CSR form (v_rows[v_ptr[v]:
-    v_ptr[v + 1]]: the rows of vertex v, increasing; h_verts likewise the vertices of
-    each row): ok[v], and the ends of the passing vertices (ends[ptr[v]:ptr[v + 1]]).
-    The simple vertices with ``pre`` set pass with the k ends ``pre_ends`` (found by
-    :func:`_simple_ends`, the same as the check's: see there) without a scan."""
+def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok, pre, pre_ends, lo, hi):
+    """:func:`combinatorial_rays` for the vertices lo ≤ v < hi, on the incidences in
+    CSR form (v_rows[v_ptr[v]:v_ptr[v + 1]]: the rows of vertex v, increasing; h_verts
+    likewise the vertices of each row): ok[v], and the ends of the passing vertices
+    (ends[ptr[v − lo]:ptr[v − lo + 1]]). The simple vertices with ``pre`` set pass with
+    the k ends ``pre_ends`` (found by :func:`_simple_ends`, the same as the check's:
+    see there) without a scan. Each vertex's check reads only the shared incidences
+    (ranges on threads write disjoint entries of ``ok``)."""
     n = len(v_ptr) - 1
     count = np.zeros(n, dtype=np.int64)
     mask = np.zeros(n, dtype=np.int64)
     touched = np.empty(n, dtype=np.int64)
-    ptr = np.zeros(n + 1, dtype=np.int64)
-    ends = np.empty(16 * n + 16, dtype=np.int64)
+    ptr = np.zeros(hi - lo + 1, dtype=np.int64)
+    ends = np.empty(16 * (hi - lo) + 16, dtype=np.int64)
     found_u = np.empty(n, dtype=np.int64)
     found_z = np.empty(n, dtype=np.int64)
     R = np.empty((MAX_ROWS, k), dtype=np.int64)
     work = np.empty((MAX_ROWS, k), dtype=np.int64)
-    for v in range(n):
-        ptr[v + 1] = ptr[v]
+    for v in range(lo, hi):
+        i = v - lo
+        ptr[i + 1] = ptr[i]
         t = v_ptr[v + 1] - v_ptr[v]
         if t < k or t > MAX_ROWS:
             continue
         if pre[v]:
             ok[v] = True
-            if ptr[v] + k > len(ends):
-                grown = np.empty(2 * (ptr[v] + k), dtype=np.int64)
-                grown[:ptr[v]] = ends[:ptr[v]]
+            if ptr[i] + k > len(ends):
+                grown = np.empty(2 * (ptr[i] + k), dtype=np.int64)
+                grown[:ptr[i]] = ends[:ptr[i]]
                 ends = grown
-            ends[ptr[v]:ptr[v] + k] = np.sort(pre_ends[v])
-            ptr[v + 1] = ptr[v] + k
+            ends[ptr[i]:ptr[i] + k] = np.sort(pre_ends[v])
+            ptr[i + 1] = ptr[i] + k
             continue
         # the vertices sharing rows with v: how many, and which (bits over v's rows)
         m = 0
@@ -157,12 +178,12 @@ def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok, pre, pre_ends):
         if not _faces_closed(found_z[:f].copy(), k - 1, R, work):
             continue
         ok[v] = True
-        if ptr[v] + f > len(ends):
-            grown = np.empty(2 * (ptr[v] + f), dtype=np.int64)
-            grown[:ptr[v]] = ends[:ptr[v]]
+        if ptr[i] + f > len(ends):
+            grown = np.empty(2 * (ptr[i] + f), dtype=np.int64)
+            grown[:ptr[i]] = ends[:ptr[i]]
             ends = grown
-        ends[ptr[v]:ptr[v] + f] = np.sort(found_u[:f])
-        ptr[v + 1] = ptr[v] + f
+        ends[ptr[i]:ptr[i] + f] = np.sort(found_u[:f])
+        ptr[i + 1] = ptr[i] + f
     return ptr, ends[:ptr[-1]]
 
 

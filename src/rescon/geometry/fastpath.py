@@ -110,18 +110,21 @@ MERGED_OPTIONS_5D = ("C-0 Q14", None)
 #: clouds, with 6–10 % less qhull time (sphere(4, 50, 5) 20.7 → 18.8 CPU-ms, medians
 #: of 8 alternating). A proposal alone: the certification decides.
 MERGED_OPTIONS_4D = ("Q5",)
+#: qhull's intersection in dimension ≥ SPLIT_DIM with at least SPLIT_ROWS halfspaces
+#: runs as two halves on two threads (:func:`_halves`)
+SPLIT_DIM = 5
+SPLIT_ROWS = 400
 
 
-def _propose(H, sel: np.ndarray, options: str | None = None
+def _propose(H, sel: np.ndarray, options: str | None = None, split: bool = True
              ) -> tuple[np.ndarray, list[list[int]]] | None:
     """Vertices and their defining halfspaces (indices into sel) of {A x ≤ b}, from
     qhull around a Chebyshev centre. A kernel small against its coordinates (states
     that have nearly converged) is re-centred and rescaled first: x = o + s y with o
     the first centre, s the distance from o to its (k+1)-th nearest halfspace, so the
     LP and qhull see it at unit size. ``options``: qhull's option string (None: its
-    default). None for a flat or empty kernel or a qhull failure."""
-    from scipy.spatial import HalfspaceIntersection, QhullError
-
+    default); ``split``: large ones in d ≥ 5 may come from two halves
+    (:func:`_intersection`). None for a flat or empty kernel or a qhull failure."""
     norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
     if not norms.all():  # a float row rounded to zero: no proposal
         return None
@@ -151,6 +154,37 @@ def _propose(H, sel: np.ndarray, options: str | None = None
         x0, r = found
     if r <= 1e-9 * (1.0 + np.abs(x0).max()):
         return None
+    found = _intersection(A, b, x0, r, options, split)
+    if found is None:
+        return None
+    V, facets = found  # facets: lists of ints, positions in rows
+    if len(rows) < len(sel):  # the local pass left rows out: positions in sel
+        kept = rows.tolist()
+        facets = [[kept[i] for i in f] for f in facets]
+    return o + s * V, facets
+
+
+def _intersection(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float,
+                  options: str | None, split: bool = True
+                  ) -> tuple[np.ndarray, list[list[int]]] | None:
+    """The vertices of P = {A x ≤ b} (x0 inside, with the ball of radius r around it)
+    and, for each, the rows qhull finds tight there (positions in A): qhull's
+    halfspace intersection — with ``split``, in dimension ≥ SPLIT_DIM with at least
+    SPLIT_ROWS rows, as two halves on two threads (:func:`_halves`), on P itself where
+    that fails. None if qhull fails."""
+    if split and A.shape[1] >= SPLIT_DIM and len(A) >= SPLIT_ROWS:
+        found = _halves(A, b, x0, r, options)
+        if found is not None:
+            return found
+    return _qhull(A, b, x0, options)
+
+
+def _qhull(A: np.ndarray, b: np.ndarray, x0: np.ndarray, options: str | None
+           ) -> tuple[np.ndarray, list[list[int]]] | None:
+    """qhull's intersection of {A x ≤ b} around the interior point x0: its vertices
+    and dual facets; None if qhull fails or gives a non-finite vertex."""
+    from scipy.spatial import HalfspaceIntersection, QhullError
+
     try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
         with np.errstate(divide="ignore", invalid="ignore"):
             hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0,
@@ -159,11 +193,95 @@ def _propose(H, sel: np.ndarray, options: str | None = None
         return None
     if not np.isfinite(hs.intersections).all():
         return None
-    facets = hs.dual_facets  # lists of ints, positions in rows
-    if len(rows) < len(sel):  # the local pass left rows out: positions in sel
-        kept = rows.tolist()
-        facets = [[kept[i] for i in f] for f in facets]
-    return o + s * hs.intersections, facets
+    return hs.intersections, hs.dual_facets
+
+
+def _halves(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float, options: str | None
+            ) -> tuple[np.ndarray, list[list[int]]] | None:
+    """:func:`_intersection` from the halves P⁻ = P ∩ {x_1 ≤ c} and P⁺ = P ∩ {x_1 ≥ c}
+    (c = x0's first coordinate; x0 ∓ (r/2) e_1 are inside them, r/2 from their
+    boundaries), one qhull each on two threads (numba's thread count; one thread runs
+    them in turn) — qhull runs without the GIL, and its work follows its output.
+
+    With the cut as row m: a vertex of P off the cut is a vertex of the half holding
+    it, tight on the same rows; every other vertex of a half lies on the cut — a
+    vertex of the section of P by the cut, which both halves share: where an edge of
+    P crosses the cut, or a vertex of P on it. So the proposals are the halves'
+    vertices not tight on m and those of :func:`_on_the_cut`. Proposals only: the
+    certification decides, and :func:`_attempt` asks qhull for P itself when the
+    halves' proposal fails. None if qhull fails on a half or the halves' sections
+    do not match."""
+    from ._candidates import on_threads
+
+    k, m = A.shape[1], len(A)
+    cut = np.zeros(k)
+    cut[0] = 1.0
+    shift = np.zeros(k)
+    shift[0] = 0.5 * r
+    sides = ((np.vstack([A, cut]), np.append(b, x0[0]), x0 - shift),
+             (np.vstack([A, -cut]), np.append(b, -x0[0]), x0 + shift))
+    found: list = [None, None]
+
+    def run(lo: int, hi: int) -> None:
+        for side in range(lo, hi):
+            found[side] = _qhull(*sides[side], options)
+
+    on_threads(run, 2, 2)
+    if found[0] is None or found[1] is None:
+        return None
+    points: list[np.ndarray] = []
+    facets: list[list[int]] = []
+    cuts = []  # per half: its vertices on the cut (points) and their other rows
+    for V, dual in found:
+        on = [m in f for f in dual]
+        for i, f in enumerate(dual):
+            if not on[i]:
+                points.append(V[i])
+                facets.append(f)
+        at = np.flatnonzero(on)
+        cuts.append((V[at], [[h for h in dual[i] if h != m] for i in at.tolist()]))
+    more = _on_the_cut(A, k, *cuts[0], *cuts[1])
+    if more is None:
+        return None
+    for p, f in more:
+        points.append(p)
+        facets.append(f)
+    if not facets:
+        return None
+    return np.array(points), facets
+
+
+def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
+                V1: np.ndarray, rows1: list[list[int]]
+                ) -> list[tuple[np.ndarray, list[int]]] | None:
+    """The vertices of P among the two halves' vertices on the cut (points V0, V1 and
+    their rows other than the cut): the halves share the section of P by the cut, so
+    each point of one matches a point of the other (the nearest, within 10⁻⁹ of the
+    coordinates: floats of two qhull runs) — else None. A matched pair whose rows
+    (their union: a half sees only the rows of P that bound it near the point) have
+    rank k in floats is a vertex of P on the cut, or near it where qhull merged it
+    with the cut's vertices: proposed once; rank k − 1 is an edge of P crossing the
+    cut (k − 1 rows at a simple one; more, common, where the edge lies in several
+    hyperplanes through data points, each solve of which would find no point)."""
+    if len(V0) != len(V1):
+        return None
+    if not len(V0):
+        return []
+    from scipy.spatial import cKDTree
+
+    tol = 1e-9 * (1.0 + max(np.abs(V0).max(), np.abs(V1).max()))
+    gap, match = cKDTree(V1).query(V0)
+    if not (gap <= tol).all() or len(np.unique(match)) != len(V0):
+        return None
+    out, seen = [], set()
+    for i, j in enumerate(match.tolist()):
+        rows = sorted(set(rows0[i]).union(rows1[j]))
+        if len(rows) < k or tuple(rows) in seen:
+            continue
+        seen.add(tuple(rows))
+        if np.linalg.matrix_rank(A[rows]) == k:
+            out.append((V0[i], rows))
+    return out
 
 
 def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope | None:
@@ -212,9 +330,12 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
              ) -> ExactPolytope | None:
     """Proposals from qhull with ``options``, certified by :func:`_certify`; None on
     failure. If the certification fails, the halfspaces clearly violated by a proposed
-    vertex (:func:`_row_max` of the float proposals) join ``sel`` for the next round."""
+    vertex (:func:`_row_max` of the float proposals) join ``sel`` for the next round;
+    if none is, the next round's proposal comes from qhull on P itself (not its
+    halves, :func:`_halves`), or the attempt fails if it already did."""
+    split = True
     for _ in range(MAX_ROUNDS):
-        prop = _propose(H, sel, options)
+        prop = _propose(H, sel, options, split)
         if prop is None:
             return None
         V, facets = prop
@@ -225,7 +346,9 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
             return P
         bad = _row_max(H, V) > 1e-9 * (1.0 + np.abs(H.bf))
         if not bad.any():
-            return None
+            if not split:
+                return None
+            split = False  # the halves may have lost a vertex on their cut
         sel = np.union1d(sel, np.flatnonzero(bad))
     return None
 
