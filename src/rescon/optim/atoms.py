@@ -52,6 +52,7 @@ __all__ = [
     "Quadratic",
     "Scaled",
     "Sum",
+    "complete_square",
     "is_psd",
     "ldl_psd",
 ]
@@ -88,6 +89,44 @@ def is_psd(M: Sequence[Sequence[Any]]) -> bool:
     """Whether the symmetric matrix ``M`` is positive semidefinite, exactly
     (see :func:`ldl_psd`)."""
     return ldl_psd(M) is not None
+
+
+def complete_square(Q: Sequence[Sequence[Fraction]], q: Sequence[Fraction]
+                    ) -> tuple[list[Fraction], list[Fraction]]:
+    """(c, r) with q = r − Qc, r in null(Q) and c in range(Q), exactly, for a symmetric
+    matrix Q and a vector q of Fractions: r is the orthogonal projection of q on null(Q)
+    and c = −Q⁺q, so that (as rᵀc = 0)
+
+        ½xᵀQx + qᵀx + k = ½(x − c)ᵀQ(x − c) + rᵀx + (k − ½cᵀQc),
+
+    the constant being the value at c. Exact row reduction, O(d³) Fraction operations.
+    """
+    from ..geometry.exact import _rref, nullspace_exact
+
+    d = len(q)
+    null = nullspace_exact([list(row) for row in Q])
+    r = _projection(null, q)
+    A = [list(row) + [ri - qi] for row, ri, qi in zip(Q, r, q, strict=True)]
+    c = [Fraction(0)] * d
+    for i, col in enumerate(_rref(A, d)):
+        c[col] = A[i][d]
+    return [ci - pi for ci, pi in zip(c, _projection(null, c), strict=True)], r
+
+
+def _projection(basis: list[list[Fraction]], v: Sequence[Fraction]) -> list[Fraction]:
+    """The orthogonal projection of v on the span of ``basis`` (independent vectors)."""
+    from ..geometry.exact import solve_exact
+
+    if not basis:
+        return [Fraction(0)] * len(v)
+    gram = [[_dot(a, b) for b in basis] for a in basis]
+    y = solve_exact(gram, [_dot(a, v) for a in basis])
+    return [sum((yk * bk[i] for yk, bk in zip(y, basis, strict=True)), Fraction(0))
+            for i in range(len(v))]
+
+
+def _dot(a: Sequence[Fraction], b: Sequence[Fraction]) -> Fraction:
+    return sum((x * y for x, y in zip(a, b, strict=True)), Fraction(0))
 
 
 def _rational(value: Any, shape: tuple[int, ...]) -> Any:
@@ -195,7 +234,15 @@ class Atom(Oracle):
 
 class Quadratic(Atom):
     """f(x) = ½(x − c)ᵀQ(x − c) + qᵀx + const, Q symmetric positive semidefinite
-    (both checked exactly on the given data); ∇f = Q(x − c) + q."""
+    (both checked exactly on the given data); ∇f = Q(x − c) + q.
+
+    With c ≠ 0, f is also kept expanded at the origin, ½xᵀQx + q₀ᵀx + k₀ (q₀ = q − Qc,
+    k₀ = const + ½cᵀQc, correctly rounded from the exact data), and each point is
+    evaluated (value and gradient) in the form with the smaller rounding bound
+    ½|wᵀQw| + Σ|q_i x_i| + |const| (+ Σ|(Qw)_i c_i| for the rounding of c; w = x − c,
+    resp. x): the centred form far from the origin (no cancellation of ~|c|² terms at
+    x ≈ c), the expanded one near it (no cancellation of ~|Q||c|² terms when the
+    minimum is far away and very negative)."""
 
     quadratic = True
 
@@ -216,29 +263,68 @@ class Quadratic(Atom):
         self.exact = {"Q": Qx, "c": _rational(c, (d,)), "q": _rational(q, (d,)),
                       "const": _rational(const, ())}
         self.polyhedral = not Qf.any()
+        self._origin = _expanded(self.exact) if any(self.exact["c"]) else None
 
     def _value(self, Z: np.ndarray) -> np.ndarray:
-        W = Z - self.c
-        return 0.5 * ((W @ self.Q) * W).sum(axis=1) + Z @ self.q + self.const
+        if self._origin is None:
+            W = Z - self.c
+            return 0.5 * ((W @ self.Q) * W).sum(axis=1) + Z @ self.q + self.const
+        return self._value_each(Z, self._data(), None)
 
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
-        return (Z - self.c) @ self.Q + self.q
+        if self._origin is None:
+            return (Z - self.c) @ self.Q + self.q
+        return self._subgradient_each(Z, self._data(), None)
 
     def _signature(self) -> Hashable:
         return (Quadratic, self.d)
 
     def _data(self) -> dict[str, Any]:
-        return {"Q": self.Q, "c": self.c, "q": self.q, "const": self.const}
+        q0, k0, b0 = self._origin or (self.q, self.const, np.inf)
+        return {"Q": self.Q, "c": self.c, "q": self.q, "const": self.const,
+                "q0": q0, "k0": k0, "b0": b0}
 
     @staticmethod
-    def _value_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+    def _forms(Z: np.ndarray, S: dict[str, Any]
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(value centred, value expanded, whether the expanded one is taken, Q(z − c),
+        Qz) on points Z (leading axes broadcast against the data S)."""
         W = Z - S["c"]
-        return (0.5 * _rsum(np.einsum("...d,...de->...e", W, S["Q"]) * W)
-                + _rsum(Z * S["q"]) + S["const"])
+        QW = np.einsum("...d,...de->...e", W, S["Q"])
+        a, lin = 0.5 * _rsum(QW * W), Z * S["q"]
+        v = a + _rsum(lin) + S["const"]
+        with np.errstate(over="ignore", invalid="ignore"):
+            QZ = np.einsum("...d,...de->...e", Z, S["Q"])
+            a0, lin0 = 0.5 * _rsum(QZ * Z), Z * S["q0"]
+            v0 = a0 + _rsum(lin0) + S["k0"]
+            bound = np.abs(a) + _rsum(np.abs(lin)) + np.abs(S["const"]) \
+                + _rsum(np.abs(QW * S["c"]))
+            bound0 = np.abs(a0) + _rsum(np.abs(lin0)) + np.abs(S["k0"]) + S["b0"]
+            return v, v0, bound0 < bound, QW, QZ
 
-    @staticmethod
-    def _subgradient_each(Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
-        return np.einsum("...d,...de->...e", Z - S["c"], S["Q"]) + S["q"]
+    @classmethod
+    def _value_each(cls, Z: np.ndarray, S: dict[str, Any], sig: Hashable) -> np.ndarray:
+        v, v0, origin, _, _ = cls._forms(Z, S)
+        return np.where(origin, v0, v)
+
+    @classmethod
+    def _subgradient_each(cls, Z: np.ndarray, S: dict[str, Any], sig: Hashable
+                          ) -> np.ndarray:
+        _, _, origin, QW, QZ = cls._forms(Z, S)
+        return np.where(origin[..., None], QZ + S["q0"], QW + S["q"])
+
+
+def _expanded(exact: dict[str, Any]) -> tuple[np.ndarray, float, float] | None:
+    """(q₀, k₀, 0.0): Quadratic's ``exact`` data expanded at the origin, ½xᵀQx + q₀ᵀx + k₀,
+    correctly rounded; None when a number does not fit a float."""
+    Q, c = exact["Q"], exact["c"]
+    Qc = [_dot(row, c) for row in Q]
+    try:
+        q0 = np.array([float(qi - v) for qi, v in zip(exact["q"], Qc, strict=True)])
+        k0 = float(exact["const"] + _dot(c, Qc) / 2)
+    except OverflowError:
+        return None
+    return (q0, k0, 0.0) if np.isfinite(q0).all() and math.isfinite(k0) else None
 
 
 class Affine(Atom):
@@ -673,12 +759,13 @@ class Merged(Atom):
     The terms are flattened through sums and scalings (Scaled(c, f) with weight w is f
     with weight wc), then:
 
-    * Quadratic and Affine terms collapse into one quadratic
-      ½(x − m)ᵀH(x − m) + gᵀ(x − m) + F₀ with H = Σ w_j Q_j, centred at m, a
-      least-squares solution of Hm = −ℓ (ℓ = Σ w_j (q_j − Q_j c_j) + Σ w_j a_j, the
-      linear part), g = Hm + ℓ (≈ 0), and F₀ = Σ w_j f_j(m) summed exactly rounded
-      (``math.fsum``): the large constants are summed once, at the minimiser of that
-      part when it has one, so nothing cancels near X*;
+    * Quadratic and Affine terms collapse into one :class:`Quadratic`
+      ½(x − m)ᵀH(x − m) + rᵀx + F₀ computed exactly from the terms' exact data and
+      weights: H = Σ w_j Q_j, ℓ = Σ w_j (q_j − Q_j c_j) + Σ w_j a_j (the linear part),
+      m = −H⁺ℓ, r the projection of ℓ on null(H) (:func:`complete_square`), F₀ the
+      value at m, each correctly rounded; evaluated per point in the centred or the
+      expanded form (see :class:`Quadratic`), so nothing cancels near X* (m is X* of
+      that part when it has one) nor near the origin when m is far away;
     * the separable row atoms stack their rows with their weights, one matrix per
       kind: Σ_k w_k φ(a_kᵀx − b_k) with φ = |·| (AbsAffine, Norm1), max(0, ·) (Hinge),
       h_M (Huber, per-row M); subgradient Aᵀ(w ⊙ φ'(r)) with the atoms' own φ';
@@ -687,8 +774,9 @@ class Merged(Atom):
     * any other oracle (callables, CasADi, CVXPY) is called as itself (checked).
 
     Values (and subgradients) are summed in that order. They equal Σ_j w_j f_j up to
-    rounding: the collapsed quadratic differs from the term-by-term sum by a few ulps
-    of Σ_j w_j |f_j| (from H, ℓ, m), the rest by the order of the sums.
+    rounding: the collapsed quadratic differs from the exact Σ_j w_j f_j by a few ulps
+    of the magnitudes of its form's terms (the smaller of the two forms' bounds), the
+    rest by the order of the sums.
     """
 
     def __init__(self, terms: Sequence[tuple[float, Oracle]], d: int, *,
@@ -713,9 +801,7 @@ class Merged(Atom):
     def _value(self, Z: np.ndarray) -> np.ndarray:
         F = np.zeros(len(Z))
         if self._quad is not None:
-            H, m, g, F0 = self._quad
-            W = Z - m
-            F += 0.5 * ((W @ H) * W).sum(axis=1) + W @ g + F0
+            F += self._quad._value(Z)
         for kind, At, b, M, w in self._rows:
             F += np.einsum("pk,k->p", kind._phi(_residuals(Z, At, b), M), w)
         for st, w in self._packs:
@@ -728,8 +814,7 @@ class Merged(Atom):
     def _subgradient(self, Z: np.ndarray) -> np.ndarray:
         G = np.zeros(Z.shape)
         if self._quad is not None:
-            H, m, g, _ = self._quad
-            G += (Z - m) @ H + g
+            G += self._quad._subgradient(Z)
         for kind, At, b, M, w in self._rows:
             G += np.einsum("pk,dk->pd", kind._w(_residuals(Z, At, b), M) * w, At)
         for st, w in self._packs:
@@ -763,26 +848,30 @@ def _flatten(o: Oracle, w: float, out: list[tuple[float, Oracle]]) -> None:
         out.append((w, o))
 
 
-def _collapse(quad: list[tuple[float, Oracle]], d: int
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float] | None:
-    """(H, m, g, F₀) of Σ w_j f_j over Quadratic / Affine terms (see :class:`Merged`);
-    None when a number overflows (those terms then go the stacked way)."""
-    H, lin = np.zeros((d, d)), np.zeros(d)
-    with np.errstate(all="ignore"):
-        for w, o in quad:
-            if isinstance(o, Quadratic):
-                H += w * o.Q
-                lin += w * (o.q - o.Q @ o.c)
-            else:
-                lin += w * o.a
-        if not (np.isfinite(H).all() and np.isfinite(lin).all()):
-            return None
-        m = np.linalg.lstsq(H, -lin, rcond=None)[0]
-        g = H @ m + lin
-        F0 = math.fsum(w * float(o._value(m[None])[0]) for w, o in quad)
-    if not (np.isfinite(m).all() and np.isfinite(g).all() and math.isfinite(F0)):
+def _collapse(quad: list[tuple[float, Oracle]], d: int) -> Quadratic | None:
+    """Σ w_j f_j over Quadratic / Affine terms as one :class:`Quadratic` centred at
+    m = −H⁺ℓ with the linear part r in null(H) (:func:`complete_square`) and the value at
+    m as its constant, all exact (see :class:`Merged`); None when a number does not fit
+    a float (those terms then go the stacked way)."""
+    H = [[Fraction(0)] * d for _ in range(d)]
+    lin, const = [Fraction(0)] * d, Fraction(0)
+    for w, o in quad:
+        wx, ex = Fraction(w), o.exact
+        if isinstance(o, Quadratic):
+            q0 = [qi - _dot(row, ex["c"]) for qi, row in zip(ex["q"], ex["Q"], strict=True)]
+            k0 = ex["const"] + _dot(ex["c"], [_dot(row, ex["c"]) for row in ex["Q"]]) / 2
+            for i, row in enumerate(ex["Q"]):
+                H[i] = [h + wx * v for h, v in zip(H[i], row, strict=True)]
+        else:
+            q0, k0 = ex["a"], ex["b"]
+        lin = [v + wx * qi for v, qi in zip(lin, q0, strict=True)]
+        const += wx * k0
+    m, r = complete_square(H, lin)
+    Hm = [_dot(row, m) for row in H]
+    try:
+        return Quadratic(H, c=m, q=r, const=const + _dot(lin, m) + _dot(m, Hm) / 2)
+    except InputError:
         return None
-    return H, m, g, F0
 
 
 def _row_kind(o: Oracle) -> type | None:

@@ -46,9 +46,10 @@ __all__ = ["CasadiOracle", "casadi_cost"]
 
 def casadi_cost(spec: Any, *, x: Any = None, d: int | None = None,
                 name: str = "cost") -> Oracle:
-    """The oracle of a scalar CasADi SX/MX expression in the symbol ``x`` (a d-vector),
-    or of a CasADi Function of one d-vector with a scalar first output; the lowered
-    atom when the graph allows (see the module notes), else a :class:`CasadiOracle`."""
+    """The oracle of a scalar CasADi SX/MX expression in the symbol ``x`` (a d-vector;
+    None: the expression's only symbol, e.g. an MX vector or one scalar SX), or of a
+    CasADi Function of one d-vector with a scalar first output; the lowered atom when
+    the graph allows (see the module notes), else a :class:`CasadiOracle`."""
     require_backend("casadi", "model")
     import casadi as ca
 
@@ -81,7 +82,9 @@ def _function(ca: Any, spec: Any, x: Any, name: str) -> Any:
         if not isinstance(spec, (ca.SX, ca.MX)):
             raise InputError(f"{name}: a CasADi cost must be an SX/MX expression or a "
                              f"Function; got {type(spec).__name__}")
-        if x is None or type(x) is not type(spec) or not x.is_valid_input():
+        if x is None:
+            x = _symbol(ca, spec, name)
+        if type(x) is not type(spec) or not x.is_valid_input():
             raise InputError(f"{name}: give the CasADi symbol the cost is written in "
                              f"(rescon.cost(expr, x=x), x of the same type as expr)")
         try:
@@ -96,6 +99,19 @@ def _function(ca: Any, spec: Any, x: Any, name: str) -> Any:
                          f"got inputs {[fn.size_in(i) for i in range(fn.n_in())]}, first "
                          f"output {fn.size_out(0) if fn.n_out() else None}")
     return fn
+
+
+def _symbol(ca: Any, spec: Any, name: str) -> Any:
+    """The one symbol ``spec`` is written in (``casadi.symvar``); InputError when it has
+    none or several (an SX vector's entries are separate symbols: give x= then)."""
+    syms = ca.symvar(spec)
+    if len(syms) == 1:
+        return syms[0]
+    names = ", ".join(str(s) for s in syms[:4]) + (", …" if len(syms) > 4 else "")
+    have = f"{len(syms)} symbols ({names})" if syms else "no symbol"
+    raise InputError(f"{name}: the CasADi cost has {have}; give the CasADi symbol it is "
+                     f"written in "
+                     f"(rescon.cost(expr, x=x))")
 
 
 class _Lower:

@@ -28,7 +28,8 @@ def cost(spec: Any, *, x: Any = None, d: int | None = None, vectorised: bool = F
         * an :class:`~rescon.optim.oracle.Oracle` (returned as is), or any object with
           ``value``/``subgradient``/``d`` (wrapped so its answers are checked).
     x : the CasADi symbol or CVXPY Variable ``spec`` is written in (CasADi: found from
-        the expression when it has exactly one symbol).
+        the expression when it has exactly one symbol — an MX vector, or one scalar SX;
+        an SX vector's entries are separate symbols, so give x there).
     d : the dimension (an expression may use fewer variables than d; a callable pair
         without d accepts any dimension).
     vectorised : for a pair of callables, whether they take stacked points.

@@ -9,7 +9,8 @@ Grammar (DESIGN.md; a recursive-descent parser, no ``eval``)::
     atom  := NUMBER | x1 | x2 | … | FUNC "(" expr ("," expr)* ")" | "(" expr ")"
     FUNC  := abs | pos | max | min | norm1 | norm2 | norminf | huber | sqrt | logsumexp
 
-Numbers are read exactly (``0.3`` is 3/10). Every expression is kept in a canonical
+Numbers are read exactly (``0.3`` is 3/10); parentheses, calls, signs and exponents
+nest at most :data:`MAX_DEPTH` (100) levels deep. Every expression is kept in a canonical
 form: a polynomial of degree ≤ 2 with rational coefficients plus a list of
 coef · call terms. Convexity is decided by DCP-style rules, with one exact
 refinement: the polynomial part is convex iff its Hessian is positive semidefinite,
@@ -316,14 +317,16 @@ def lower(e: Expr, d: int) -> Oracle:
     """The atom (tree) computing the convex expression ``e`` over x ∈ R^d
     (:meth:`Expr.check_convex` must have passed): the polynomial part as one
     Quadratic (or Affine), two or more positive ``abs`` terms as one Norm1 (one
-    matrix product instead of one per term), each other term as its atom."""
+    matrix product instead of one per term), each other term as its atom. The
+    polynomial part is centred at its (minimum-norm) minimiser, exactly (see
+    :func:`_quadratic`)."""
     parts: list[Oracle] = []
     A, c = _affine_rows([_linear(e)], d)
     if any(e.quad.values()):
         Q = e.hessian(d)
         for v in (v for row in Q for v in row):
             _float(v)
-        parts.append(atoms.Quadratic(Q, q=A[0], const=c[0]))
+        parts.append(_quadratic(Q, list(A[0]), c[0]))
     elif any(e.lin.values()) or e.const or not e.terms:
         parts.append(atoms.Affine(A[0], c[0]))
     absolute = [(coef, call) for coef, call in e.terms if coef > 0 and call.fn == "abs"]
@@ -336,6 +339,22 @@ def lower(e: Expr, d: int) -> Oracle:
         atom = _lower_call(call, d) if coef > 0 else _lower_negated_min(call, d)
         parts.append(atom if abs(coef) == 1 else atoms.Scaled(abs(coef), atom))
     return parts[0] if len(parts) == 1 else atoms.Sum(parts)
+
+
+def _quadratic(Q: list[list[Fraction]], q: list[Fraction], k: Fraction) -> Oracle:
+    """½xᵀQx + qᵀx + k as a Quadratic centred at c = −Q⁺q, completed exactly
+    (:func:`~rescon.optim.atoms.complete_square`): ½(x − c)ᵀQ(x − c) + rᵀx + f(c), which
+    the atom evaluates in this or the expanded form, whichever rounds less at the point
+    (so (x1 − 1e50)^2 is 0 at 1e50); the expanded form alone when c, r or f(c) does not
+    fit a float."""
+    c, r = atoms.complete_square(Q, q)
+    fc = k - sum(ci * sum(a * b for a, b in zip(row, c)) for ci, row in zip(c, Q)) / 2
+    try:
+        for v in (*c, *r, fc):
+            _float(v)
+    except ExprError:
+        return atoms.Quadratic(Q, q=q, const=k)
+    return atoms.Quadratic(Q, c=c, q=r, const=fc)
 
 
 def _linear(e: Expr) -> Expr:
@@ -400,10 +419,26 @@ def _tokens(src: str) -> list[tuple[str, str, int]]:
     return out
 
 
+#: how deeply parentheses, calls, signs and exponents may nest (each level is a few
+#: Python frames of the recursive descent; deeper input is refused, not a RecursionError)
+MAX_DEPTH = 100
+
+
 class _Parser:
     def __init__(self, src: str) -> None:
         self.toks = _tokens(src)
         self.i = 0
+        self.depth = 0
+
+    def nested(self, parse: Any, pos: int) -> Expr:
+        """``parse()`` one level deeper (ExprError beyond :data:`MAX_DEPTH`)."""
+        if self.depth == MAX_DEPTH:
+            raise ExprError(f"the expression nests more than {MAX_DEPTH} levels deep "
+                            f"(parentheses, calls, signs, exponents)", pos)
+        self.depth += 1
+        e = parse()
+        self.depth -= 1
+        return e
 
     def peek(self) -> tuple[str, str, int]:
         return self.toks[self.i]
@@ -435,7 +470,7 @@ class _Parser:
     def unary(self) -> Expr:
         if self.peek()[1] in ("+", "-"):
             _, op, pos = self.take()
-            e = self.unary()
+            e = self.nested(self.unary, pos)
             e = e if op == "+" else -e
             e.pos = pos
             return e
@@ -445,7 +480,7 @@ class _Parser:
         e = self.atom()
         if self.peek()[1] == "^":
             pos = self.take()[2]
-            e = e.power(self.unary(), pos)
+            e = e.power(self.nested(self.unary, pos), pos)
         return e
 
     def atom(self) -> Expr:
@@ -453,7 +488,7 @@ class _Parser:
         if kind == "num":
             return Expr.number(Fraction(text), pos)
         if text == "(":
-            e = self.expr()
+            e = self.nested(self.expr, pos)
             self.take(")")
             e.pos = pos
             return e
@@ -470,10 +505,10 @@ class _Parser:
 
     def call(self, fn: str, pos: int) -> Expr:
         self.take("(")
-        args = [self.expr()]
+        args = [self.nested(self.expr, pos)]
         while self.peek()[1] == ",":
             self.take()
-            args.append(self.expr())
+            args.append(self.nested(self.expr, pos))
         self.take(")")
         n = FUNCTIONS[fn]
         lo, hi = (n, n) if isinstance(n, int) else n if n else (1, None)

@@ -105,7 +105,7 @@ class Oracle:
         """``out`` as a float array of ``shape`` with finite entries, or InputError
         naming the oracle, what it returned and at which point."""
         try:
-            R = np.asarray(out, dtype=float)
+            R = _real(out)
         except (TypeError, ValueError):
             raise InputError(f"{self.name}: {what} returned {type(out).__name__}, "
                              f"not a real array") from None
@@ -123,6 +123,14 @@ class Oracle:
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name!r} d={self.d}>"
+
+
+def _real(out: Any) -> np.ndarray:
+    """``out`` as a float array; TypeError for complex numbers (numpy would drop their
+    imaginary part with a warning), ValueError for what is not numbers."""
+    if np.iscomplexobj(out):
+        raise TypeError("complex")
+    return np.asarray(out, dtype=float)
 
 
 def _first_bad(A: np.ndarray) -> str:
@@ -158,15 +166,23 @@ class CallableOracle(Oracle):
     def _subgradient(self, Z: np.ndarray) -> Any:
         if self.vectorised:
             return self.g(Z)
-        out = [np.asarray(self.g(z), dtype=float) for z in Z]
+        out = [self._array("subgradient", self.g(z), z) for z in Z]
         for z, g in zip(Z, out):
             if g.shape != z.shape:
                 raise InputError(f"{self.name}: subgradient returned shape {g.shape} at point "
                                  f"{z.tolist()}; expected {z.shape}")
         return np.array(out).reshape(Z.shape)
 
+    def _array(self, what: str, v: Any, z: np.ndarray) -> np.ndarray:
+        """One point's answer as a float array (InputError for a complex one)."""
+        try:
+            return _real(v)
+        except (TypeError, ValueError):
+            raise InputError(f"{self.name}: {what} returned {type(v).__name__} at point "
+                             f"{z.tolist()}, not a real array") from None
+
     def _scalar(self, v: Any, z: np.ndarray) -> float:
-        a = np.asarray(v, dtype=float)
+        a = self._array("value", v, z)
         if a.size != 1:
             raise InputError(f"{self.name}: value returned shape {a.shape} at point "
                              f"{z.tolist()}; expected a number")
