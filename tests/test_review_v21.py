@@ -406,7 +406,8 @@ def test_twosum_error_dropped_is_caught(monkeypatch):
 
         monkeypatch.setattr(vf, "_two_sum", two_sum)
         with np.errstate(all="ignore"):
-            vf._rounded(E, at, scale, k, slack, out, ok)
+            rows = vf._row_floats(E, scale, k)
+            vf._rounded(rows, *vf._split(rows[0].T), at, k, slack, out, ok)
         monkeypatch.setattr(vf, "_two_sum", real)
         return out, ok
 
@@ -817,7 +818,8 @@ def _bound_violations(name: str, k: int, slack: float = 1.0, old: str = "", new:
     E, at = _table(systems, k)
     out, ok = np.full((len(at), k), np.nan), np.zeros(len(at), dtype=np.bool_)
     with np.errstate(all="ignore"):
-        rounded(E, at, scale, k, slack, out, ok)
+        rows = vf._row_floats(E, scale, k)
+        rounded(rows, *vf._split(rows[0].T), at, k, slack, out, ok)
     idx, good, z0, delta, Eb, _, _, _ = seen[0]
     checked = bad = 0
     for q, p in enumerate(idx.tolist()):
@@ -857,7 +859,8 @@ def test_the_bounds_beta_and_e_hold_exactly(name):
     E, at = _table(systems, k)
     out, ok = np.full((len(at), k), np.nan), np.zeros(len(at), dtype=np.bool_)
     with np.errstate(all="ignore"):
-        rounded(E, at, scale, k, 1.0, out, ok)
+        rows = vf._row_floats(E, scale, k)
+        rounded(rows, *vf._split(rows[0].T), at, k, 1.0, out, ok)
     if not seen:
         return
     idx, good, z0, delta, Eb, beta, R, _ = seen[0]

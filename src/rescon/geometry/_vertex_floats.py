@@ -57,6 +57,10 @@ __all__ = ["rounded_points"]
 LIMIT = 400
 #: the floor of the bound terms (β_i, E_s)
 FLOOR = 2.0**-300
+#: from this many proposals on, ranges of them (THREAD_CHUNKS) are proven on threads
+#: (:func:`._candidates.on_threads`; numpy's array operations run without the GIL)
+THREADS_MIN = 2000
+THREAD_CHUNKS = 4
 
 _bit_length = np.frompyfunc(int.bit_length, 1, 1)
 
@@ -78,21 +82,33 @@ def rounded_points(E: np.ndarray, at: np.ndarray, scale: int, k: int,
     where its rows meet, and whether they are proven correctly rounded (module
     docstring); entries not proven are NaN. ``slack`` multiplies the bound E (1: the
     proven bound; tests pass < 1 to show a weakened bound is caught)."""
+    from ._candidates import on_threads  # looked up per call: tests replace it
+
     P = len(at)
     out = np.full((P, k), np.nan)
     ok = np.zeros(P, dtype=np.bool_)
     if not P or scale <= 0 or scale & (scale - 1):
         return out, ok
     with np.errstate(all="ignore"):
-        _rounded(E, at, scale, k, slack, out, ok)
+        rows = _row_floats(E, scale, k)
+        ah, al = _split(rows[0].T)  # columns first: (k, P, k) gathers, each contiguous
+
+        def scan(lo: int, hi: int) -> None:
+            if lo < hi:
+                with np.errstate(all="ignore"):  # numpy's error state is per thread
+                    _rounded(rows, ah, al, at[lo:hi], k, slack, out[lo:hi], ok[lo:hi])
+
+        on_threads(scan, P, THREAD_CHUNKS if P >= THREADS_MIN else 1)
     return out, ok
 
 
-def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
-             out: np.ndarray, ok: np.ndarray) -> None:
-    """:func:`rounded_points`, writing into ``out`` and ``ok``."""
-    Ahi, Alo, bhi, blo, _, split = _row_floats(E, scale, k)
-    split &= _in_range(Ahi, True) & _in_range(Alo, True)
+def _rounded(rows: tuple, ah: np.ndarray, al: np.ndarray, at: np.ndarray, k: int,
+             slack: float, out: np.ndarray, ok: np.ndarray) -> None:
+    """:func:`rounded_points` for the proposals ``at``, writing into ``out`` and ``ok``
+    (views): ``rows`` from :func:`_row_floats`, (ah, al) the split of its Ahi's
+    columns."""
+    Ahi, Alo, bhi, blo, _, split = rows
+    split = split & _in_range(Ahi, True) & _in_range(Alo, True)
     Af = Ahi[at]  # (P, k, k)
     R = _inverses(Af)
     z0 = (R @ (bhi[at] + blo[at])[:, :, None])[:, :, 0]
@@ -102,7 +118,6 @@ def _rounded(E: np.ndarray, at: np.ndarray, scale: int, k: int, slack: float,
     idx = np.flatnonzero(good)
     Af, R, z0, at = Af[idx], R[idx], z0[idx], at[idx]
     # 1. the residual with its error bound, scaled by 2^σ
-    ah, al = _split(Ahi.T)  # columns first: (k, P, k) gathers, each column contiguous
     rf, T, Q = _residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at], bhi[at],
                          blo[at], z0)
     top = np.abs(rf).max(axis=1)
