@@ -42,6 +42,7 @@ F(x + tv) decreases without bound in t.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -222,6 +223,20 @@ class Optimal:
         """y breaks one of the ``faces`` (n·y ≤ h, stored as (*n, h))."""
         return any(_dot(f[:-1], y) > f[-1] for f in self.faces or ())
 
+    def point_near(self, tight: list[tuple[Fraction, ...]], guess: list[Fraction]
+                   ) -> list[Fraction] | None:
+        """An exact point of E ∩ {the faces} (= argmin F when describable) on which the
+        faces ``tight`` hold with equality: ``guess`` projected exactly onto that affine
+        set (its only point when it is one), or None when the projection breaks a face
+        or the equalities are inconsistent."""
+        d = len(self.x)
+        rows = [list(r) + [_dot(r, self.x)] for r in self.rref] + [list(f) for f in tight]
+        piv = _rref(rows, d) if rows else []
+        if any(row[d] for row in rows[len(piv):]):
+            return None
+        y = _project(rows[:len(piv)], list(guess)) if piv else list(guess)
+        return None if self.violates_face(y) else y
+
 
 def check_optimal(F: PQ, x: list[Fraction], lam: Mult, mu: Mult) -> str | None:
     """None when (x, lam, mu) is an optimality certificate for F, else what fails."""
@@ -290,24 +305,36 @@ def _canonical(v: list[Fraction], R: list[list[Fraction]], piv: list[int], x: li
     return None if lead is None else tuple(a / abs(lead) for a in w)
 
 
-def rational(v: float) -> Fraction:
-    """A short rational near the float v (a guess; every use is verified exactly)."""
-    return Fraction(float(v)).limit_denominator(_FREE_DEN)
+def rational(v: float, scale: float = 1.0) -> Fraction:
+    """A short rational near the float v, to about 1/_FREE_DEN of ``scale`` (a guess;
+    every use is verified exactly); scale 0: v exactly (its binary value)."""
+    if not scale:
+        return Fraction(float(v))
+    s = Fraction(2) ** round(math.log2(scale))  # a power of two: exact rescaling
+    return (Fraction(float(v)) / s).limit_denominator(_FREE_DEN) * s
 
 
 def certify(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], muf: list[np.ndarray]
             ) -> Optimal | None:
     """An exact optimality certificate near the float solution, or None.
 
-    The support S_k of each block's multipliers is guessed from the floats (large
-    multipliers, then all pieces active to 1e-6); norm terms must have a zero residual
-    there. The linear system in (x, λ_S, μ) — equal values of the pieces in S_k,
-    A_l x = c_l, stationarity, Σ_j λ_kj = 1 — is solved exactly with its free unknowns
-    set to short rationals near the floats, or else projected exactly (least squares)
-    from those rationals onto the solution set, which keeps the interior-point
-    multipliers positive; the result is kept only when :func:`check_optimal` accepts it."""
-    for guess in ("support", "active"):
-        S = _support(F, xf, lamf, guess)
+    The support S_k of each block's multipliers is guessed from the floats: the
+    multipliers above 1e-6 of the block's largest, then the pieces whose values are
+    within 1e-6, then 1e-9, of the block's maximum *relative to the size of the block's
+    terms at x* (Σ_i |a_kji x_i| + |b_kj|: no absolute threshold, so argmins at any
+    scale are tried); norm terms must have a zero residual there. The linear system in
+    (x, λ_S, μ) — equal values of the pieces in S_k, A_l x = c_l, stationarity,
+    Σ_j λ_kj = 1 — is solved exactly with its free unknowns set to short rationals near
+    the floats (x to 1e-6 of 1, then of |x|, then x's floats exactly), or else projected
+    exactly (least squares) from those rationals onto the solution set, which keeps the
+    interior-point multipliers positive. Thresholds and roundings only choose what is
+    tried: the result is kept only when :func:`check_optimal` accepts it."""
+    tried: set[tuple] = set()
+    for guess, t in (("support", 1e-6), ("active", 1e-6), ("active", 1e-9)):
+        S = _support(F, xf, lamf, guess, t)
+        if (key := tuple(map(tuple, S))) in tried:
+            continue
+        tried.add(key)
         for sol in _candidates(F, S, xf, lamf, muf):
             if sol is not None and check_optimal(F, *sol) is None:
                 return describe(F, *sol)
@@ -317,10 +344,13 @@ def certify(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], muf: list[np.ndarray]
 def _candidates(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray],
                 muf: list[np.ndarray]) -> Iterator[tuple[list[Fraction], Mult, Mult] | None]:
     """Solutions to try, lazily (the joint systems are large): two-stage, then joint
-    with free unknowns at the floats, then joint projected."""
+    with free unknowns at the floats, then joint projected — x rounded to 1e-6 of 1,
+    then of |x|, then exactly."""
     yield _two_stage(F, S, xf, lamf, muf)
-    for project in (False, True):
-        yield _solve_system(F, S, xf, lamf, muf, project)
+    xs = float(np.abs(xf).max(initial=0.0))
+    for scale in dict.fromkeys((1.0, xs if 0 < xs < math.inf else 1.0, 0.0)):
+        for project in (False, True):
+            yield _solve_system(F, S, xf, lamf, muf, project, scale)
 
 
 def _two_stage(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray],
@@ -364,21 +394,25 @@ def _two_stage(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray]
     return x, lam, [[next(it) for _ in c] for _, c in F.norms]
 
 
-def _support(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], guess: str) -> list[list[int]]:
+def _support(F: PQ, xf: np.ndarray, lamf: list[np.ndarray], guess: str, t: float
+             ) -> list[list[int]]:
+    """Each block's guessed support: multipliers above t·max (``guess`` "support"), or
+    pieces within t·(size of the block's terms at xf) of the maximum ("active")."""
     out = []
     for blk, lk in zip(F.blocks, lamf, strict=True):
         if guess == "support":
-            s = [j for j, v in enumerate(lk) if v > 1e-6 * max(lk.max(), 1e-300)]
+            s = [j for j, v in enumerate(lk) if v > t * max(lk.max(), 1e-300)]
         else:
-            vals = np.array([sum(float(u) * xi for u, xi in zip(a, xf)) + float(b)
-                             for a, b in blk])
-            s = [int(j) for j in np.flatnonzero(vals >= vals.max() - 1e-6 * (1 + abs(vals).max()))]
+            A = np.array([[float(u) for u in a] for a, _ in blk])
+            b = np.array([float(bj) for _, bj in blk])
+            vals, size = A @ xf + b, np.abs(A) @ np.abs(xf) + np.abs(b)
+            s = [int(j) for j in np.flatnonzero(vals >= vals.max() - t * size.max())]
         out.append(s or [int(np.argmax(lk))])
     return out
 
 
 def _solve_system(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarray],
-                  muf: list[np.ndarray], project: bool
+                  muf: list[np.ndarray], project: bool, scale: float
                   ) -> tuple[list[Fraction], Mult, Mult] | None:
     """Solve for (x, λ on the multi-piece supports, μ) exactly, free unknowns near the
     floats (module docstring of :func:`certify`)."""
@@ -403,7 +437,7 @@ def _solve_system(F: PQ, S: list[list[int]], xf: np.ndarray, lamf: list[np.ndarr
     for i in range(d):
         rows.append(list(F.H[i]) + [F.blocks[k][j][0][i] for k, j in multi]
                     + [a[i] for A, _ in F.norms for a in A] + [-rhs[i]])
-    guess = ([rational(v) for v in xf] + [rational(lamf[k][j]) for k, j in multi]
+    guess = ([rational(v, scale) for v in xf] + [rational(lamf[k][j]) for k, j in multi]
              + [rational(v) for m in muf for v in m])
     piv = _rref(rows, n)
     if any(row[n] for row in rows[len(piv):]):
@@ -467,6 +501,12 @@ def is_recession(F: PQ, v: list[Fraction]) -> bool:
     slope = _dot(F.g, v) + sum((max(_dot(a, v) for a, _ in blk) for blk in F.blocks),
                                Fraction(0))
     return slope < 0
+
+
+def strongly_convex(F: PQ) -> bool:
+    """H ≻ 0 (null(H) = {0}, exactly): then F ≥ ½λ_min‖x‖² − C‖x‖ − C' is bounded below
+    (its pieces and norms are Lipschitz) and has exactly one minimiser."""
+    return not nullspace_exact(F.H)
 
 
 def quadratic_argmin(F: PQ) -> tuple[str, Any]:

@@ -37,8 +37,11 @@ def paper_costs(f7: str = "as-written") -> dict[int, Oracle]:
 
     Notes
     -----
-    f_6 = max(x1, x2) is unbounded below, and the minimisers differ (f_1 at the origin,
-    f_5 at (1, 0.5)), so the set is not F-redundant (SPEC §5).
+    f_6 = max(x1, x2) is unbounded below and the individual minimisers differ (f_1 at
+    the origin, f_5 at (1, 0.5)), as SPEC §5 notes — yet the costs *are* F-redundant
+    (F = 2): every 8 of the 10 sum to a function whose argmin is exactly {(0, 0)} (both
+    readings of f_7; ``check_redundancy(paper_costs(), 2)`` proves it, exactly), while
+    they are not 2F = 4-redundant (an exact witness).
 
     Examples
     --------

@@ -16,9 +16,16 @@ sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functi
 |aᵀx − b|, hinge, ‖·‖₁, ‖·‖∞ of affine maps, max of affine functions, sums, scalings):
 
 * each A_S is computed by Clarabel and then *certified* in rationals (a minimiser and
-  multipliers, or a recession direction when the sum is unbounded below);
+  multipliers, or a recession direction when the sum is unbounded below). Clarabel
+  solves in the frame x = c + s·y (c the median of the terms' kinks and centres, s
+  their spread; the data transformed exactly), so argmins at 1e-7 or 1e50 are solved
+  at unit scale; an uncertified solution is re-solved centred on itself, 2^20 times
+  finer (``ZOOMS`` times). The certificate alone decides: thresholds and roundings
+  only choose what is tried. A strongly convex sum (H ≻ 0, exactly) is never taken
+  as unbounded below;
 * x ∉ A_S2 is proved by exact evaluation: F_S2(y) < F_S2(x) for a certified y ∈ A_S2,
-  or F_S2 unbounded below;
+  or F_S2 unbounded below; x is the certified minimiser of S1 or an exact vertex of
+  its certified argmin (the support points below);
 * equality is proved when the certified argmins have the same canonical description:
   the affine set E (reduced row echelon form and a common point) and the inequalities
   that cut it, reduced modulo E and normalised (:mod:`rescon.optim._pq`) — always the
@@ -29,9 +36,12 @@ sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functi
 Everything else is numerical (``exact=False``): support functions h_A(u) = max_{x∈A} uᵀx
 in the fixed directions ±e_i and ±u_j (j < d, u_j seeded Gaussian unit vectors, seed 0),
 from Clarabel via CVXPY (min F_S, then max uᵀx on {F_S ≤ F_S* + 1e-8(1 + |F_S*|)}) or,
-for certified polyhedral argmins, from HiGHS on their exact description; sets agree
-when every support differs by at most ``tolerance`` = 1e-4 (1 + the largest |h|). The
-``gap`` is then max |h_S(u) − h*(u)| over those directions — a lower bound on the
+for certified polyhedral argmins, from HiGHS on their canonical faces (centred and
+scaled), each support point then made exact on the faces it makes tight; when one of
+the two sets is not certified, also the distance from each set's minimiser to the other
+set (Clarabel; supports are +inf in every direction on sets such as parallel lines).
+Sets agree when every support and distance differs by at most ``tolerance`` = 1e-4
+(1 + the largest |h|). The ``gap`` is then the largest of them — a lower bound on the
 Hausdorff distance (exact for single points and affine sets).
 """
 
@@ -59,6 +69,7 @@ __all__ = ["RedundancyReport", "check_redundancy"]
 REL_TOL = 1e-4  # numerical verdicts: supports agree to REL_TOL (1 + max |h|)
 LEVEL_TOL = 1e-8  # numerical supports: on {F ≤ F* + LEVEL_TOL (1 + |F*|)}
 MAX_PAIRS = 5_000  # pairs of certified subsets tried for an exact witness
+ZOOMS = 3  # re-solves centred at an uncertified solution, each 2^20 times finer
 
 
 @dataclass(frozen=True)
@@ -168,7 +179,8 @@ class _Set:
     opt: _pq.Optimal | None = None
     ray: list[Fraction] | None = None
     point: np.ndarray | None = None
-    supports: dict[int, tuple[float, np.ndarray | None]] = field(default_factory=dict)
+    supports: dict[int, tuple[float, np.ndarray | None, list[Fraction] | None]] = field(
+        default_factory=dict)
 
     @property
     def certified(self) -> bool:
@@ -181,6 +193,9 @@ class _Check:
         self.pq = [_pq.of_oracle(o, d) for o in oracles]
         self.dirs = _directions(d)
         self._cvx: _Cvx | None = None
+        self.far: dict[tuple[int, ...], tuple[float, Any, Any]] = {}
+        self._frame: tuple[np.ndarray, float] | None = None
+        self._framed: dict[int, _pq.PQ] = {}
 
     # -- computing argmin sets ------------------------------------------------ #
 
@@ -191,6 +206,9 @@ class _Check:
             self._exact(s)
         if s.status == "unknown":
             s.status, s.point = self.cvx.minimise(members)
+            if s.status == "unbounded" and F is not None and _pq.strongly_convex(F):
+                raise SolverError(f"Clarabel finds the sum of agents {members} unbounded "
+                                  f"below, but it is strongly convex (H ≻ 0, exactly)")
         return s
 
     def _sum(self, members: tuple[int, ...]) -> _pq.PQ | None:
@@ -207,12 +225,28 @@ class _Check:
             s.status, data = _pq.quadratic_argmin(F)
             s.opt, s.ray = (data, None) if s.status == "optimal" else (None, data)
         else:
-            status, data = _clarabel(F)
+            c, sc = self.frame
+            G = self._framed_sum(s.members)
+            status, data = _clarabel(G)
+            opt = None
+            for zoom in range(ZOOMS + 1):  # y to ~1e-8: zoom in on an uncertified solution
+                if status != "optimal":
+                    break
+                opt = (_pq.certify(F, c + sc * data[0], data[1], data[2])
+                       or _certify_framed(F, G, c, sc, data))
+                if opt is not None or zoom == ZOOMS:
+                    break
+                c2, s2 = c + sc * data[0], sc * 2.0**-20
+                G2 = _framed(F, c2, s2)
+                st2, data2 = _clarabel(G2)
+                if st2 != "optimal":
+                    break
+                c, sc, G, data = c2, s2, G2, data2
             if status == "optimal":
-                s.opt = _pq.certify(F, *data)
+                s.opt = opt
                 if s.opt is not None and not s.opt.describable:
                     s.opt = None  # a norm term with |μ| = 1: not described by linear data
-                s.status, s.point = "optimal", data[0]
+                s.status, s.point = "optimal", c + sc * data[0]
             elif status == "unbounded":
                 s.ray = _pq.recession(F, data)
                 s.status = "unbounded"
@@ -222,18 +256,37 @@ class _Check:
             s.point = np.array([float(v) for v in s.opt.x])
 
     @property
+    def frame(self) -> tuple[np.ndarray, float]:
+        """(c, s) for the solver (:func:`_frame`), from every piecewise-quadratic cost."""
+        if self._frame is None:
+            self._frame = _frame(self._sum(tuple(i for i, F in enumerate(self.pq)
+                                                 if F is not None)))
+        return self._frame
+
+    def _framed_sum(self, members: tuple[int, ...]) -> _pq.PQ:
+        """Σ_{i ∈ members} f_i(c + s·y) (:func:`_framed`, each cost's computed once)."""
+        G = _pq.PQ.zero(self.d)
+        for i in members:
+            if i not in self._framed:
+                self._framed[i] = _framed(self.pq[i], *self.frame)
+            G.add(self._framed[i])
+        return G
+
+    @property
     def cvx(self) -> _Cvx:
         if self._cvx is None:
             self._cvx = _Cvx(self.oracles, self.d)
         return self._cvx
 
-    def support(self, s: _Set, k: int) -> tuple[float, np.ndarray | None]:
-        """h_{A_S}(u_k) and a point attaining it (inf, None: unbounded in u_k)."""
+    def support(self, s: _Set, k: int
+                ) -> tuple[float, np.ndarray | None, list[Fraction] | None]:
+        """h_{A_S}(u_k), a point attaining it and that point exactly when it is proven in
+        A_S (inf, None, None: unbounded in u_k)."""
         if k not in s.supports:
             if s.opt is not None:
-                s.supports[k] = _poly_support(s.F, s.opt, self.dirs[k])
+                s.supports[k] = _poly_support(s.opt, self.dirs[k])
             else:
-                s.supports[k] = self.cvx.support(s.members, self.dirs[k])
+                s.supports[k] = (*self.cvx.support(s.members, self.dirs[k]), None)
         return s.supports[k]
 
     # -- the decision ---------------------------------------------------------- #
@@ -285,11 +338,28 @@ class _Check:
             R = np.array(a.rref, dtype=float)  # distance of parallel affine sets
             diff = np.array([float(u - v) for u, v in zip(a.x, b.x, strict=True)])
             return float(np.linalg.norm(R.T @ np.linalg.lstsq(R.T, diff, rcond=None)[0]))
-        return max(_difference(self.support(s, k)[0], self.support(ref, k)[0])
-                   for k in range(len(self.dirs)))
+        sup = max(_difference(self.support(s, k)[0], self.support(ref, k)[0])
+                  for k in range(len(self.dirs)))
+        if a is not None and b is not None:
+            return sup
+        return max(sup, self.point_gap(s, ref))
+
+    def point_gap(self, s: _Set, ref: _Set) -> float:
+        """The distances of each set's minimiser from the other set (numerical, both
+        lower bounds on the Hausdorff distance): unlike supports, they see sets that are
+        unbounded in every direction tried (parallel lines). The larger one is kept in
+        ``self.far`` for the witness."""
+        best = (0.0, None, None)
+        for t, p in ((ref, s.point), (s, ref.point)):
+            if p is not None:
+                dist, q = self.cvx.distance(t.members, p)
+                if dist > best[0]:
+                    best = (dist, p, q)
+        self.far[s.members] = best
+        return best[0]
 
     def tolerance(self, sets: list[_Set]) -> float:
-        vals = [abs(h) for s in sets for h, _ in s.supports.values() if math.isfinite(h)]
+        vals = [abs(h) for s in sets for h, *_ in s.supports.values() if math.isfinite(h)]
         vals += [float(np.abs(s.point).max()) for s in sets if s.point is not None]
         return REL_TOL * (1.0 + max(vals, default=0.0))
 
@@ -316,16 +386,16 @@ class _Check:
 
     def support_separation(self, s1: _Set, s2: _Set) -> dict[str, Any] | None:
         """:func:`_separation` from a support point of A_S1 instead of its minimiser: the
-        float support point in each direction, as short rationals, kept when s1's
-        multipliers still prove it a minimiser (check_optimal) — for polyhedral argmins
-        that are not affine, where both minimisers found may lie in both sets."""
+        exact point of the certified argmin attaining each support (:func:`_poly_support`),
+        kept when s1's multipliers prove it a minimiser (check_optimal, as the checker
+        will) — for polyhedral argmins that are not affine, where both minimisers found
+        may lie in both sets."""
         if s1.opt is None or s1.F.norms or s2 is s1 or not s2.certified:
             return None
         for k in range(len(self.dirs)):
-            p = self.support(s1, k)[1]
-            if p is None:
+            x = self.support(s1, k)[2]
+            if x is None:
                 continue
-            x = [_pq.rational(v) for v in p]
             if _pq.check_optimal(s1.F, x, s1.opt.lam, s1.opt.mu) is None:
                 w = _separation(dataclasses.replace(s1, opt=dataclasses.replace(s1.opt, x=x)), s2)
                 if w is not None:
@@ -341,8 +411,14 @@ class _Check:
                     "exact": False, "reason": "one of the two sums is unbounded below"}
         diffs = [_difference(self.support(s, k)[0], self.support(ref, k)[0])
                  for k in range(len(self.dirs))]
+        dist, p, q = self.far.get(s.members, (0.0, None, None))
+        if dist > max(diffs):
+            return {"subsets": [s.members, ref.members], "direction": None, "support": None,
+                    "points": [_pt(p), _pt(q)], "exact": False,
+                    "reason": f"a minimiser of one sum is at distance {dist:.6g} from the "
+                              f"other's argmin (the nearest point second)"}
         k = int(np.argmax(diffs))
-        (h1, p1), (h2, p2) = self.support(s, k), self.support(ref, k)
+        (h1, p1, _), (h2, p2, _) = self.support(s, k), self.support(ref, k)
         return {"subsets": [s.members, ref.members], "direction": self.dirs[k].tolist(),
                 "support": [h1, h2], "points": [_pt(p1), _pt(p2)], "exact": False,
                 "reason": "support functions differ beyond the tolerance"}
@@ -475,16 +551,24 @@ def _directions(d: int) -> list[np.ndarray]:
 # --------------------------------------------------------------------------- #
 
 
-def _clarabel(F: _pq.PQ) -> tuple[str, Any]:
-    """min ½xᵀHx + gᵀx + Σ t_k + Σ s_l s.t. a_kjᵀx + b_kj ≤ t_k, ‖A_l x − c_l‖ ≤ s_l, by
-    Clarabel: ("optimal", (x, λ per block, μ per norm term)), ("unbounded", direction)
-    or ("failed", status). Clarabel's duals z satisfy Px + q + Aᵀz = 0, so λ = z on the
-    pieces and μ = −(z on a norm cone's residual rows)."""
+def _clarabel(G: _pq.PQ) -> tuple[str, Any]:
+    """min ½yᵀHy + gᵀy + Σ t_k + Σ s_l s.t. a_kjᵀy + b_kj ≤ t_k, ‖A_l y − c_l‖ ≤ s_l (G's
+    data divided by w, the power of two nearest its largest coefficient: the same λ
+    and μ), by Clarabel: ("optimal", (y, λ per block, μ per norm term)), ("unbounded",
+    direction) or ("failed", status). Clarabel's duals z satisfy Py + q + Aᵀz = 0, so
+    λ = z on the pieces and μ = −(z on a norm cone's residual rows). G is F in the
+    frame y = (x − c)/s (:func:`_framed`)."""
     import clarabel
     import scipy.sparse as sp
 
-    f = F.float_data()
-    d, K, L, m = F.d, len(F.blocks), len(F.norms), len(f["b"])
+    f = G.float_data()
+    big = max([np.abs(f["H"]).max(initial=0.0), np.abs(f["g"]).max(initial=0.0),
+               np.abs(f["A"]).max(initial=0.0)] + [np.abs(A).max(initial=0.0)
+                                                   for A, _ in f["norms"]])
+    w = float(_pow2(big)) if 0 < big < math.inf else 1.0
+    f.update(H=f["H"] / w, g=f["g"] / w, A=f["A"] / w, b=f["b"] / w,
+             norms=[(A / w, c / w) for A, c in f["norms"]])
+    d, K, L, m = G.d, len(G.blocks), len(G.norms), len(f["b"])
     n = d + K + L
     P = sp.triu(sp.block_diag([sp.csc_matrix(f["H"]), sp.csc_matrix((K + L, K + L))]),
                 format="csc")
@@ -516,32 +600,96 @@ def _clarabel(F: _pq.PQ) -> tuple[str, Any]:
     return "failed", status
 
 
-def _poly_support(F: _pq.PQ, opt: _pq.Optimal, u: np.ndarray) -> tuple[float, np.ndarray | None]:
-    """max uᵀy over the certified argmin {M(y − x̄) = 0, pieces of supp λ maximal}
-    (HiGHS, floats)."""
+def _certify_framed(F: _pq.PQ, G: _pq.PQ, c: np.ndarray, s: float, data: tuple
+                    ) -> _pq.Optimal | None:
+    """:func:`_pq.certify` in the solver's frame (G(y) = F(c + s·y), at its float solution
+    y: thresholds and roundings act at the frame's scale), mapped back exactly
+    (x = c + s·y, the same λ and μ) and checked against F itself."""
+    opt = _pq.certify(G, *data)
+    if opt is None:
+        return None
+    x = [Fraction(float(ci)) + Fraction(s) * yi for ci, yi in zip(c, opt.x, strict=True)]
+    return (_pq.describe(F, x, opt.lam, opt.mu)
+            if _pq.check_optimal(F, x, opt.lam, opt.mu) is None else None)
+
+
+def _frame(F: _pq.PQ) -> tuple[np.ndarray, float]:
+    """(c, s) centring and scaling F's data: c the coordinate-wise median of the terms'
+    anchors (the point of each piece's zero set nearest 0, the least-squares minimisers
+    of the quadratic part and of each norm's residual), s the power of two nearest their
+    largest distance from c (at least 2^-30 ‖c‖∞: c is a float, rounded by up to
+    2^-53 ‖c‖∞)."""
+    f = F.float_data()
+    anchors = [-bj * a / (a @ a) for a, bj in zip(f["A"], f["b"], strict=True) if a.any()]
+    if f["H"].any():
+        anchors.append(np.linalg.lstsq(f["H"], -f["g"], rcond=None)[0])
+    anchors += [np.linalg.lstsq(A, c, rcond=None)[0] for A, c in f["norms"]]
+    P = np.array(anchors).reshape(-1, F.d)
+    c = np.median(P, axis=0) if len(P) else np.zeros(F.d)
+    spread = max(float(np.abs(P - c).max(initial=0.0)), 2.0**-30 * np.abs(c).max(initial=0.0))
+    if not (np.isfinite(c).all() and math.isfinite(spread)):
+        return np.zeros(F.d), 1.0
+    return c, float(_pow2(spread)) if spread > 0 else 1.0
+
+
+def _framed(F: _pq.PQ, c: np.ndarray, s: float) -> _pq.PQ:
+    """G(y) = F(c + s·y) up to a constant, exactly (s a power of two): H ↦ s²H,
+    g ↦ s(Hc + g), a ↦ s·a, b ↦ aᵀc + b, A_l ↦ s·A_l, c_l ↦ c_l − A_l c. Stationarity
+    of G at y is s·stationarity of F at c + s·y with the same λ and μ."""
+    cx, sf = [Fraction(float(v)) for v in c], Fraction(s)
+    if not any(cx) and sf == 1:
+        return F
+    return _pq.PQ(
+        [[sf * sf * v for v in row] for row in F.H],
+        [sf * (_pq._dot(row, cx) + gi) for row, gi in zip(F.H, F.g, strict=True)],
+        [[(tuple(sf * v for v in a), _pq._dot(a, cx) + b) for a, b in blk]
+         for blk in F.blocks],
+        [([tuple(sf * v for v in a) for a in A],
+          [ci - _pq._dot(a, cx) for a, ci in zip(A, cl, strict=True)]) for A, cl in F.norms])
+
+
+def _pow2(v: float) -> Fraction:
+    """The power of two nearest v > 0 (exact)."""
+    return Fraction(2) ** max(-1000, min(1000, round(math.log2(v))))
+
+
+def _poly_support(opt: _pq.Optimal, u: np.ndarray
+                  ) -> tuple[float, np.ndarray | None, list[Fraction] | None]:
+    """max uᵀy over the certified argmin E ∩ {n·y ≤ h, the canonical ``faces``}: HiGHS on
+    y = x̄ + σz (σ the power of two nearest the largest slack h − n·x̄, so the LP is at
+    unit scale whatever the argmin's size and position), then the exact point of the
+    argmin on the faces tight at HiGHS's solution (:meth:`_pq.Optimal.point_near`; the
+    value is uᵀ of it). Returns (value, float point, exact point or None); (inf, None,
+    None) when unbounded in u."""
     from scipy.optimize import linprog
 
-    x = np.array([float(v) for v in opt.x])
-    if opt.affine and len(opt.rref) == F.d:
-        return float(u @ x), x
-    Aub, bub = [], []
-    for lk, blk in zip(opt.lam, F.blocks, strict=True):
-        j0 = next(j for j, v in enumerate(lk) if v)
-        a0, b0 = blk[j0]
-        for j, (a, bj) in enumerate(blk):
-            if not lk[j]:
-                Aub.append([float(p - q) for p, q in zip(a, a0, strict=True)])
-                bub.append(float(b0 - bj))
-    R = np.array(opt.rref, dtype=float).reshape(-1, F.d)
-    res = linprog(-u, A_ub=np.array(Aub).reshape(-1, F.d) if Aub else None,
-                  b_ub=bub or None, A_eq=R if len(R) else None,
-                  b_eq=R @ x if len(R) else None, bounds=[(None, None)] * F.d,
-                  method="highs")
+    x, d = opt.x, len(opt.x)
+    if opt.affine and len(opt.rref) == d:
+        return float(u @ np.array([float(v) for v in x])), np.array([float(v) for v in x]), x
+    faces = sorted(opt.faces)
+    slack = [f[-1] - _pq._dot(f[:-1], x) for f in faces]
+    sigma = _pow2(float(max(slack))) if any(slack) else Fraction(1)
+    rhs = np.array([float(v / sigma) for v in slack])
+    N = np.array([[float(v) for v in f[:-1]] for f in faces]).reshape(-1, d)
+    R = np.array(opt.rref, dtype=float).reshape(-1, d)
+    res = linprog(-u, A_ub=N if len(N) else None, b_ub=rhs if len(N) else None,
+                  A_eq=R if len(R) else None, b_eq=np.zeros(len(R)) if len(R) else None,
+                  bounds=[(None, None)] * d, method="highs")
     if res.status == 3:
-        return math.inf, None
+        return math.inf, None, None
     if res.status != 0:
         raise SolverError(f"HiGHS could not compute a support value: {res.message}")
-    return float(-res.fun), np.asarray(res.x)
+    z = np.asarray(res.x)
+    guess = [a + sigma * Fraction(float(b)) for a, b in zip(x, z, strict=True)]
+    tight = [f for f, nz, h in zip(faces, N @ z, rhs, strict=True)
+             if abs(nz - h) <= 1e-7 * (1 + abs(h))]
+    y = opt.point_near(tight, guess)
+    if y is None:
+        yf = np.array([float(v) for v in guess])
+        return float(u @ yf), yf, None
+    yf = np.array([float(v) for v in y])
+    return float(sum((Fraction(float(a)) * b for a, b in zip(u, y, strict=True)),
+                     Fraction(0))), yf, y
 
 
 class _Cvx:
@@ -561,9 +709,22 @@ class _Cvx:
         self.w = cp.Parameter(len(oracles), nonneg=True)
         F = sum(self.w[i] * _to_cvxpy(cp, o, self.x) for i, o in enumerate(oracles))
         self.u, self.level = cp.Parameter(d), cp.Parameter()
+        self.p = cp.Parameter(d)
         self.pmin = cp.Problem(cp.Minimize(F))
         self.psup = cp.Problem(cp.Maximize(self.u @ self.x), [F <= self.level])
+        self.pdist = cp.Problem(cp.Minimize(cp.norm(self.x - self.p, 2)), [F <= self.level])
         self.fstar: dict[tuple[int, ...], float] = {}
+
+    def _solve(self, problem: Any) -> None:
+        """problem.solve by Clarabel; its status is read by the caller ("inaccurate"
+        warnings are dropped: the verdict is numerical anyway), CVXPY's own SolverError
+        becomes rescon's."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            try:
+                problem.solve(solver="CLARABEL")
+            except self.cp.error.SolverError as e:
+                raise SolverError(f"Clarabel failed on the numerical path: {e}") from None
 
     def _weights(self, members: tuple[int, ...]) -> None:
         w = np.zeros(self.w.size)
@@ -572,9 +733,7 @@ class _Cvx:
 
     def minimise(self, members: tuple[int, ...]) -> tuple[str, np.ndarray | None]:
         self._weights(members)
-        with warnings.catch_warnings():  # "inaccurate": the verdict is numerical anyway
-            warnings.simplefilter("ignore", UserWarning)
-            self.pmin.solve(solver="CLARABEL")
+        self._solve(self.pmin)
         if self.pmin.status in ("unbounded", "unbounded_inaccurate"):
             return "unbounded", None
         if self.pmin.status not in ("optimal", "optimal_inaccurate"):
@@ -583,19 +742,36 @@ class _Cvx:
         self.fstar[members] = float(self.pmin.value)
         return "optimal", np.array(self.x.value, dtype=float)
 
-    def support(self, members: tuple[int, ...], u: np.ndarray) -> tuple[float, np.ndarray | None]:
+    def _level(self, members: tuple[int, ...]) -> None:
+        """Weights and level F* + LEVEL_TOL (1 + |F*|) of the sum over ``members``."""
+        if members not in self.fstar and self.minimise(members)[0] != "optimal":
+            raise SolverError(f"Clarabel finds the sum of agents {members} unbounded below, "
+                              f"but its argmin was found nonempty")
         self._weights(members)
         f = self.fstar[members]
-        self.u.value, self.level.value = u, f + LEVEL_TOL * (1.0 + abs(f))
-        with warnings.catch_warnings():  # "inaccurate": the verdict is numerical anyway
-            warnings.simplefilter("ignore", UserWarning)
-            self.psup.solve(solver="CLARABEL")
+        self.level.value = f + LEVEL_TOL * (1.0 + abs(f))
+
+    def support(self, members: tuple[int, ...], u: np.ndarray) -> tuple[float, np.ndarray | None]:
+        self._level(members)
+        self.u.value = u
+        self._solve(self.psup)
         if self.psup.status in ("unbounded", "unbounded_inaccurate"):
             return math.inf, None
         if self.psup.status not in ("optimal", "optimal_inaccurate"):
             raise SolverError(f"Clarabel could not compute a support value of agents "
                               f"{members}: {self.psup.status}")
         return float(self.psup.value), np.array(self.x.value, dtype=float)
+
+    def distance(self, members: tuple[int, ...], p: np.ndarray) -> tuple[float, np.ndarray]:
+        """The distance from p to {F ≤ level} for the sum over ``members`` and the
+        nearest point."""
+        self._level(members)
+        self.p.value = p
+        self._solve(self.pdist)
+        if self.pdist.status not in ("optimal", "optimal_inaccurate"):
+            raise SolverError(f"Clarabel could not compute a distance to the argmin of "
+                              f"agents {members}: {self.pdist.status}")
+        return float(self.pdist.value), np.array(self.x.value, dtype=float)
 
 
 def _grad_parts(o: Any) -> Iterator[Any]:
