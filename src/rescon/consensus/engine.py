@@ -14,7 +14,8 @@ One step k (t_k = k T), for every benign agent i (SPEC §3):
    coordinate, what the agreement proof computes) may leave conv Λ and, with it, the
    benign hull. With fewer than m usable values the agent holds its state this step
    (counted in ``starved``);
-3. the update rule on z_i = α_i x_i + (1 − α_i) x̃_i: Algorithm 1's x_i ← z_i + ε(t_k)·1
+3. the update rule on z_i = α_i x_i + (1 − α_i) x̃_i (:func:`_between`: between x_i and
+   x̃_i in floats, x_i itself when x̃_i = x_i): Algorithm 1's x_i ← z_i + ε(t_k)·1
    (:class:`ConvexStep`, what :func:`simulate` runs); Algorithm 2's subgradient step
    x_i ← z_i − β_k d_i, d_i ∈ ∂f_i(z_i), lives in :mod:`rescon.optim.rmdo` and is
    passed to the same loop (:func:`run`), as are the per-step monitors (consensus
@@ -208,7 +209,7 @@ def run(scenario: Scenario, rule: UpdateRule, *, monitors: Sequence[Monitor] | N
         metrics["starved"][k] = len(starved)
         moving = np.ones(len(benign), dtype=bool)
         moving[starved] = False  # starved agents hold their state
-        z = alpha[moving] * xb[moving] + (1 - alpha[moving]) * aux[moving]
+        z = _between(xb[moving], aux[moving], alpha[moving])
         x = x.copy()
         if moving.any():
             x[benign[moving]] = rule(k, t, z, benign[moving])
@@ -220,6 +221,35 @@ def run(scenario: Scenario, rule: UpdateRule, *, monitors: Sequence[Monitor] | N
             "T": sc.T, "steps": K, "kernel_point": sc.kernel_point, "seed": sc.seed}
     return Trajectory(np.arange(K + 1) * sc.T, states, tuple(nodes), benign, metrics,
                       {**base, **(info or {})}, time.perf_counter() - t0, sent=sent_range)
+
+
+def _between(x: np.ndarray, aux: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """z = α x + (1 − α) x̃ row by row (``alpha`` (R, 1), 0 < α < 1), computed so that
+    every coordinate of z lies between those of x and x̃ at every magnitude, and z = x
+    exactly where x̃ = x (converged states and states at X* stay put).
+
+    With δ = fl(x̃ − x): z = fl(x + fl((1 − α)δ)) when α ≥ ½, z = fl(x̃ − fl(αδ)) when
+    α < ½, and z = fl(fl(αx) + fl((1 − α)x̃)) where δ overflows. (The plain
+    αx + (1 − α)x̃ rounds 0.5·5e-324 to 0: states at ±5e-324 drifted to 0.)
+
+    Proof, per coordinate. Let a be the end z starts from (x, or x̃ when α < ½), b the
+    other end and t ∈ [0, ½] the weight of b − a (1 − α, exact for α ≥ ½ by Sterbenz's
+    lemma, or α); by symmetry (fl(−v) = −fl(v)) a ≤ b. Rounding is monotone, so
+    δ = fl(b − a) ≥ 0 and s = fl(tδ) satisfy 0 ≤ s ≤ fl(δ/2). If δ ≥ 2^-1021, δ/2 is a
+    float and δ/2 ≤ (1 + 2^-53)(b − a)/2 ≤ b − a; else b − a < 2^-1021 is a multiple
+    of 2^-1074, hence a float, δ = b − a and fl(δ/2) ≤ δ. Either way a ≤ a + s ≤ b, so
+    a ≤ fl(a + s) ≤ b (a, b are floats). No overflow: |b − a| ≤ max(|a|, |b|) unless
+    a < 0 < b, and the last form is used only there, where fl(αx) and fl((1 − α)x̃)
+    lie between 0 and x, x̃ respectively, have opposite signs, and their rounded sum
+    lies between them. Where x̃ = x, δ = 0 and z = x + 0 or x̃ − 0 = x."""
+    with np.errstate(over="ignore"):  # δ = ±inf is replaced below
+        step = aux - x
+        z = np.where(alpha >= 0.5, x + (1 - alpha) * step, aux - alpha * step)
+    far = np.nonzero(~np.isfinite(step))
+    if far[0].size:
+        a = alpha[far[0], 0]
+        z[far] = a * x[far] + (1 - a) * aux[far]
+    return z
 
 
 def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metrics, d):

@@ -29,7 +29,8 @@ would silently ignore the costs). Examples: ``examples/scenarios/paper_rmdo.toml
 
 A costs file (``rescon redundancy``) is ``[costs]`` and an optional top-level ``d``
 (default: the largest variable index its expressions use), or a whole RMDO file (its
-benign agents' costs, d of its states).
+benign agents' costs, d of its states; as for ``rescon rmdo``, every benign agent needs
+a cost).
 """
 
 from __future__ import annotations
@@ -105,13 +106,25 @@ def rmdo_from_dict(data: Mapping[str, Any], *, path: str | Path = "rmdo") -> RMD
 
 
 def read_costs(path: str | Path) -> tuple[dict[Hashable, Oracle], int]:
-    """The costs of a costs file and their dimension d (format: module docstring)."""
+    """The costs of a costs file and their dimension d (format: module docstring).
+
+    Raises
+    ------
+    InputError
+        One line naming the file: what :func:`read_rmdo` refuses, a benign agent of an
+        RMDO file without a cost (as :func:`rescon.rmdo` refuses it), no [costs], a bad
+        ``d``, a cost the expression parser or :func:`rescon.cost` refuses.
+    """
     p = Path(path)
     data = read_toml(p)
     if set(data) & {"scenario", "graph", "initial"}:  # an RMDO file: its benign agents'
         f = read_rmdo(p)
-        benign = set(f.scenario.benign)
-        return {v: o for v, o in f.costs.items() if v in benign}, f.scenario.d
+        benign = f.scenario.benign
+        missing = [v for v in benign if v not in f.costs]
+        if missing:  # as rescon.rmdo refuses the file
+            raise InputError(f"{p} [costs]: no cost for benign agent(s) {missing[:5]}")
+        keep = set(benign)
+        return {v: o for v, o in f.costs.items() if v in keep}, f.scenario.d
     _keys(data, {"d", "costs"}, str(p))
     if "costs" not in data:
         raise InputError(f"{p}: a costs file needs a [costs] table")
@@ -212,7 +225,7 @@ def _module(ref: Any, base: Path, where: str) -> Mapping[Hashable, Any]:
 def _step_size(table: Mapping[str, Any], where: str) -> StepSize:
     """[step_size] → the preset it names (module docstring); absent: the paper's."""
     kind = table.get("kind", "paper")
-    if kind not in _STEP_KINDS:
+    if not isinstance(kind, str) or kind not in _STEP_KINDS:  # a TOML list is unhashable
         raise InputError(f"{where}: kind must be one of {', '.join(_STEP_KINDS)}; got {kind!r}")
     params, make = _STEP_KINDS[kind]
     _keys(table, {"kind", *params}, f"{where} (kind = {kind!r})")

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..consensus.engine import ConsensusMonitor, run
-from ..consensus.scenario import Scenario, ScenarioWarning
+from ..consensus.scenario import STATE_LIMIT, Scenario, ScenarioWarning
 from ..consensus.trajectory import Trajectory
 from ..errors import InputError
 from . import atoms
@@ -80,8 +80,10 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
     InputError
         ``costs`` not a mapping, a benign agent without a cost, a cost of the wrong
         dimension, a bad step size, a bad ``optimum``, or an oracle that fails, returns
-        NaN/inf or the wrong shape during the run (the message names the agent, the
-        step and the point; nothing reaches the states).
+        NaN/inf or the wrong shape during the run, or a subgradient step that overflows
+        or leaves |x| ≤ 1e150 (:data:`~rescon.consensus.scenario.STATE_LIMIT`, the
+        bound on initial states; the message names the agent, the step and the point,
+        with a hint when the iterates diverged; nothing reaches the states).
 
     Examples
     --------
@@ -213,9 +215,11 @@ class SubgradientStep:
     :class:`~rescon.optim.atoms.Stacked` call (agent row i with its own oracle's data);
     every other group is evaluated in one call of its oracle. A pack that answers
     NaN/inf is re-evaluated group by group through the oracles' checked calls, so that
-    a subgradient that is not finite or of the wrong shape, or a step that overflows,
-    is an InputError naming the agent, the step and the point (``reach``: the scale of
-    :func:`_divergence_hint`)."""
+    a subgradient that is not finite or of the wrong shape, or a step that overflows or
+    leaves |x| ≤ STATE_LIMIT (the bound on initial states,
+    :data:`rescon.consensus.scenario.STATE_LIMIT`, under which the monitors' distances
+    stay finite), is an InputError naming the agent, the step and the point
+    (``reach``: the scale of :func:`_divergence_hint`)."""
 
     name = "rmdo"
 
@@ -249,13 +253,16 @@ class SubgradientStep:
         self._per_group(D, k, t, z, agents, np.flatnonzero(pid < 0))
         with np.errstate(over="ignore", invalid="ignore"):
             new = z - self.betas[k] * D
-        bad = np.flatnonzero(~np.isfinite(new).all(axis=1))
+        inf = np.flatnonzero(~np.isfinite(new).all(axis=1))
+        bad = inf if inf.size else np.flatnonzero((np.abs(new) > STATE_LIMIT).any(axis=1))
         if bad.size:
             r = int(bad[0])
+            what = ("overflows" if inf.size else f"leaves the states' bound |x| <= "
+                    f"{STATE_LIMIT:g} (new point {new[r].tolist()})")
             raise InputError(f"the subgradient step of agent {self.nodes[agents[r]]!r} at step "
-                             f"{k} (t = {t:g}) overflows: point {z[r].tolist()}, β = "
+                             f"{k} (t = {t:g}) {what}: point {z[r].tolist()}, β = "
                              f"{self.betas[k]:g}, subgradient {D[r].tolist()}"
-                             f"{_divergence_hint(z[r], self.reach)}")
+                             f"{_divergence_hint(z[r] if inf.size else new[r], self.reach)}")
         return new
 
     def _per_group(self, D: np.ndarray, k: int, t: float, z: np.ndarray, agents: np.ndarray,
