@@ -17,7 +17,8 @@ Attacked:
 * the CLI: pure JSON on stdout, one-line errors with exit 2 on malformed files;
   optional packages missing (``sys.modules[name] = None`` in a subprocess).
 
-Bugs are strict xfails (they pass once fixed); the other tests guard attacks that held.
+Bugs were strict xfails, now passing tests (each commented "Fixed (was a bug: …)"); the
+other tests guard attacks that held.
 """
 
 from __future__ import annotations
@@ -92,9 +93,8 @@ GOOD_COSTS = '[costs]\n0 = "(x1-1)^2"\n1 = "x2^2"\n2 = "abs(x1)"\n'
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="V22: expression costs are expanded to ½xᵀQx + qᵀx + c "
-                   "around 0, so (x1 - c)^2 cancels catastrophically far from 0 (negative "
-                   "values of a square)")
+# Fixed (was a bug: expression costs are expanded to ½xᵀQx + qᵀx + c around 0, so (x1 -
+# c)^2 cancels catastrophically far from 0 (negative values of a square)).
 def test_expression_square_far_from_origin_is_accurate():
     # (x1 - 1e50)^2 at its minimiser is 0; rescon says -1.9e84
     assert rescon.cost("(x1 - 1e50)^2").value([[1e50]]).tolist() == [0.0]
@@ -103,8 +103,8 @@ def test_expression_square_far_from_origin_is_accurate():
     assert abs(v - 0.01) <= 1e-9
 
 
-@pytest.mark.xfail(strict=True, reason="V22: atoms.Merged centres the collapsed quadratic at "
-                   "m = -H⁺ℓ, far away when H is flat: the cost metric loses ~3e-5 relative")
+# Fixed (was a bug: atoms.Merged centres the collapsed quadratic at m = -H⁺ℓ, far away
+# when H is flat: the cost metric loses ~3e-5 relative).
 def test_cost_metric_of_flat_quadratic_plus_linear_is_accurate():
     sc = _scenario([[1.0], [2.0], [3.0], [4.0]], steps=1)
     tr = _rmdo(sc, {i: "1e-12*(x1 - 0.1)^2 + x1" for i in range(4)}, step_size=1e-9)
@@ -115,8 +115,8 @@ def test_cost_metric_of_flat_quadratic_plus_linear_is_accurate():
     assert np.abs(got - np.array([float(e) for e in exact])).max() <= 1e-12
 
 
-@pytest.mark.xfail(strict=True, reason="V22: atoms.Merged's float centre m of quadratics "
-                   "centred at 1e150 is an ulp off, so F at X* (which is 0) is 1.65e269")
+# Fixed (was a bug: atoms.Merged's float centre m of quadratics centred at 1e150 is an
+# ulp off, so F at X* (which is 0) is 1.65e269).
 def test_cost_metric_at_far_optimum_is_zero():
     c = 1e150
     q1 = atoms.Quadratic([[2.0, 0.0], [0.0, 2.0]], c=[c, -c])
@@ -129,8 +129,8 @@ def test_cost_metric_at_far_optimum_is_zero():
     assert np.abs(tr.metrics["cost"][0]).max() <= 1.0    # Σ f_j at X* = 0
 
 
-@pytest.mark.xfail(strict=True, reason="V22: an oracle's complex subgradient is cast to real "
-                   "(imaginary part dropped, ComplexWarning) instead of refused")
+# Fixed (was a bug: an oracle's complex subgradient is cast to real (imaginary part
+# dropped, ComplexWarning) instead of refused).
 def test_complex_subgradient_is_refused():
     f = rescon.cost((lambda z: 1.0, lambda z: np.array([1 + 1j, 0.0])))
     with warnings.catch_warnings():
@@ -139,8 +139,8 @@ def test_complex_subgradient_is_refused():
             f.subgradient([[0.0, 0.0]])
 
 
-@pytest.mark.xfail(strict=True, reason="V22: the cost-expression parser recurses per "
-                   "parenthesis: ~200 nested parentheses raise RecursionError, not InputError")
+# Fixed (was a bug: the cost-expression parser recurses per parenthesis: ~200 nested
+# parentheses raise RecursionError, not InputError).
 def test_deeply_nested_expression_is_input_error():
     try:
         f = rescon.cost("(" * 300 + "x1" + ")" * 300 + "^2")
@@ -149,8 +149,8 @@ def test_deeply_nested_expression_is_input_error():
     assert f.value([[3.0]]).tolist() == [9.0]
 
 
-@pytest.mark.xfail(strict=True, reason="V22: rescon.cost's docstring says the CasADi symbol is "
-                   "found when the expression has exactly one; it is always required")
+# Fixed (was a bug: rescon.cost's docstring says the CasADi symbol is found when the
+# expression has exactly one; it is always required).
 def test_casadi_symbol_found_when_unique():
     ca = pytest.importorskip("casadi")
     x = ca.MX.sym("x", 2)
@@ -162,9 +162,9 @@ def test_casadi_symbol_found_when_unique():
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="V22: argmins [0, 1] vs [0, 1 + 1e-9] are certified "
-                   "exactly but the support point 1.000000001 is rounded to 1 "
-                   "(limit_denominator(10^6)): verdict 'holds' by a numerical tolerance")
+# Fixed (was a bug: argmins [0, 1] vs [0, 1 + 1e-9] are certified exactly but the
+# support point 1.000000001 is rounded to 1 (limit_denominator(10^6)): verdict 'holds'
+# by a numerical tolerance).
 def test_redundancy_false_by_a_hair_is_decided_exactly():
     costs = ["abs(x1) + abs(x1 - 1)"] * 2 + ["abs(x1) + abs(x1 - 1.000000001)"]
     rep = rescon.check_redundancy(costs, 2)
@@ -172,17 +172,16 @@ def test_redundancy_false_by_a_hair_is_decided_exactly():
     assert rescon.check_certificate(rep.certificate).verdict == "valid"
 
 
-@pytest.mark.xfail(strict=True, reason="V22: argmins below ~1e-6 are never certified (absolute "
-                   "1e-6 activity and 10^6-denominator guesses): [0, 1e-7] vs [0, 1e-6] "
-                   "'holds' within the 1e-4 tolerance")
+# Fixed (was a bug: argmins below ~1e-6 are never certified (absolute 1e-6 activity and
+# 10^6-denominator guesses): [0, 1e-7] vs [0, 1e-6] 'holds' within the 1e-4 tolerance).
 def test_redundancy_at_small_scale_is_not_a_tolerance_call():
     costs = ["abs(x1) + abs(x1 - 1e-7)"] * 2 + ["abs(x1) + abs(x1 - 1e-6)"]
     rep = rescon.check_redundancy(costs, 2)
     assert rep.holds is False            # the argmins differ by a factor of 10
 
 
-@pytest.mark.xfail(strict=True, reason="V22: numerical verdicts compare support functions only; "
-                   "on unbounded argmins (lines) every support is +inf, gap 0, 'holds'")
+# Fixed (was a bug: numerical verdicts compare support functions only; on unbounded
+# argmins (lines) every support is +inf, gap 0, 'holds').
 def test_numerical_redundancy_sees_parallel_lines():
     # argmins: the lines x1 - x2 = 0, 0 and 5 (distance 3.5)
     rep = rescon.check_redundancy(["huber(x1 - x2)"] * 2 + ["huber(x1 - x2 - 5)"], 2)
@@ -190,9 +189,9 @@ def test_numerical_redundancy_sees_parallel_lines():
     assert rep.gap > 1.0
 
 
-@pytest.mark.xfail(strict=True, reason="V22: _poly_support gives HiGHS the raw rows (1e-12 x "
-                   "<= 5e-13) below its feasibility tolerance: gap 0 for an exact violation "
-                   "whose argmins are [0, 1] and [0, 0.5]")
+# Fixed (was a bug: _poly_support gives HiGHS the raw rows (1e-12 x <= 5e-13) below its
+# feasibility tolerance: gap 0 for an exact violation whose argmins are [0, 1] and [0,
+# 0.5]).
 def test_redundancy_gap_of_exact_violation():
     costs = ["abs(x1) + abs(x1 - 1)"] * 2 + ["abs(x1) + abs(x1 - 1) + 1e-12*pos(x1 - 0.5)"]
     rep = rescon.check_redundancy(costs, 2)
@@ -211,15 +210,15 @@ def test_redundancy_polyhedral_at_unit_scale():
     assert rescon.check_certificate(rep.certificate).verdict == "valid"
 
 
-@pytest.mark.xfail(strict=True, reason="V22: Clarabel on the unscaled data calls an "
-                   "unconstrained sum 'infeasible': SolverError for costs centred at 1e50")
+# Fixed (was a bug: Clarabel on the unscaled data calls an unconstrained sum
+# 'infeasible': SolverError for costs centred at 1e50).
 def test_redundancy_polyhedral_far_from_origin():
     rep = rescon.check_redundancy([s.format(c="1e50") for s in FAR_POLY], 1)
     assert (rep.holds, rep.exact) == (True, True)   # translation of the test above
 
 
-@pytest.mark.xfail(strict=True, reason="V22: Clarabel's DualInfeasible on badly scaled data is "
-                   "taken as 'unbounded below' (numerical path) for strongly convex sums")
+# Fixed (was a bug: Clarabel's DualInfeasible on badly scaled data is taken as
+# 'unbounded below' (numerical path) for strongly convex sums).
 def test_redundancy_bounded_sums_are_not_reported_unbounded():
     rep = rescon.check_redundancy(["(x1 - 1e8)^2", "(x1 + 1e8)^2", "2*abs(x1)"], 1)
     assert rep.holds is False
@@ -233,8 +232,8 @@ def test_redundancy_bounded_sums_are_not_reported_unbounded():
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="V22: files._step_size tests `kind not in dict` on an "
-                   "unhashable kind: TypeError traceback instead of exit 2")
+# Fixed (was a bug: files._step_size tests `kind not in dict` on an unhashable kind:
+# TypeError traceback instead of exit 2).
 def test_cli_step_size_kind_list_is_a_one_line_error(tmp_path):
     p = tmp_path / "bad.toml"
     p.write_text(BASE_TOML + GOOD_COSTS + '[step_size]\nkind = ["paper"]\n')
@@ -242,8 +241,8 @@ def test_cli_step_size_kind_list_is_a_one_line_error(tmp_path):
     assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
 
 
-@pytest.mark.xfail(strict=True, reason="V22: `rescon redundancy` on an RMDO file silently drops "
-                   "benign agents without a cost (rmdo refuses the same file)")
+# Fixed (was a bug: `rescon redundancy` on an RMDO file silently drops benign agents
+# without a cost (rmdo refuses the same file)).
 def test_cli_redundancy_of_rmdo_file_missing_a_cost(tmp_path):
     p = tmp_path / "missing.toml"
     p.write_text(BASE_TOML + '[costs]\n0 = "x1^2"\n1 = "x1^2"\n')
@@ -309,9 +308,9 @@ def test_converged_states_reduce_to_centralised_subgradient_descent(algorithm):
 
 @pytest.mark.parametrize("c", [
     1.0, 1e-300, 1e150,
-    pytest.param(5e-324, marks=pytest.mark.xfail(strict=True, reason=(
-        "V22: the engine's z = αx + (1−α)x̃ with x̃ = x is not x at subnormals (0.5·5e-324 "
-        "rounds to 0): states at X* drift to 0 and leave the initial hull")))])
+    # Fixed (was a bug: the engine's z = αx + (1−α)x̃ with x̃ = x is not x at subnormals,
+    # 0.5·5e-324 rounds to 0: states at X* drift to 0 and leave the initial hull).
+    5e-324])
 def test_states_at_the_optimum_stay_there(c):
     sc = _scenario([[c, -c]] * 5, F=1, steps=10)
     tr = _rmdo(sc, {i: atoms.Quadratic([[2.0, 0.0], [0.0, 4.0]], c=[c, -c]) for i in range(5)})
@@ -620,9 +619,9 @@ def test_cli_huge_step_is_one_line_error(tmp_path):
     assert rc == 2 and out == "" and "overflows" in err and len(err.strip().splitlines()) == 1
 
 
-@pytest.mark.xfail(strict=True, reason="V22: a subgradient step may leave the states finite "
-                   "but beyond 1e150 (the scenario bound); the diameter monitor then raises a "
-                   "raw OverflowError (math.ldexp) out of rescon.rmdo")
+# Fixed (was a bug: a subgradient step may leave the states finite but beyond 1e150 (the
+# scenario bound); the diameter monitor then raises a raw OverflowError (math.ldexp) out
+# of rescon.rmdo).
 def test_diverging_finite_states_are_input_error():
     sc = _scenario([[-1.0], [0.25], [1.0]], steps=3)
     with pytest.raises(InputError, match="diverged|overflow|step size"):
