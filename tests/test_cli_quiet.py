@@ -16,6 +16,7 @@ import pytest
 
 from rescon import paper
 from rescon.cli import _parser
+from rescon.graphs.facts import clear_cache
 from tests.test_cli import run
 
 ROOT = Path(__file__).parent.parent
@@ -37,8 +38,12 @@ WITH_BARS = {
 @pytest.fixture
 def terminal(capsys, monkeypatch):
     """``terminal(argv)``: the CLI run in-process, its captured stderr saying it is a
-    terminal (patched in the test's call phase: pytest swaps the capture stream)."""
+    terminal (patched in the test's call phase: pytest swaps the capture stream). Each
+    run starts cold: robustness remembers what it proved about a graph in this process
+    (graphs.facts), so a second run on it answers from those facts ("method": "bounds"
+    where a cold run says "search")."""
     def call(argv):
+        clear_cache()
         monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
         return run(argv, capsys)
     return call
