@@ -31,15 +31,18 @@ def _polytope(A: np.ndarray, b: np.ndarray):
     return A, b, x0, r
 
 
-def test_halves_of_a_cross_polytope_propose_its_vertices_on_the_cut_once():
+@pytest.mark.parametrize("axis", range(5))
+def test_halves_of_a_cross_polytope_propose_its_vertices_on_the_cut_once(axis):
     """The 5-dimensional cross-polytope |x_1| + … + |x_5| ≤ 1 (32 rows, 10 vertices of
-    16 rows each): the Chebyshev centre is 0, so the cut x_1 = 0 holds the 8 vertices
-    ±e_j (j ≥ 2) — each in both halves, tight on the cut too; each is proposed once,
-    with rows of full rank, beside ±e_1."""
+    16 rows each): the Chebyshev centre is 0, so the cut x_j = 0 holds the 8 vertices
+    ±e_i (i ≠ j) — each in both halves, where each half sees only the 8 of its rows
+    that bound it there (rank 4: the union of the halves' rows makes the vertex); each
+    is proposed once, with rows of full rank, beside ±e_j."""
     A = np.array(list(itertools.product((-1.0, 1.0), repeat=5)))
     A, b, x0, r = _polytope(A, np.ones(len(A)))
     assert np.allclose(x0, 0.0)
-    whole, halves = fastpath._qhull(A, b, x0, None), fastpath._halves(A, b, x0, r, None)
+    whole = fastpath._qhull(A, b, x0, None)
+    halves = fastpath._halves(A, b, x0, r, None, axis)
     want = {tuple(s * e) for e in np.eye(5) for s in (-1.0, 1.0)}
     assert _points_of(whole) == _points_of(halves) == want
     assert len(halves[1]) == 10
@@ -91,6 +94,29 @@ def test_a_vertex_lost_by_the_halves_is_found_on_the_whole(monkeypatch):
     monkeypatch.setattr(fastpath, "_propose", spy)
     _same_as_clipping(X, F, monkeypatch)
     assert calls and splits[:2] == [True, False]
+
+
+def test_a_half_qhull_fails_on_is_cut_again_across_the_next_axis(monkeypatch):
+    """qhull failing on the lower half across x_1 (as it does on sphere(5, 30, 3)): the
+    halves are cut across x_2, and the kernel is the exact clipping's."""
+    X, F = _cloud("gaussian", 5, 18, 2), 2
+    real, seen = fastpath._qhull, []
+
+    def failing(A, b, x0, options):
+        lower_x1 = len(A) and A[-1, 0] == -1.0 and not A[-1, 1:].any()
+        seen.append(bool(lower_x1))
+        return None if lower_x1 else real(A, b, x0, options)
+
+    axes, halves = [], fastpath._halves
+
+    def spy(*args):
+        axes.append(args[-1])
+        return halves(*args)
+
+    monkeypatch.setattr(fastpath, "_qhull", failing)
+    monkeypatch.setattr(fastpath, "_halves", spy)
+    _same_as_clipping(X, F, monkeypatch)
+    assert axes[:2] == [0, 1] and any(seen)
 
 
 @pytest.mark.parametrize("threads", [1, 2])

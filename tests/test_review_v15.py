@@ -242,9 +242,9 @@ def test_hostile_schedule_is_the_exact_clipping(cloud, scale, seed, monkeypatch)
 
 def test_threaded_branches_run_on_the_larger_clouds(monkeypatch):
     """The LARGER clouds reach every threaded branch (chunks > 1): the scan, the near
-    pairs, the walks of graph_top, the cofactors, the closure, the proof of the vertex
-    floats and qhull's two halves in d = 5 — so the hostile schedule replaced real
-    splits (row_top runs only when a proposal fails)."""
+    pairs, the walks of graph_top, the cofactors, the closure (keyed and scanned), the
+    proof of the vertex floats and qhull's two halves in d = 5 — so the hostile
+    schedule replaced real splits (row_top runs only when a proposal fails)."""
     seen = []
 
     def spy(scan, total, chunks, workers=None):
@@ -256,7 +256,7 @@ def test_threaded_branches_run_on_the_larger_clouds(monkeypatch):
         rescon.safe_kernel(make_cloud(fam, d, n, F).X, F)
     threaded = {name for name, chunks in seen if chunks > 1}
     assert threaded == {"classify", "_near_run", "graph_top", "cofactors", "_halves",
-                        "combinatorial_rays", "rounded_points"}, seen
+                        "combinatorial_rays", "_simple_ends", "rounded_points"}, seen
 
 
 @pytest.mark.parametrize("scale", [1.0, pytest.param(2.0**990, marks=pytest.mark.slow)])

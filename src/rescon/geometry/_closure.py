@@ -187,7 +187,6 @@ def _closures(v_ptr, v_rows, h_ptr, h_verts, residues, k, ok, pre, pre_ends, lo,
     return ptr, ends[:ptr[-1]]
 
 
-@njit(cache=True, nogil=True)
 def _simple_ends(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed, pre, pre_ends):
     """The check at simple vertices (k tight rows, independent) from keys instead of a
     scan: sets pre[v] and the k ends pre_ends[v] where it passes; a vertex it leaves
@@ -205,6 +204,21 @@ def _simple_ends(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed, pre, pre_ends)
     onto the Z_g iff each Z_g has exactly one owner u_g ≠ v and g ∉ T(u_g) (then
     T(u_g) ∩ T(v) = Z_g, and u_g holds no other Z_g', whose union with Z_g is T(v)):
     the scan's verdict and ends, exactly."""
+    from ._candidates import on_threads  # looked up per call: tests replace it
+
+    keys, owners, left = _simple_keys(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed)
+    n = len(v_ptr) - 1
+
+    def scan(lo: int, hi: int) -> None:
+        _simple_check(v_ptr, v_rows, keys, owners, left, n_rows, k, pre, pre_ends, lo, hi)
+
+    on_threads(scan, n, CLOSURE_CHUNKS if n >= CLOSURE_THREADS_MIN else 1)
+
+
+@njit(cache=True, nogil=True)
+def _simple_keys(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed):
+    """The keys of :func:`_simple_ends`, sorted, with their owners, and per vertex
+    whether it shares k − 1 rows with a vertex of more than ``keyed`` rows (``left``)."""
     n = len(v_ptr) - 1
     total = 0
     for u in range(n):
@@ -264,7 +278,14 @@ def _simple_ends(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed, pre, pre_ends)
             if count[w] >= k - 1 and w != u:
                 left[w] = True
             count[w] = 0
-    for v in range(n):
+    return keys, owners, left
+
+
+@njit(cache=True, nogil=True)
+def _simple_check(v_ptr, v_rows, keys, owners, left, n_rows, k, pre, pre_ends, lo, hi):
+    """:func:`_simple_ends` at the simple vertices lo ≤ v < hi, from the keys of
+    :func:`_simple_keys` (ranges on threads write disjoint rows of pre, pre_ends)."""
+    for v in range(lo, hi):
         if v_ptr[v + 1] - v_ptr[v] != k or left[v]:
             continue
         rows = v_rows[v_ptr[v]:v_ptr[v + 1]]
@@ -274,10 +295,10 @@ def _simple_ends(v_ptr, v_rows, h_ptr, h_verts, n_rows, k, keyed, pre, pre_ends)
             for i in range(k):
                 if i != g:
                     key = key * n_rows + rows[i]
-            lo = np.searchsorted(keys, key)
-            hi = np.searchsorted(keys, key, side="right")
+            first = np.searchsorted(keys, key)
+            last = np.searchsorted(keys, key, side="right")
             u = -1
-            for f in range(lo, hi):
+            for f in range(first, last):
                 w = owners[f]
                 if w == v:
                     continue
