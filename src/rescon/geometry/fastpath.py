@@ -1,7 +1,8 @@
 """Certified fast path for full-dimensional kernels: qhull proposes, integers decide.
 
-Floats (a Chebyshev LP for an interior point, then qhull's halfspace intersection)
-propose the vertices of Ψ and, for each vertex, the valid halfspaces that qhull finds
+Floats (a Chebyshev LP for an interior point, then qhull's halfspace intersection —
+in d ≥ 5 as two halves on two threads, :func:`_halves`) propose the vertices of Ψ
+and, for each vertex, the valid halfspaces that qhull finds
 tight there (k of them at a simple vertex, more where qhull merged a non-simple one —
 common in d ≥ 4, where many hyperplanes through data points meet). Each proposal is
 solved exactly from k of its rows that floats suggest are independent: det A ≠ 0 is
