@@ -86,8 +86,8 @@ def test_a_vertex_lost_by_the_halves_is_found_on_the_whole(monkeypatch):
 
     propose, splits = fastpath._propose, []
 
-    def spy(H, sel, options=None, split=True):
-        splits.append(split)
+    def spy(H, sel, options=None, split=None):
+        splits.append(split.on)
         return propose(H, sel, options, split)
 
     monkeypatch.setattr(fastpath, "_halves", lossy)

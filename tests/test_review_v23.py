@@ -22,9 +22,9 @@ small clouds (clipping well under a second) run as halves.
 
 Found: off-centre clouds (data around 100 or 1000) make qhull fail on a half on both
 axes for every qhull option, and nothing remembers it — 1.6–2.4× the CPU and ~1.7× the
-wall time of the code before this session on gaussian(5, 30, 3) + 100 (xfail below);
-and a latent overflow in ``_on_the_cut``'s KD-tree beyond 2^511 (unreachable: qhull
-sees the kernel at unit size).
+wall time of the code before this session on gaussian(5, 30, 3) + 100; and a latent
+overflow in ``_on_the_cut``'s KD-tree beyond 2^511 (unreachable: qhull sees the kernel
+at unit size). Both fixed (the tests below were strict xfails).
 
 Held, beside these tests: 68 clouds (17 families, d = 5, n = 16–22, F = 1–3; 45 of
 them split into halves) identical to the exact clipping, with the same vertex counts
@@ -195,15 +195,15 @@ def test_qhull_never_hands_a_non_finite_point_to_the_matching(monkeypatch):
                              Fake().intersections, [[0], [1]])
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "V23 (latent, unreachable through safe_kernel, whose floats reach qhull at unit "
-    "size): _on_the_cut's KD-tree squares coordinate differences — beyond 2^511 the "
-    "gap of two floats 1 ulp apart overflows to inf and the matched halves are refused"))
+# Fixed (was a latent bug, unreachable through safe_kernel, whose floats reach qhull at
+# unit size: _on_the_cut's KD-tree squares coordinate differences — beyond 2^511 the gap
+# of two floats 1 ulp apart overflowed to inf and the matched halves were refused; the
+# nearest point is now found in the largest coordinate gap, nothing squared).
 def test_on_the_cut_matches_points_one_ulp_apart_at_2_990():
-    V0 = np.array([[2.0**990, 1, 2, 3, 4], [2.0**990, 5, 6, 7, 8]])
-    V1 = V0.copy()
-    V1[:, 1] = np.nextafter(V1[:, 1] * 2.0**980, np.inf) / 2.0**980  # 1 ulp at 2^990
-    V1[:, 0] = np.nextafter(V1[:, 0], np.inf)
+    """Two cut points ~2^990 apart, each matched to its twin 1 ulp away in every
+    coordinate (squared gaps ~2^1876 overflowed)."""
+    V0 = np.array([[2.0**990, 2.0**989, 0.0, 1.0, 2.0], [2.0**990, -2.0**989, 0.0, 3.0, 4.0]])
+    V1 = np.nextafter(V0, np.inf)
     A = np.vstack([np.eye(5)] * 2)
     out = fastpath._on_the_cut(A, 5, V0, [[0, 1, 2, 3], [5, 6, 7, 8]], V1, [[4], [9]])
     assert out is not None and len(out) == 2
@@ -485,13 +485,13 @@ def test_duplicated_points_with_halves(few_rows):
 # off-centre clouds: the halves fail, every round, every option
 # --------------------------------------------------------------------------- #
 
-@pytest.mark.xfail(strict=True, reason=(
-    "V23: off-centre clouds (data around 100 or 1000, kernel not small enough for the "
-    "local pass): qhull fails on a half (QH6271 dupridge) across both axes, for every "
-    "qhull option in turn — nothing remembers it, so each proposal pays 2 axes x 2 "
-    "halves before the whole polytope: safe_kernel ~1.7x the wall time and "
-    "1.5-2.4x the CPU of the code before (gaussian(5, 30, 3) + 100: 1.0-1.3 vs "
-    "0.55-0.77 s wall, 1.3-1.8 vs 0.55-0.65 CPU-s at 46b0fa8)"))
+# Fixed (was a bug: off-centre clouds — data around 100 or 1000, kernel not small enough
+# for the local pass: qhull fails on a half (QH6271 dupridge) across both axes, for
+# every qhull option in turn — nothing remembered it, so each proposal paid 2 axes x 2
+# halves before the whole polytope: gaussian(5, 30, 3) + 100 1.0-1.3 s wall against
+# 0.55-0.77 s at 46b0fa8). Now a kernel stops splitting once the halves failed on every
+# axis, and clouds far off-centre (Chebyshev centre beyond SPLIT_MAX_OFFSET radii) do
+# not split at all.
 def test_halves_that_failed_are_not_tried_again_in_the_same_kernel(monkeypatch):
     real, failed = fastpath._halves, []
 
@@ -501,12 +501,30 @@ def test_halves_that_failed_are_not_tried_again_in_the_same_kernel(monkeypatch):
         return found
 
     monkeypatch.setattr(fastpath, "_halves", spy)
+    monkeypatch.setattr(fastpath, "SPLIT_MAX_OFFSET", np.inf)  # split wherever it may
     K = rescon.safe_kernel(_cloud("gaussian", 5, 16, 2) + 100.0, 2)
     assert K.dim == 5 and failed
     assert sum(failed) <= fastpath.SPLIT_AXES  # one failure per axis at most
 
 
-def test_off_centre_kernel_with_halves_is_the_exact_clipping(few_rows):
+def test_off_centre_clouds_are_not_split(monkeypatch):
+    real, calls = fastpath._halves, []
+
+    def spy(*args):
+        calls.append(args[-1])
+        return real(*args)
+
+    monkeypatch.setattr(fastpath, "_halves", spy)
+    for offset in (100.0, 1000.0):
+        K = rescon.safe_kernel(_cloud("gaussian", 5, 16, 2) + offset, 2)
+        assert K.dim == 5
+    assert not calls
+    rescon.safe_kernel(_cloud("gaussian", 5, 16, 2), 2)  # centred: split
+    assert calls
+
+
+def test_off_centre_kernel_with_halves_is_the_exact_clipping(few_rows, monkeypatch):
+    monkeypatch.setattr(fastpath, "SPLIT_MAX_OFFSET", np.inf)  # off-centre: split anyway
     CLOUDS["reflect1+100"] = ("reflect1", 5, 12, 1)
     kind, d, n, F = CLOUDS["reflect1+100"]
     X = _cloud(kind, d, n, F) + 100.0

@@ -117,17 +117,25 @@ SPLIT_DIM = 5
 SPLIT_ROWS = 400
 #: the axes across which the halves are cut, tried in turn
 SPLIT_AXES = 2
+#: ... and only when the Chebyshev centre lies within this many radii of the origin:
+#: about a point far from the origin the float rows' offsets carry more rounding
+#: (up to CENTRE_MIN_RATIO spreads of the data: kernel.py), and qhull failed (QH6271)
+#: on a half across both axes of every d = 5 cloud tried 180–3400 radii out (data
+#: around 100 or 1000), often on P itself too; at 25–35 radii it failed on some and
+#: not on others (the bench clouds: ≤ 1.5). Only a choice of proposal: a failure
+#: costs time, once per kernel (:class:`_Split`)
+SPLIT_MAX_OFFSET = 64.0
 
 
-def _propose(H, sel: np.ndarray, options: str | None = None, split: bool = True
+def _propose(H, sel: np.ndarray, options: str | None = None, split: _Split | None = None
              ) -> tuple[np.ndarray, list[list[int]]] | None:
     """Vertices and their defining halfspaces (indices into sel) of {A x ≤ b}, from
     qhull around a Chebyshev centre. A kernel small against its coordinates (states
     that have nearly converged) is re-centred and rescaled first: x = o + s y with o
     the first centre, s the distance from o to its (k+1)-th nearest halfspace, so the
     LP and qhull see it at unit size. ``options``: qhull's option string (None: its
-    default); ``split``: large ones in d ≥ 5 may come from two halves
-    (:func:`_intersection`). None for a flat or empty kernel or a qhull failure."""
+    default); ``split``: whether large ones in d ≥ 5 may still come from two halves
+    (:func:`_intersection`; None: they may). None for a flat or empty kernel or a qhull failure."""
     norms = np.linalg.norm(H.af[sel], axis=1)  # cofactor rows can be ~1e-14: unit rows
     if not norms.all():  # a float row rounded to zero: no proposal
         return None
@@ -157,7 +165,7 @@ def _propose(H, sel: np.ndarray, options: str | None = None, split: bool = True
         x0, r = found
     if r <= 1e-9 * (1.0 + np.abs(x0).max()):
         return None
-    found = _intersection(A, b, x0, r, options, split)
+    found = _intersection(A, b, x0, r, options, _Split() if split is None else split)
     if found is None:
         return None
     V, facets = found  # facets: lists of ints, positions in rows
@@ -167,21 +175,34 @@ def _propose(H, sel: np.ndarray, options: str | None = None, split: bool = True
     return o + s * V, facets
 
 
+class _Split:
+    """Whether a kernel's qhull proposals may (still) come from two halves
+    (:func:`_halves`: ``on``, off for the rest of the kernel once the halves failed on
+    every axis or their proposal was refused) and whether the last one did (``used``)."""
+
+    def __init__(self) -> None:
+        self.on, self.used = True, False
+
+
 def _intersection(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float,
-                  options: str | None, split: bool = True
+                  options: str | None, split: _Split
                   ) -> tuple[np.ndarray, list[list[int]]] | None:
     """The vertices of P = {A x ≤ b} (x0 inside, with the ball of radius r around it)
     and, for each, the rows qhull finds tight there (positions in A): qhull's
-    halfspace intersection — with ``split``, in dimension ≥ SPLIT_DIM with at least
-    SPLIT_ROWS rows, as two halves on two threads (:func:`_halves`, cut across the
-    first axis, else the second: qhull can fail on one half of a cut and not on
-    another's — sphere(5, 30, 3) across x_1, within 0.04 s), on P itself where that
-    fails. None if qhull fails."""
-    if split and A.shape[1] >= SPLIT_DIM and len(A) >= SPLIT_ROWS:
+    halfspace intersection — while ``split`` is on, in dimension ≥ SPLIT_DIM with at
+    least SPLIT_ROWS rows and x0 within SPLIT_MAX_OFFSET radii of the origin, as two
+    halves on two threads (:func:`_halves`, cut across the first axis, else the
+    second: qhull can fail on one half of a cut and not on another's — sphere(5, 30, 3)
+    across x_1, within 0.04 s), on P itself where that fails. None if qhull fails."""
+    split.used = False
+    if (split.on and A.shape[1] >= SPLIT_DIM and len(A) >= SPLIT_ROWS
+            and np.abs(x0).max() <= SPLIT_MAX_OFFSET * r):
         for axis in range(SPLIT_AXES):
             found = _halves(A, b, x0, r, options, axis)
             if found is not None:
+                split.used = True
                 return found
+        split.on = False  # failed on every axis: not again in this kernel
     return _qhull(A, b, x0, options)
 
 
@@ -261,8 +282,9 @@ def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
                 ) -> list[tuple[np.ndarray, list[int]]] | None:
     """The vertices of P among the two halves' vertices on the cut (points V0, V1 and
     their rows other than the cut): the halves share the section of P by the cut, so
-    each point of one matches a point of the other (the nearest, within 10⁻⁹ of the
-    coordinates: floats of two qhull runs) — else None. A matched pair whose rows
+    each point of one matches a point of the other (the nearest in the largest
+    coordinate gap, within 10⁻⁹ of the coordinates: floats of two qhull runs) — else
+    None. A matched pair whose rows
     (their union: a half sees only the rows of P that bound it near the point) have
     rank k in floats is a vertex of P on the cut, or near it where qhull merged it
     with the cut's vertices: proposed once; rank k − 1 is an edge of P crossing the
@@ -275,7 +297,8 @@ def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
     from scipy.spatial import cKDTree
 
     tol = 1e-9 * (1.0 + max(np.abs(V0).max(), np.abs(V1).max()))
-    gap, match = cKDTree(V1).query(V0)
+    gap, match = cKDTree(V1).query(V0, p=np.inf)  # the largest coordinate gap: nothing
+    # squared, so no overflow or underflow at any magnitude
     if not (gap <= tol).all() or len(np.unique(match)) != len(V0):
         return None
     out, seen = [], set()
@@ -296,10 +319,11 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
     if len(H) < k + 1:
         return None
     sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
+    split = _Split()
     with _collection_deferred():
         for options in QHULL_OPTIONS:
             for opts in _chain(options, k):
-                P = _attempt(H, k, scale, sel, opts)
+                P = _attempt(H, k, scale, sel, opts, split)
                 if P is not None:
                     return P
     return None
@@ -331,14 +355,14 @@ def _collection_deferred():
             gc.enable()
 
 
-def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
-             ) -> ExactPolytope | None:
+def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None,
+             split: _Split) -> ExactPolytope | None:
     """Proposals from qhull with ``options``, certified by :func:`_certify`; None on
     failure. If the certification fails, the halfspaces clearly violated by a proposed
     vertex (:func:`_row_max` of the float proposals) join ``sel`` for the next round;
-    if none is, the next round's proposal comes from qhull on P itself (not its
-    halves, :func:`_halves`), or the attempt fails if it already did."""
-    split = True
+    if none is, the next round's proposal comes from qhull on P itself if the refused
+    one came from its halves (:func:`_halves`; ``split``, shared by the kernel's
+    attempts, then turned off), else the attempt fails."""
     for _ in range(MAX_ROUNDS):
         prop = _propose(H, sel, options, split)
         if prop is None:
@@ -351,9 +375,9 @@ def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None
             return P
         bad = _row_max(H, V) > 1e-9 * (1.0 + np.abs(H.bf))
         if not bad.any():
-            if not split:
+            if not split.used:
                 return None
-            split = False  # the halves may have lost a vertex on their cut
+            split.on = False  # the halves may have lost a vertex on their cut
         sel = np.union1d(sel, np.flatnonzero(bad))
     return None
 
