@@ -49,6 +49,7 @@ import rescon
 from rescon.geometry import _candidates, _closure, _vertex_floats, fastpath
 from rescon.geometry import kernel as km
 from tests.test_kernel_d45_around2 import assert_identical
+from tests.test_review_r2 import _fast_path_calls
 from tests.test_review_v15 import _hostile
 
 #: small clouds run as halves with this many rows
@@ -119,19 +120,6 @@ def few_rows(monkeypatch):
 
     monkeypatch.setattr(fastpath, "_halves", spy)
     return calls
-
-
-def _certified(monkeypatch) -> list:
-    """Records whether each certified_kernel call certified (fast path) or not."""
-    real, out = km.certified_kernel, []
-
-    def spy(*args):
-        P = real(*args)
-        out.append(P is not None)
-        return P
-
-    monkeypatch.setattr(km, "certified_kernel", spy)
-    return out
 
 
 # --------------------------------------------------------------------------- #
@@ -250,7 +238,7 @@ def _forced(mode: str, log: list):
 def test_cut_through_vertices_or_one_ulp_beside(name, mode, few_rows, monkeypatch):
     log: list = []
     monkeypatch.setattr(fastpath, "_halves", _forced(mode, log))
-    cert = _certified(monkeypatch)
+    cert = _fast_path_calls(monkeypatch)
     assert_identical(_fast(name), _clipped(name))
     assert log and cert == [True]
 
@@ -298,7 +286,7 @@ def test_qhull_failing_selectively(fails, few_rows, monkeypatch):
 
     monkeypatch.setattr(fastpath, "_qhull", failing)
     monkeypatch.setattr(fastpath, "SPLIT_ROWS", 10)  # the first round's 36 rows too
-    cert = _certified(monkeypatch)
+    cert = _fast_path_calls(monkeypatch)
     assert_identical(_fast("reflect1"), _clipped("reflect1"))
     assert any(d for _, d in seen) or fails == "the whole"  # halves alone: never asked
     if fails == "upper x1":
@@ -316,7 +304,7 @@ def test_sections_that_do_not_match_fall_back_to_the_whole(few_rows, monkeypatch
         return real(A, k, V0[1:], rows0[1:], V1, rows1)
 
     monkeypatch.setattr(fastpath, "_on_the_cut", lossy)
-    cert = _certified(monkeypatch)
+    cert = _fast_path_calls(monkeypatch)
     assert_identical(_fast("intgrid"), _clipped("intgrid"))
     assert few_rows[:2] == [(0, few_rows[0][1], False), (1, few_rows[0][1], False)]
     assert cert == [True]
