@@ -51,8 +51,9 @@ class ScenarioWarning(UserWarning):
     """An assumption of the convergence theorems does not hold for this scenario."""
 
 
-#: largest |entry| of an initial state: distances between states are computed in floats,
-#: and Σ_p (x_p − y_p)² ≤ d·(2·10^150)² stays finite for any d below 4·10^7
+#: largest |entry| of an initial state (and of an RMDO iterate: optim/rmdo.py refuses
+#: one beyond it): distances between states are computed in floats, and
+#: Σ_p (x_p − y_p)² ≤ d·(2·10^150)² stays finite for any d below 4·10^7
 STATE_LIMIT = 1e150
 
 
