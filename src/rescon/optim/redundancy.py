@@ -326,7 +326,10 @@ class _Check:
 
     def gap(self, s: _Set, ref: _Set) -> float:
         """Hausdorff distance of two nonempty argmins: exact formula for affine sets,
-        else the largest support difference over the directions."""
+        else the largest support difference over the directions — and, where a set is
+        not certified and unbounded (a support +∞: the directions include ± each axis,
+        so a finite support in each means a bounded set), the distances of the
+        minimisers from the other set (:meth:`point_gap`)."""
         a, b = s.opt, ref.opt
         if self.equal(s, ref):
             return 0.0
@@ -338,9 +341,11 @@ class _Check:
             R = np.array(a.rref, dtype=float)  # distance of parallel affine sets
             diff = np.array([float(u - v) for u, v in zip(a.x, b.x, strict=True)])
             return float(np.linalg.norm(R.T @ np.linalg.lstsq(R.T, diff, rcond=None)[0]))
-        sup = max(_difference(self.support(s, k)[0], self.support(ref, k)[0])
-                  for k in range(len(self.dirs)))
-        if a is not None and b is not None:
+        supports = [(self.support(s, k)[0], self.support(ref, k)[0])
+                    for k in range(len(self.dirs))]
+        sup = max(_difference(h1, h2) for h1, h2 in supports)
+        bounded = all(math.isfinite(h) for pair in supports for h in pair)
+        if (a is not None and b is not None) or bounded:
             return sup
         return max(sup, self.point_gap(s, ref))
 
