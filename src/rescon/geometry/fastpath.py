@@ -227,8 +227,8 @@ def _halves(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float, options: str
             axis: int = 0) -> tuple[np.ndarray, list[list[int]]] | None:
     """:func:`_intersection` from the halves P⁻ = P ∩ {x_j ≤ c} and P⁺ = P ∩ {x_j ≥ c}
     (j = ``axis``, c = x0's coordinate j; x0 ∓ (r/2) e_j are inside them, r/2 from
-    their boundaries), one qhull each on two threads (numba's thread count; one thread runs
-    them in turn) — qhull runs without the GIL, and its work follows its output.
+    their boundaries), one qhull each on two threads (numba's thread count; one thread
+    runs them in turn) — qhull runs without the GIL, and its work follows its output.
 
     With the cut as row m: a vertex of P off the cut is a vertex of the half holding
     it, tight on the same rows; every other vertex of a half lies on the cut — a
@@ -284,12 +284,12 @@ def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
     their rows other than the cut): the halves share the section of P by the cut, so
     each point of one matches a point of the other (the nearest in the largest
     coordinate gap, within 10⁻⁹ of the coordinates: floats of two qhull runs) — else
-    None. A matched pair whose rows
-    (their union: a half sees only the rows of P that bound it near the point) have
-    rank k in floats is a vertex of P on the cut, or near it where qhull merged it
-    with the cut's vertices: proposed once; rank k − 1 is an edge of P crossing the
-    cut (k − 1 rows at a simple one; more, common, where the edge lies in several
-    hyperplanes through data points, each solve of which would find no point)."""
+    None. A matched pair whose rows (their union: a half sees only the rows of P that
+    bound it near the point) have rank k in floats is a vertex of P on the cut, or
+    near it where qhull merged it with the cut's vertices: proposed once; rank k − 1
+    is an edge of P crossing the cut (k − 1 rows at a simple one; more, common, where
+    the edge lies in several hyperplanes through data points, each solve of which
+    would find no point)."""
     if len(V0) != len(V1):
         return None
     if not len(V0):
@@ -297,8 +297,8 @@ def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
     from scipy.spatial import cKDTree
 
     tol = 1e-9 * (1.0 + max(np.abs(V0).max(), np.abs(V1).max()))
-    gap, match = cKDTree(V1).query(V0, p=np.inf)  # the largest coordinate gap: nothing
-    # squared, so no overflow or underflow at any magnitude
+    # the largest coordinate gap: nothing squared, no overflow at any magnitude
+    gap, match = cKDTree(V1).query(V0, p=np.inf)
     if not (gap <= tol).all() or len(np.unique(match)) != len(V0):
         return None
     out, seen = [], set()
