@@ -85,7 +85,11 @@ def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
     all the extreme rays of its tangent cone, and those u, increasing (empty where it
     does not). At a simple vertex (k rows, independent) every k − 1 of them have rank
     k − 1: no modular rank is needed, and the check passes iff each of its k rays has
-    an end. ``pairs``: :func:`.polytope.tight_pairs` of ``tight`` when known."""
+    an end. ``pairs``: :func:`.polytope.tight_pairs` of ``tight`` when known. Each
+    vertex's check is its own: from CLOSURE_THREADS_MIN vertices on, ranges of them run
+    on threads (:func:`._candidates.on_threads`)."""
+    from ._candidates import on_threads  # looked up per call: tests replace it
+
     v_of, h_of = tight_pairs(tight) if pairs is None else pairs  # by vertex, then row
     v_ptr = np.searchsorted(v_of, np.arange(len(tight) + 1)).astype(np.int64)
     by_row = np.argsort(h_of, kind="stable")  # by row, then vertex
@@ -98,8 +102,6 @@ def combinatorial_rays(tight: list[int], normals: list[tuple[int, ...]], k: int,
     if k >= 2 and len(normals) ** (k - 1) < 2**62:  # the keys fit int64
         _simple_ends(v_ptr, v_rows, h_ptr, h_verts, len(normals), k, KEYED_ROWS, pre,
                      pre_ends)
-    from ._candidates import on_threads  # looked up per call: tests replace it
-
     n = len(tight)
     chunks = CLOSURE_CHUNKS if n >= CLOSURE_THREADS_MIN else 1
     parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
