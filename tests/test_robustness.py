@@ -817,13 +817,17 @@ def test_paper_example_graph():
 def test_time_limit_dense_random_digraph():
     G = nx.gnp_random_graph(40, 0.5, directed=True, seed=1)
     rescon.robustness(nx.cycle_graph(5))  # warm the numba cache outside the timing
+    clear_cache()  # cold: facts other tests proved about G would shorten the search
     t0 = time.perf_counter()
     rep = rescon.robustness(G, time_limit=1.0)
     elapsed = time.perf_counter() - t0
     assert elapsed < 3.5, elapsed
     assert rep.r_lower <= rep.r_upper
-    res = check_valid(rep.certificate, G, roundtrip=False)  # a big search tree: ~3 s to replay
-    assert res.valid
+    # a big search tree: ~3 s to replay. Valid when the limit stopped the search (ρ in
+    # [2, 10] here); where the search settled ρ (a faster machine, or facts cached) its
+    # proof at n = 40 > 20 is accepted on trust: "unchecked", never "invalid"
+    res = check_valid(rep.certificate, G, roundtrip=False)
+    assert res.valid or (rep.r_lower == rep.r_upper and res.trusted == ("search",)), res
     if rep.exact:
         assert rep.r_lower == rep.r_upper == rep.r_max
         assert rep.certificate["exact"] is True
