@@ -97,8 +97,8 @@ def test_a_vertex_lost_by_the_halves_is_found_on_the_whole(monkeypatch):
 
 
 def test_a_half_qhull_fails_on_is_cut_again_across_the_next_axis(monkeypatch):
-    """qhull failing on the lower half across x_1 (as it does on sphere(5, 30, 3)): the
-    halves are cut across x_2, and the kernel is the exact clipping's."""
+    """qhull failing on the lower half across x_1 with every option (its retry too):
+    the halves are cut across x_2, and the kernel is the exact clipping's."""
     X, F = _cloud("gaussian", 5, 18, 2), 2
     real, seen = fastpath._qhull, []
 
@@ -117,6 +117,33 @@ def test_a_half_qhull_fails_on_is_cut_again_across_the_next_axis(monkeypatch):
     monkeypatch.setattr(fastpath, "_halves", spy)
     _same_as_clipping(X, F, monkeypatch)
     assert axes[:2] == [0, 1] and any(seen)
+
+
+def test_a_half_qhull_fails_on_with_the_merged_option_is_retried_at_once(monkeypatch):
+    """qhull failing on the lower half across x_1 with the merged options only (as
+    "C-0 Q14" does on sphere(5, 30, 3)): that half is retried with HALF_RETRY_OPTIONS,
+    the cut stays across x_1, and the kernel is the exact clipping's."""
+    X, F = _cloud("gaussian", 5, 18, 2), 2
+    real, retried = fastpath._qhull, []
+
+    def failing(A, b, x0, options):
+        lower_x1 = len(A) and A[-1, 0] == -1.0 and not A[-1, 1:].any()
+        if lower_x1 and options == fastpath.HALF_RETRY_OPTIONS:
+            retried.append(options)
+        elif lower_x1:
+            return None
+        return real(A, b, x0, options)
+
+    axes, halves = [], fastpath._halves
+
+    def spy(*args):
+        axes.append(args[-1])
+        return halves(*args)
+
+    monkeypatch.setattr(fastpath, "_qhull", failing)
+    monkeypatch.setattr(fastpath, "_halves", spy)
+    _same_as_clipping(X, F, monkeypatch)
+    assert retried and axes and set(axes) == {0}
 
 
 @pytest.mark.parametrize("threads", [1, 2])

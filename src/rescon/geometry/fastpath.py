@@ -125,6 +125,12 @@ SPLIT_AXES = 2
 #: not on others (the bench clouds: ≤ 1.5). Only a choice of proposal: a failure
 #: costs time, once per kernel (:class:`_Split`)
 SPLIT_MAX_OFFSET = 64.0
+#: a half on which qhull fails with a merged option is retried at once, on its thread,
+#: with these options (qhull's initial simplex from all points): 2 of the 72 halves
+#: (both axes) of 18 d = 5, n = 24–30 bench-family clouds failed with "C-0 Q14", both
+#: succeeded thus (sphere(5, 30, 3)'s lower half across x_0: 0.08 s, where both halves
+#: across x_1 took 0.09 s wall, 0.14 CPU-s, after the failure)
+HALF_RETRY_OPTIONS = "Qs C-0 Q14"
 
 
 def _propose(H, sel: np.ndarray, options: str | None = None, split: _Split | None = None
@@ -192,8 +198,8 @@ def _intersection(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float,
     halfspace intersection — while ``split`` is on, in dimension ≥ SPLIT_DIM with at
     least SPLIT_ROWS rows and x0 within SPLIT_MAX_OFFSET radii of the origin, as two
     halves on two threads (:func:`_halves`, cut across the first axis, else the
-    second: qhull can fail on one half of a cut and not on another's — sphere(5, 30, 3)
-    across x_1, within 0.04 s), on P itself where that fails. None if qhull fails."""
+    second: qhull can fail on one half of a cut and not on another's), on P itself
+    where that fails. None if qhull fails."""
     split.used = False
     if (split.on and A.shape[1] >= SPLIT_DIM and len(A) >= SPLIT_ROWS
             and np.abs(x0).max() <= SPLIT_MAX_OFFSET * r):
@@ -228,7 +234,8 @@ def _halves(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float, options: str
     """:func:`_intersection` from the halves P⁻ = P ∩ {x_j ≤ c} and P⁺ = P ∩ {x_j ≥ c}
     (j = ``axis``, c = x0's coordinate j; x0 ∓ (r/2) e_j are inside them, r/2 from
     their boundaries), one qhull each on two threads (numba's thread count; one thread
-    runs them in turn) — qhull runs without the GIL, and its work follows its output.
+    runs them in turn) — qhull runs without the GIL, and its work follows its output;
+    a half it fails on with a merged option is retried with HALF_RETRY_OPTIONS.
 
     With the cut as row m: a vertex of P off the cut is a vertex of the half holding
     it, tight on the same rows; every other vertex of a half lies on the cut — a
@@ -251,6 +258,8 @@ def _halves(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float, options: str
     def run(lo: int, hi: int) -> None:
         for side in range(lo, hi):
             found[side] = _qhull(*sides[side], options)
+            if found[side] is None and options in MERGED_OPTIONS_5D:
+                found[side] = _qhull(*sides[side], HALF_RETRY_OPTIONS)
 
     on_threads(run, 2, 2)
     if found[0] is None or found[1] is None:
