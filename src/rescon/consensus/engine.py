@@ -40,7 +40,7 @@ from ..geometry.kernel import safe_kernel
 from .adversaries import StepView, adversary_messages
 from .dos import blocked_mask
 from .metrics import ValidityMonitor, diameter, monitor_names, spread
-from .scenario import Scenario
+from .scenario import STATE_LIMIT, Scenario
 from .trajectory import Trajectory
 
 __all__ = ["ConsensusMonitor", "ConvexStep", "Monitor", "UpdateRule", "run", "simulate"]
@@ -75,6 +75,13 @@ def simulate(scenario: Scenario, *, metrics: Sequence[str] | str | None = None,
     Returns
     -------
     Trajectory (states, metrics per step, the violated assumptions in ``info``).
+
+    Raises
+    ------
+    InputError
+        A metric passing the float range (:meth:`ConsensusMonitor.record`: benign
+        states dragged apart to ±1e308 by adversaries, with F = 0 or the "mean"
+        baseline). States themselves stay finite at every magnitude.
     """
     t0 = time.perf_counter()
     monitor = ConsensusMonitor(scenario, metrics)
@@ -133,6 +140,10 @@ class ConsensusMonitor:
                          else None)
 
     def record(self, k: int, t: float, xb: np.ndarray) -> None:
+        """Row k of each metric; InputError when one passes the float range (benign
+        states stay finite — means and convex combinations of finite values, plus
+        ε ≤ 1 — but a rule that follows the adversaries, F = 0 or the "mean" baseline,
+        can be dragged to ±1e308, where a distance between them overflows)."""
         m = self.metrics
         if "spread" in m:
             m["spread"][k] = spread(xb)
@@ -142,6 +153,14 @@ class ConsensusMonitor:
             dist = self.validity.distances(xb)
             m["validity_per_agent"][k] = dist
             m["validity"][k] = dist.max()
+        over = [key for key, v in m.items() if not np.isfinite(v[k]).all()]
+        if over:
+            raise InputError(f"the benign states at step {k} (t = {t:g}) are too far apart "
+                             f"for floats ({over[0]} > 1.8e308; max |x| = "
+                             f"{float(np.abs(xb).max()):.3g}): the states diverged — "
+                             f"adversary values this large drag a rule without filtering "
+                             f"(F = 0, the 'mean' baseline) along; keep them within "
+                             f"{STATE_LIMIT:g}, the bound on initial states")
 
 
 def _benign_rows(sc: Scenario) -> np.ndarray:

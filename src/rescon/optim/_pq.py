@@ -480,17 +480,25 @@ def _project(R: list[list[Fraction]], guess: list[Fraction]) -> list[Fraction]:
 
 
 def recession(F: PQ, vf: np.ndarray) -> list[Fraction] | None:
-    """An exact unboundedness certificate near the float direction vf, or None."""
+    """An exact unboundedness certificate near the float direction vf, or None.
+
+    Tried in turn: vf / max|vf| rounded to 1/_FREE_DEN of 1 (float noise in its zero
+    entries dropped), then each entry rounded relative to itself (rational(v, |v|):
+    entries of every size kept, e.g. (1, 1e-8) when the data mix scales 1 and 1e8);
+    when H ≠ 0, the same two roundings of v's coordinates in an exact basis of null(H).
+    Roundings only choose what is tried: :func:`is_recession` decides."""
     s = float(np.abs(vf).max(initial=0.0))
     if not s > 0:
         return None
-    cands = [[rational(v / s) for v in vf]]
+    v1 = vf / s
+    cands = [[rational(v) for v in v1], [rational(v, abs(v)) for v in v1]]
     if any(v for row in F.H for v in row):  # the component of v in null(H), exactly
         null = nullspace_exact(F.H)
         if null:
-            coef = np.linalg.lstsq(np.array(null, dtype=float).T, vf / s, rcond=None)[0]
-            cands.append([sum((rational(c) * b[i] for c, b in zip(coef, null)), Fraction(0))
-                          for i in range(F.d)])
+            coef = np.linalg.lstsq(np.array(null, dtype=float).T, v1, rcond=None)[0]
+            for cs in ([rational(c) for c in coef], [rational(c, abs(c)) for c in coef]):
+                cands.append([sum((c * b[i] for c, b in zip(cs, null)), Fraction(0))
+                              for i in range(F.d)])
     return next((v for v in cands if is_recession(F, v)), None)
 
 

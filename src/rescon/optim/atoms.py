@@ -773,22 +773,24 @@ class Merged(Atom):
       :class:`Stacked` evaluation over (points × terms) weighted by w;
     * any other oracle (callables, CasADi, CVXPY) is called as itself (checked).
 
-    Values (and subgradients) are summed in that order. They equal Σ_j w_j f_j up to
-    rounding: the collapsed quadratic differs from the exact Σ_j w_j f_j by a few ulps
-    of the magnitudes of its form's terms (the smaller of the two forms' bounds), the
-    rest by the order of the sums.
+    Weights are multiplied exactly (the floats' exact values as Fractions) through the
+    scalings, so the collapsed quadratic is the exact Σ_j w_j f_j of those terms before
+    its final rounding. Values (and subgradients) are summed in that order. They equal
+    Σ_j w_j f_j up to rounding: the collapsed quadratic differs from the exact
+    Σ_j w_j f_j by a few ulps of the magnitudes of its form's terms (the smaller of the
+    two forms' bounds), the rest by the order of the sums.
     """
 
     def __init__(self, terms: Sequence[tuple[float, Oracle]], d: int, *,
                  name: str = "global cost") -> None:
         super().__init__(d, name)
-        flat: list[tuple[float, Oracle]] = []
+        flat: list[tuple[Fraction, Oracle]] = []
         for w, o in terms:
-            _flatten(o, float(w), flat)
+            _flatten(o, _rational(w, ()), flat)
         quad = [(w, o) for w, o in flat if isinstance(o, (Quadratic, Affine))]
         self._quad = _collapse(quad, d) if quad else None
-        rest = [t for t in flat
-                if self._quad is None or not isinstance(t[1], (Quadratic, Affine))]
+        rest = [(float(w), o) for w, o in flat
+                if self._quad is None or not isinstance(o, (Quadratic, Affine))]
         self._rows = _row_kinds([t for t in rest if _row_kind(t[1])])
         rest = [t for t in rest if not _row_kind(t[1])]
         packs: dict[Hashable, list[tuple[float, Oracle]]] = {}
@@ -837,18 +839,19 @@ def _residuals(Z: np.ndarray, At: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("pd,dk->pk", Z, At) - b
 
 
-def _flatten(o: Oracle, w: float, out: list[tuple[float, Oracle]]) -> None:
-    """(weight, term) pairs of w·o through Sum and Scaled."""
+def _flatten(o: Oracle, w: Fraction, out: list[tuple[Fraction, Oracle]]) -> None:
+    """(weight, term) pairs of w·o through Sum and Scaled, the weights exact (products
+    of the floats' exact values: no rounding before :func:`_collapse`)."""
     if isinstance(o, Sum):
         for t in o.terms:
             _flatten(t, w, out)
     elif isinstance(o, Scaled):
-        _flatten(o.term, w * o.coef, out)
+        _flatten(o.term, w * o.exact["coef"], out)
     else:
         out.append((w, o))
 
 
-def _collapse(quad: list[tuple[float, Oracle]], d: int) -> Quadratic | None:
+def _collapse(quad: list[tuple[Fraction, Oracle]], d: int) -> Quadratic | None:
     """Σ w_j f_j over Quadratic / Affine terms as one :class:`Quadratic` centred at
     m = −H⁺ℓ with the linear part r in null(H) (:func:`complete_square`) and the value at
     m as its constant, all exact (see :class:`Merged`); None when a number does not fit

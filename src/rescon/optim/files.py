@@ -81,7 +81,7 @@ def read_rmdo(path: str | Path) -> RMDOFile:
         One line naming the file: anything the scenario parser refuses, no [costs], an
         unparsable or non-convex expression (with its position), a cost of the wrong
         dimension, a module that cannot be imported or whose function fails, a bad
-        [step_size]. Agents without a cost are refused by :func:`rescon.rmdo`.
+        [step_size], a benign agent without a cost.
     """
     p = Path(path)
     return rmdo_from_dict(read_toml(p), path=p)
@@ -102,6 +102,9 @@ def rmdo_from_dict(data: Mapping[str, Any], *, path: str | Path = "rmdo") -> RMD
         data.pop(k, None)
     sc = _from_dict(data, p.parent, str(p))
     costs = _costs(tables["costs"], p, sc.d, sc.graph)
+    missing = [v for v in sc.benign if v not in costs]
+    if missing:  # rescon.rmdo would refuse it without naming the file
+        raise InputError(f"{p} [costs]: no cost for benign agent(s) {missing[:5]}")
     return RMDOFile(sc, costs, _step_size(tables["step_size"], f"{p} [step_size]"))
 
 
@@ -118,12 +121,8 @@ def read_costs(path: str | Path) -> tuple[dict[Hashable, Oracle], int]:
     p = Path(path)
     data = read_toml(p)
     if set(data) & {"scenario", "graph", "initial"}:  # an RMDO file: its benign agents'
-        f = read_rmdo(p)
-        benign = f.scenario.benign
-        missing = [v for v in benign if v not in f.costs]
-        if missing:  # as rescon.rmdo refuses the file
-            raise InputError(f"{p} [costs]: no cost for benign agent(s) {missing[:5]}")
-        keep = set(benign)
+        f = read_rmdo(p)  # it refuses a benign agent without a cost
+        keep = set(f.scenario.benign)
         return {v: o for v, o in f.costs.items() if v in keep}, f.scenario.d
     _keys(data, {"d", "costs"}, str(p))
     if "costs" not in data:

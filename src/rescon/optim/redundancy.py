@@ -88,7 +88,9 @@ class RedundancyReport:
         uᵀx2 (the support values when both argmins are single points); for numerical
         ones, the support values in the direction where they differ most. None if holds.
     gap : the largest distance found between a subset's argmin and the whole set's
-        (inf when exactly one of them is empty): the ε of (r, ε)-redundancy
+        (inf when exactly one of them is empty, or past the float range): the ε of
+        (r, ε)-redundancy. Exact witness values past the float range are ±inf (the
+        certificate holds them exactly)
     unbounded : the (N − r)-subsets whose sum has no minimiser (tuples of labels)
     unbounded_agents : the agents whose cost alone has no minimiser
     tolerance : of a numerical verdict (None when exact)
@@ -253,7 +255,7 @@ class _Check:
         if s.opt is None and s.ray is None:
             s.status = "unknown"
         elif s.opt is not None:
-            s.point = np.array([float(v) for v in s.opt.x])
+            s.point = _floats(s.opt.x)
 
     @property
     def frame(self) -> tuple[np.ndarray, float]:
@@ -341,10 +343,9 @@ class _Check:
             R = np.array(a.rref, dtype=float)  # distance of parallel affine sets
             diff = np.array([float(u - v) for u, v in zip(a.x, b.x, strict=True)])
             return float(np.linalg.norm(R.T @ np.linalg.lstsq(R.T, diff, rcond=None)[0]))
-        supports = [(self.support(s, k)[0], self.support(ref, k)[0])
-                    for k in range(len(self.dirs))]
-        sup = max(_difference(h1, h2) for h1, h2 in supports)
-        bounded = all(math.isfinite(h) for pair in supports for h in pair)
+        supports = [(self.support(s, k), self.support(ref, k)) for k in range(len(self.dirs))]
+        sup = max(_difference(a, b, u) for (a, b), u in zip(supports, self.dirs, strict=True))
+        bounded = all(h[1] is not None for pair in supports for h in pair)
         if (a is not None and b is not None) or bounded:
             return sup
         return max(sup, self.point_gap(s, ref))
@@ -364,9 +365,17 @@ class _Check:
         return best[0]
 
     def tolerance(self, sets: list[_Set]) -> float:
-        vals = [abs(h) for s in sets for h, *_ in s.supports.values() if math.isfinite(h)]
+        """REL_TOL (1 + the largest finite support or coordinate of a minimiser);
+        InputError when a minimiser or a bounded support passes the float range (an
+        exact verdict was not reached, and a numerical one has no scale there)."""
+        vals = [abs(h) for s in sets for h, p, _ in s.supports.values() if p is not None]
         vals += [float(np.abs(s.point).max()) for s in sets if s.point is not None]
-        return REL_TOL * (1.0 + max(vals, default=0.0))
+        tol = REL_TOL * (1.0 + max(vals, default=0.0))
+        if not math.isfinite(tol):
+            raise InputError("check_redundancy: an argmin reaches beyond the float range "
+                             "(|x| > 1.8e308) and no exact verdict was found; rescale the "
+                             "costs")
+        return tol
 
     # -- witnesses --------------------------------------------------------------- #
 
@@ -414,8 +423,8 @@ class _Check:
             return {"subsets": [s.members, ref.members], "direction": None,
                     "support": None, "points": [_pt(s.point), _pt(ref.point)],
                     "exact": False, "reason": "one of the two sums is unbounded below"}
-        diffs = [_difference(self.support(s, k)[0], self.support(ref, k)[0])
-                 for k in range(len(self.dirs))]
+        diffs = [_difference(self.support(s, k), self.support(ref, k), u)
+                 for k, u in enumerate(self.dirs)]
         dist, p, q = self.far.get(s.members, (0.0, None, None))
         if dist > max(diffs):
             return {"subsets": [s.members, ref.members], "direction": None, "support": None,
@@ -506,16 +515,23 @@ def _separation(s1: _Set, s2: _Set) -> dict[str, Any] | None:
         vals, pts = [_dot_f(u, x1), _dot_f(u, proof)], [x1, proof]
     else:
         return None
-    return {"subsets": [s1.members, s2.members], "direction": [float(v) for v in u],
-            "support": vals, "points": [None if p is None else [float(v) for v in p] for p in pts],
+    return {"subsets": [s1.members, s2.members], "direction": _floats(u).tolist(),
+            "support": vals, "points": [None if p is None else _floats(p).tolist() for p in pts],
             "exact": True, "reason": ("the second sum is unbounded below" if proof == "unbounded"
                                       else "x1 minimises the first sum but not the second"),
             "_proof": (s1, s2, proof)}
 
 
-def _difference(h1: float, h2: float) -> float:
-    """|h1 − h2| for support values, which may be +inf (0 when both are)."""
-    return 0.0 if h1 == h2 else abs(h1 - h2)
+def _difference(a: tuple, b: tuple, u: np.ndarray) -> float:
+    """|h1 − h2| for supports (value, float point or None when unbounded, exact point or
+    None) in direction u: +inf when one is unbounded, 0 when both are; exact (rounded
+    once) when both points are exact — their values may be ±inf past the float range."""
+    if a[1] is None or b[1] is None:
+        return 0.0 if a[1] is b[1] else math.inf
+    if a[2] is not None and b[2] is not None:
+        diff = [p - q for p, q in zip(a[2], b[2], strict=True)]
+        return abs(_float(_pq._dot([Fraction(float(v)) for v in u], diff)))
+    return 0.0 if a[0] == b[0] else abs(a[0] - b[0])
 
 
 def _outside(s: _Set, x: list[Fraction]) -> bool:
@@ -526,7 +542,21 @@ def _outside(s: _Set, x: list[Fraction]) -> bool:
 
 
 def _dot_f(u: list[Fraction], x: list[Fraction]) -> float:
-    return float(sum((a * b for a, b in zip(u, x, strict=True)), Fraction(0)))
+    return _float(_pq._dot(u, x))
+
+
+def _float(v: Fraction) -> float:
+    """The float nearest v; ±inf beyond the float range (where ``float`` raises
+    OverflowError): exact data whose answers pass 1.8e308 still get their exact verdict,
+    with such values shown as ±inf (null in JSON)."""
+    try:
+        return float(v)
+    except OverflowError:
+        return math.inf if v > 0 else -math.inf
+
+
+def _floats(x: list[Fraction]) -> np.ndarray:
+    return np.array([_float(v) for v in x])
 
 
 def _pt(p: np.ndarray | None) -> list[float] | None:
@@ -658,6 +688,12 @@ def _pow2(v: float) -> Fraction:
     return Fraction(2) ** max(-1000, min(1000, round(math.log2(v))))
 
 
+def _pow2_exact(v: Fraction) -> Fraction:
+    """A power of two within a factor 2 of the Fraction v > 0, also beyond the float
+    range: 2^(bits of the numerator − bits of the denominator)."""
+    return Fraction(2) ** (v.numerator.bit_length() - v.denominator.bit_length())
+
+
 def _poly_support(opt: _pq.Optimal, u: np.ndarray
                   ) -> tuple[float, np.ndarray | None, list[Fraction] | None]:
     """max uᵀy over the certified argmin E ∩ {n·y ≤ h, the canonical ``faces``}: HiGHS on
@@ -669,11 +705,12 @@ def _poly_support(opt: _pq.Optimal, u: np.ndarray
     from scipy.optimize import linprog
 
     x, d = opt.x, len(opt.x)
+    uq = [Fraction(float(v)) for v in u]
     if opt.affine and len(opt.rref) == d:
-        return float(u @ np.array([float(v) for v in x])), np.array([float(v) for v in x]), x
+        return _float(_pq._dot(uq, x)), _floats(x), x
     faces = sorted(opt.faces)
     slack = [f[-1] - _pq._dot(f[:-1], x) for f in faces]
-    sigma = _pow2(float(max(slack))) if any(slack) else Fraction(1)
+    sigma = _pow2_exact(max(slack)) if any(slack) else Fraction(1)
     rhs = np.array([float(v / sigma) for v in slack])
     N = np.array([[float(v) for v in f[:-1]] for f in faces]).reshape(-1, d)
     R = np.array(opt.rref, dtype=float).reshape(-1, d)
@@ -690,11 +727,8 @@ def _poly_support(opt: _pq.Optimal, u: np.ndarray
              if abs(nz - h) <= 1e-7 * (1 + abs(h))]
     y = opt.point_near(tight, guess)
     if y is None:
-        yf = np.array([float(v) for v in guess])
-        return float(u @ yf), yf, None
-    yf = np.array([float(v) for v in y])
-    return float(sum((Fraction(float(a)) * b for a, b in zip(u, y, strict=True)),
-                     Fraction(0))), yf, y
+        return _float(_pq._dot(uq, guess)), _floats(guess), None
+    return _float(_pq._dot(uq, y)), _floats(y), y
 
 
 class _Cvx:
