@@ -1773,12 +1773,29 @@ def _no_constant(name: str) -> Any:
 
 def _finite_float(text: str) -> float:
     """A JSON number with a fraction or exponent, as a double; one beyond the double range
-    (``1e400``) is unreadable, exactly like ``Infinity``."""
+    (``1e400``) is unreadable, exactly like ``Infinity``, and so is a nonzero one that
+    underflows to zero (``1e-400``: read as 0 it would turn a claim about a nonzero
+    value into one about 0; subnormal doubles such as ``5e-324`` are read)."""
     x = float(text)
     if not math.isfinite(x):
         raise ValueError(f"the number {text[:40]} overflows a double: like Infinity, "
                          "it is not a finite JSON number")
+    if x == 0.0 and text.lower().split("e")[0].strip("-+0.") != "":
+        raise ValueError(f"the nonzero number {text[:40]} underflows a double to zero")
     return x
+
+
+def _json_int(text: str) -> int:
+    """A JSON integer of any length: up to the checker's MAX_DIGITS digits converted in
+    chunks (``kernels._decimal``: Python's int() refuses more than 4300 digits); a
+    longer one, beyond the limit whatever its digits, is read as ±2^(MAX_NUMBER_BITS + 1)
+    without converting it — a number every check refuses to work with (a rational:
+    unchecked, as any number over the limit; an integer field: out of range)."""
+    digits = text.lstrip("-")
+    sign = -1 if text.startswith("-") else 1
+    if len(digits) > _kernels.MAX_DIGITS:
+        return sign << (_kernels.MAX_NUMBER_BITS + 1)
+    return sign * _kernels._decimal(digits, "a JSON integer")
 
 
 def load(path: str) -> dict:
@@ -1786,7 +1803,8 @@ def load(path: str) -> dict:
     with open(path, "rb") as f:
         data = f.read()
     obj = json.loads(data.decode("utf-8"), object_pairs_hook=_no_duplicate_keys,
-                     parse_constant=_no_constant, parse_float=_finite_float)
+                     parse_constant=_no_constant, parse_float=_finite_float,
+                     parse_int=_json_int)
     if not isinstance(obj, dict):
         raise ValueError(f"top level is a JSON {_tname(obj)}, not an object")  # noqa: TRY004
     return obj

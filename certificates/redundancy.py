@@ -167,10 +167,16 @@ def _head(c: dict, optional: tuple[str, ...], required: tuple[str, ...] = ()
     for x in costs:
         if isinstance(x, dict):
             pieces += sum(len(b) for k in ("blocks", "norms")
-                          for b in x.get(k, []) if isinstance(b, list))
+                          for b in _listed(x.get(k)) if isinstance(b, list))
     if pieces > MAX_PIECES:
         raise Unchecked("size", f"{pieces} pieces > {MAX_PIECES}: beyond the checker's limits")
     return d, r, N, [_cost(x, f"costs[{i}]", d) for i, x in enumerate(costs)]
+
+
+def _listed(x: Any) -> list:
+    """x if it is a JSON array, else [] (the size count runs before the structure is
+    checked; :func:`_cost` then refuses what is not an array)."""
+    return x if isinstance(x, list) else []
 
 
 def _subset(x: Any, where: str, N: int, sizes: tuple[int, ...]) -> tuple[int, ...]:

@@ -1015,6 +1015,32 @@ def test_number_overflowing_a_double_is_unreadable_like_infinity(tmp_path):
     assert res.verdict == "invalid" and "not a finite number" in res.reason
 
 
+def test_json_numbers_at_the_edges_of_the_double_and_integer_ranges(tmp_path, capsys):
+    """V24's reads, at their edges: a nonzero number underflowing to zero is unreadable
+    (1e-400 would claim 0); zeros in any spelling and the smallest subnormal are read
+    exactly (5e-324 = 2^-1074: the claim x = 5e-324 ∈ Ψ([-1, 0, 1], 1) = {0} is
+    refuted, not unreadable); JSON integers of 4301–9865 digits are read (chunks; the
+    kernel {0} of ±10^9000 is valid), longer ones make the certificate unchecked
+    (beyond the 32 768-bit limit), never unreadable, in no time."""
+    def run(points, x):
+        f = tmp_path / "c.json"
+        f.write_text('{"rescon_certificate": 1, "kind": "kernel_point", "points": ' + points
+                     + ', "F": 1, "x": [' + x + '], "proof": {"method": "halfspaces"}}')
+        return C.main([str(f)])
+
+    line = "[[-1], [0], [1]]"
+    for text in ("1e-400", "-1e-400", "0.5e-330", "1E-999"):
+        assert run(line, text) == 2, text
+    for text in ("0.0", "-0.0", "0e-999", "0.000E+5"):
+        assert run(line, text) == 0, text
+    assert run(line, "5e-324") == 1
+    big = "1" + "0" * 9000
+    assert run(f"[[-{big}], [0], [{big}]]", "0") == 0
+    huge = "9" * 10 ** 6
+    assert run(f"[[-{huge}], [0], [{huge}]]", "0") == 3
+    assert run(line, huge) == 3
+
+
 def test_deeply_nested_proof_is_rejected_not_crashing():
     proof = {"method": "trivial"}
     for _ in range(3000):

@@ -31,7 +31,7 @@ Sarymsakov and redundancy certificates, certificates/examples/*.json) and by han
   BOM-prefixed, deeply nested, with NaN / Infinity / 1e400 / duplicate keys through
   ``main``.
 
-Found (strict xfails below):
+Found (strict xfails at first; all fixed, their tests now pass):
 
 * ``redundancy._head`` counts the pieces with ``x.get(k, [])`` and iterates whatever is
   there: a cost whose ``"blocks"`` or ``"norms"`` is null, a number or a boolean makes
@@ -161,16 +161,16 @@ def _redundancy_with(key: str, value) -> dict:
     return c
 
 
-@pytest.mark.xfail(strict=True, reason="V24: redundancy._head iterates a non-list 'blocks'/"
-                   "'norms' (x.get(k, [])): check() raises TypeError instead of 'invalid'")
+# Fixed (was a bug: redundancy._head iterated a non-list 'blocks'/'norms' (x.get(k, [])):
+# check() raised TypeError instead of 'invalid')
 @pytest.mark.parametrize("key,value", [("blocks", None), ("blocks", 3), ("norms", True)])
 def test_redundancy_cost_with_non_list_blocks_is_invalid_not_a_traceback(key, value):
     res = check(_redundancy_with(key, value))
     assert res.verdict == "invalid"
 
 
-@pytest.mark.xfail(strict=True, reason="V24: the command line prints a TypeError traceback "
-                   "for a cost whose 'blocks' is null (redundancy._head)")
+# Fixed (was a bug: the command line printed a TypeError traceback for a cost whose
+# 'blocks' is null (redundancy._head))
 def test_cli_redundancy_null_blocks_says_invalid(tmp_path, capsys):
     f = tmp_path / "c.json"
     f.write_text(json.dumps(_redundancy_with("blocks", None)))
@@ -182,8 +182,8 @@ _POINT_ON_LINE = ('{"rescon_certificate": 1, "kind": "kernel_point", "points": [
                   '"F": 1, "x": [%s], "proof": {"method": "halfspaces"}}')
 
 
-@pytest.mark.xfail(strict=True, reason="V24: check.load's parse_float lets a nonzero JSON number "
-                   "underflow to 0.0: x = 1e-400 is certified in Psi = {0} (1e400 is refused)")
+# Fixed (was a bug: check.load's parse_float let a nonzero JSON number underflow to 0.0:
+# x = 1e-400 was certified in Psi = {0}, while 1e400 is refused)
 @pytest.mark.parametrize("literal", ["1e-400", "-1e-400"])
 def test_underflowing_json_number_is_not_read_as_zero(tmp_path, capsys, literal):
     # Psi([-1, 0, 1], F = 1) = {0}; the file claims x = ±10^-400 lies in it: false.
@@ -201,9 +201,8 @@ def test_underflow_control_representable_tiny_number_is_refuted(tmp_path, capsys
 _BIG = "1" + "0" * 5000  # 5001 digits, about 16 600 bits: within the 32 768-bit limit
 
 
-@pytest.mark.xfail(strict=True, reason="V24: check.load leaves JSON integers to int(), which "
-                   "refuses > 4300 digits: a correct certificate within the documented "
-                   "32768-bit limit is 'unreadable'")
+# Fixed (was a bug: check.load left JSON integers to int(), which refuses > 4300 digits:
+# a correct certificate within the documented 32768-bit limit was 'unreadable')
 def test_long_json_integer_within_the_limit_is_readable(tmp_path, capsys):
     f = tmp_path / "c.json"
     f.write_text('{"rescon_certificate": 1, "kind": "kernel_point", "points": '
