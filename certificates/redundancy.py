@@ -157,6 +157,9 @@ def _head(c: dict, optional: tuple[str, ...], required: tuple[str, ...] = ()
     N = len(agents)
     if not 1 <= N <= MAX_AGENTS:
         raise Invalid(f"agents must hold 1 to {MAX_AGENTS} labels, got {N}")
+    for i, a in enumerate(agents):
+        if isinstance(a, bool) or not isinstance(a, (str, int)):
+            raise Invalid(f"agents[{i}] must be a string or an integer, got {_tname(a)}")
     if len({repr(a) for a in agents}) != N:
         raise Invalid("agents has a repeated label")
     r = _int(c["r"], "r", 0, N - 1)

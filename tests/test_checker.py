@@ -1222,3 +1222,23 @@ def test_large_sparse_graph_answers_in_bounded_time():
     edges = [[i, (i + 1) % n] for i in range(n)] + [[(i + 1) % n, i] for i in range(n)]
     res = check(rs_cert(n, edges, 1, 1, {"method": "milp", "solver": "highs"}))
     assert res.verdict == "unchecked" and res.trusted == ("milp",), res
+
+
+@pytest.mark.parametrize("label", [1.5, True, None, [1], {"a": 1}])
+def test_redundancy_agent_labels_are_strings_or_integers(label):
+    """FORMAT.md: agents are N distinct labels, JSON strings or integers; anything else
+    is invalid (V24's note: they were not type-checked), strings and integers keep the
+    genuine verdict."""
+    import json
+    from pathlib import Path
+
+    path = Path(__file__).parents[1] / "certificates/examples/redundancy_shifted_violation.json"
+    cert = json.loads(path.read_text())
+    genuine = check(cert).verdict
+    assert genuine == "valid"
+    for fine in ("agent x", 7):
+        cert["agents"][0] = fine
+        assert check(cert).verdict == genuine
+    cert["agents"][0] = label
+    res = check(cert)
+    assert res.verdict == "invalid" and "agents[0]" in res.reason, res
