@@ -50,7 +50,7 @@ def test_poly_support_of_a_segment_longer_than_the_float_range():
     assert _pq.check_optimal(F, x, lam, []) is None
     opt = _pq.describe(F, x, lam, [])
     for u, end in ((1.0, 10**308), (-1.0, -10**308)):
-        h, yf, y = _poly_support(opt, np.array([u]))
+        h, yf, y, _ = _poly_support(opt, np.array([u]))
         assert y == [Fraction(end)] and h == 1e308 and yf[0] == float(end)
 
 
@@ -199,3 +199,39 @@ value = [-1.7e308, -1.7e308]
     assert main(["simulate", str(p), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "diverged" in err[0]
+
+
+# --------------------------------------------------------------------------- #
+# 2. non-piecewise-quadratic costs far from the origin (CVXPY in the frame)
+# --------------------------------------------------------------------------- #
+
+
+def _huber_costs(c0: float) -> list[str]:
+    return [f"huber(x1 - {c0}, 1) + (x2 - {c0})^2", f"huber(x1 - {c0} - 2, 1) + (x2 - {c0})^2",
+            f"huber(x1 - {c0}, 1) + (x2 - {c0})^2"]
+
+
+@pytest.mark.parametrize("c0", [1e8, 1e20, 1e50, -1e150])
+def test_huber_costs_far_away_get_the_verdict_they_get_at_the_origin(c0):
+    """Huber costs (not piecewise quadratic: CVXPY's numerical path) centred at c0: at
+    1e8 and 1e20 the verdict was 'holds' (the tolerance grew with |x|, the supports
+    lost the gap 0.5 in rounding), at 1e50 a SolverError. Solved in the centred frame
+    (the data shifted exactly), with the tolerance measured from the centre, the
+    verdict, gap and tolerance are those at the origin."""
+    base = rescon.check_redundancy(_huber_costs(0.0), r=1)
+    rep = rescon.check_redundancy(_huber_costs(c0), r=1)
+    assert (base.holds, base.exact) == (rep.holds, rep.exact) == (False, False)
+    assert rep.gap == pytest.approx(base.gap, rel=1e-6) and rep.gap == pytest.approx(0.5,
+                                                                                     rel=1e-3)
+    assert rep.tolerance == pytest.approx(base.tolerance, rel=1e-6)
+
+
+@pytest.mark.parametrize("c0", [1e8, 1e300])
+def test_equal_huber_and_logsumexp_sums_hold_far_away(c0):
+    """Equal argmins stay equal far away: three Huber costs with one minimiser (their
+    log-sum-exp shape gives the frame its kinks), the exact decimal 10^300 included."""
+    c = [f"huber(x1 - {c0}, 1) + huber(x2 - {c0}, 1)"] * 2 + [
+        f"logsumexp(x1 - {c0}, {c0} - x1) + huber(x2 - {c0}, 2)"]
+    rep = rescon.check_redundancy(c, r=1)
+    assert (rep.holds, rep.exact) == (True, False)
+    assert rep.gap <= 1e-3 and rep.tolerance <= 2e-4

@@ -41,7 +41,11 @@ scaled), each support point then made exact on the faces it makes tight; when on
 the two sets is not certified, also the distance from each set's minimiser to the other
 set (Clarabel; supports are +inf in every direction on sets such as parallel lines).
 Sets agree when every support and distance differs by at most ``tolerance`` = 1e-4
-(1 + the largest |h|). The ``gap`` is then the largest of them — a lower bound on the
+(1 + the largest |h(u) − uᵀc| and ‖x − c‖∞ of the minimisers, c the frame's centre
+below: the same verdict wherever the costs sit). CVXPY solves in the same frame as
+Clarabel (x = c + s·y, the atoms' data transformed exactly; Huber rows and log-sum-exp
+pieces count as kinks for c and s), so costs far from the origin are solved at unit
+scale. The ``gap`` is then the largest of them — a lower bound on the
 Hausdorff distance (exact for single points and affine sets).
 """
 
@@ -123,7 +127,8 @@ def check_redundancy(costs: Any, r: int, *, d: int | None = None) -> RedundancyR
     ------
     InputError
         r ≥ N, a cost of another dimension (naming the agent), a cost that is neither
-        piecewise quadratic nor convertible to CVXPY (callables, CasADi).
+        piecewise quadratic nor convertible to CVXPY (callables, CasADi); an argmin
+        beyond the float range (|x| > 1.8e308) when no exact verdict is found.
 
     Examples
     --------
@@ -170,6 +175,12 @@ def _costs(costs: Any, d: int | None) -> tuple[list[Hashable], list[Any], int]:
 # --------------------------------------------------------------------------- #
 
 
+_Support = tuple[float, "np.ndarray | None", "list[Fraction] | None", "Fraction | None"]
+"""h_A(u), a point attaining it (None: unbounded, h = +inf), that point exactly when it
+is proven in A, and h exactly as computed (uᵀ of an exact point, or uᵀc + s·h_y of the
+numerical path: differences of supports are taken exactly, then rounded once)."""
+
+
 @dataclass
 class _Set:
     """A_S for the agents ``members`` (indices): ``status`` "optimal" / "unbounded" /
@@ -181,8 +192,7 @@ class _Set:
     opt: _pq.Optimal | None = None
     ray: list[Fraction] | None = None
     point: np.ndarray | None = None
-    supports: dict[int, tuple[float, np.ndarray | None, list[Fraction] | None]] = field(
-        default_factory=dict)
+    supports: dict[int, _Support] = field(default_factory=dict)
 
     @property
     def certified(self) -> bool:
@@ -197,6 +207,7 @@ class _Check:
         self._cvx: _Cvx | None = None
         self.far: dict[tuple[int, ...], tuple[float, Any, Any]] = {}
         self._frame: tuple[np.ndarray, float] | None = None
+        self._centre: tuple[list[Fraction], float] | None = None
         self._framed: dict[int, _pq.PQ] = {}
 
     # -- computing argmin sets ------------------------------------------------ #
@@ -259,11 +270,27 @@ class _Check:
 
     @property
     def frame(self) -> tuple[np.ndarray, float]:
-        """(c, s) for the solver (:func:`_frame`), from every piecewise-quadratic cost."""
+        """(c, s) for Clarabel on the exact path (:func:`_frame`), from every cost that
+        is piecewise quadratic or whose :func:`_shape` is (Huber, log-sum-exp)."""
         if self._frame is None:
-            self._frame = _frame(self._sum(tuple(i for i, F in enumerate(self.pq)
-                                                 if F is not None)))
+            self._frame = _frame(self._shapes())
         return self._frame
+
+    @property
+    def centre(self) -> tuple[list[Fraction], float]:
+        """(c, s) of :func:`_centred` for CVXPY and the tolerance: c exact."""
+        if self._centre is None:
+            self._centre = _centred(self._shapes())
+        return self._centre
+
+    def _shapes(self) -> _pq.PQ:
+        """The sum of the costs' piecewise-quadratic forms, else their :func:`_shape`."""
+        F = _pq.PQ.zero(self.d)
+        for o, P in zip(self.oracles, self.pq, strict=True):
+            P = P if P is not None else _pq.of_oracle(_shape(o), self.d)
+            if P is not None:
+                F.add(P)
+        return F
 
     def _framed_sum(self, members: tuple[int, ...]) -> _pq.PQ:
         """Σ_{i ∈ members} f_i(c + s·y) (:func:`_framed`, each cost's computed once)."""
@@ -277,18 +304,17 @@ class _Check:
     @property
     def cvx(self) -> _Cvx:
         if self._cvx is None:
-            self._cvx = _Cvx(self.oracles, self.d)
+            self._cvx = _Cvx(self.oracles, self.d, self.centre)
         return self._cvx
 
-    def support(self, s: _Set, k: int
-                ) -> tuple[float, np.ndarray | None, list[Fraction] | None]:
-        """h_{A_S}(u_k), a point attaining it and that point exactly when it is proven in
-        A_S (inf, None, None: unbounded in u_k)."""
+    def support(self, s: _Set, k: int) -> _Support:
+        """h_{A_S}(u_k) as a :data:`_Support` ((inf, None, None, None): unbounded in u_k)."""
         if k not in s.supports:
             if s.opt is not None:
                 s.supports[k] = _poly_support(s.opt, self.dirs[k])
             else:
-                s.supports[k] = (*self.cvx.support(s.members, self.dirs[k]), None)
+                h, pt, hq = self.cvx.support(s.members, self.dirs[k])
+                s.supports[k] = (h, pt, None, hq)
         return s.supports[k]
 
     # -- the decision ---------------------------------------------------------- #
@@ -344,7 +370,7 @@ class _Check:
             diff = np.array([float(u - v) for u, v in zip(a.x, b.x, strict=True)])
             return float(np.linalg.norm(R.T @ np.linalg.lstsq(R.T, diff, rcond=None)[0]))
         supports = [(self.support(s, k), self.support(ref, k)) for k in range(len(self.dirs))]
-        sup = max(_difference(a, b, u) for (a, b), u in zip(supports, self.dirs, strict=True))
+        sup = max(_difference(a, b) for a, b in supports)
         bounded = all(h[1] is not None for pair in supports for h in pair)
         if (a is not None and b is not None) or bounded:
             return sup
@@ -365,17 +391,31 @@ class _Check:
         return best[0]
 
     def tolerance(self, sets: list[_Set]) -> float:
-        """REL_TOL (1 + the largest finite support or coordinate of a minimiser);
-        InputError when a minimiser or a bounded support passes the float range (an
-        exact verdict was not reached, and a numerical one has no scale there)."""
-        vals = [abs(h) for s in sets for h, p, _ in s.supports.values() if p is not None]
-        vals += [float(np.abs(s.point).max()) for s in sets if s.point is not None]
+        """REL_TOL (1 + the largest finite support or coordinate of a minimiser, both
+        measured from the frame's centre c: |h(u) − uᵀc|, ‖x − c‖∞, so the verdict does
+        not depend on where the costs sit); InputError when a minimiser or a bounded
+        support passes the float range (an exact verdict was not reached, and a
+        numerical one has no scale there)."""
+        cq = self.centre[0]
+        vals = [abs(_float(hq - _pq._dot([Fraction(float(v)) for v in self.dirs[k]], cq)))
+                for s in sets for k, (_, p, _, hq) in s.supports.items() if p is not None]
+        vals += [float(np.abs(self._offset(s)).max()) for s in sets if s.point is not None]
         tol = REL_TOL * (1.0 + max(vals, default=0.0))
         if not math.isfinite(tol):
             raise InputError("check_redundancy: an argmin reaches beyond the float range "
                              "(|x| > 1.8e308) and no exact verdict was found; rescale the "
                              "costs")
         return tol
+
+    def _offset(self, s: _Set) -> np.ndarray:
+        """s's minimiser − the centre c: exact then rounded for certified sets, CVXPY's
+        unrounded s·y (its frame's centre is c) for the others."""
+        cq = self.centre[0]
+        if s.opt is not None:
+            return _floats([a - b for a, b in zip(s.opt.x, cq, strict=True)])
+        if self._cvx is not None and self._cvx.cq == cq and s.members in self._cvx.offsets:
+            return self._cvx.offsets[s.members]
+        return s.point - np.array([float(v) for v in cq])
 
     # -- witnesses --------------------------------------------------------------- #
 
@@ -423,8 +463,8 @@ class _Check:
             return {"subsets": [s.members, ref.members], "direction": None,
                     "support": None, "points": [_pt(s.point), _pt(ref.point)],
                     "exact": False, "reason": "one of the two sums is unbounded below"}
-        diffs = [_difference(self.support(s, k), self.support(ref, k), u)
-                 for k, u in enumerate(self.dirs)]
+        diffs = [_difference(self.support(s, k), self.support(ref, k))
+                 for k in range(len(self.dirs))]
         dist, p, q = self.far.get(s.members, (0.0, None, None))
         if dist > max(diffs):
             return {"subsets": [s.members, ref.members], "direction": None, "support": None,
@@ -432,7 +472,7 @@ class _Check:
                     "reason": f"a minimiser of one sum is at distance {dist:.6g} from the "
                               f"other's argmin (the nearest point second)"}
         k = int(np.argmax(diffs))
-        (h1, p1, _), (h2, p2, _) = self.support(s, k), self.support(ref, k)
+        (h1, p1, *_), (h2, p2, *_) = self.support(s, k), self.support(ref, k)
         return {"subsets": [s.members, ref.members], "direction": self.dirs[k].tolist(),
                 "support": [h1, h2], "points": [_pt(p1), _pt(p2)], "exact": False,
                 "reason": "support functions differ beyond the tolerance"}
@@ -522,16 +562,13 @@ def _separation(s1: _Set, s2: _Set) -> dict[str, Any] | None:
             "_proof": (s1, s2, proof)}
 
 
-def _difference(a: tuple, b: tuple, u: np.ndarray) -> float:
-    """|h1 − h2| for supports (value, float point or None when unbounded, exact point or
-    None) in direction u: +inf when one is unbounded, 0 when both are; exact (rounded
-    once) when both points are exact — their values may be ±inf past the float range."""
+def _difference(a: _Support, b: _Support) -> float:
+    """|h1 − h2| for two supports in one direction: +inf when one is unbounded, 0 when
+    both are, else from their exact values, rounded once (no cancellation far from the
+    origin; values past the float range included)."""
     if a[1] is None or b[1] is None:
         return 0.0 if a[1] is b[1] else math.inf
-    if a[2] is not None and b[2] is not None:
-        diff = [p - q for p, q in zip(a[2], b[2], strict=True)]
-        return abs(_float(_pq._dot([Fraction(float(v)) for v in u], diff)))
-    return 0.0 if a[0] == b[0] else abs(a[0] - b[0])
+    return abs(_float(a[3] - b[3]))
 
 
 def _outside(s: _Set, x: list[Fraction]) -> bool:
@@ -648,23 +685,55 @@ def _certify_framed(F: _pq.PQ, G: _pq.PQ, c: np.ndarray, s: float, data: tuple
             if _pq.check_optimal(F, x, opt.lam, opt.mu) is None else None)
 
 
-def _frame(F: _pq.PQ) -> tuple[np.ndarray, float]:
+def _frame(F: _pq.PQ, *, floor: bool = True) -> tuple[np.ndarray, float]:
     """(c, s) centring and scaling F's data: c the coordinate-wise median of the terms'
-    anchors (the point of each piece's zero set nearest 0, the least-squares minimisers
-    of the quadratic part and of each norm's residual), s the power of two nearest their
-    largest distance from c (at least 2^-30 ‖c‖∞: c is a float, rounded by up to
-    2^-53 ‖c‖∞)."""
+    anchors, s the power of two nearest their largest distance from c (with ``floor``,
+    at least 2^-30 ‖c‖∞: the exact path's points c + s·y are then distinct in floats;
+    CVXPY's path maps its results back exactly or only reports points). A term's zero set (each
+    piece's {aᵀx + b = 0}, the quadratic part's stationary set {Hx = −g}, each norm's
+    {A_l x = c_l}) is anchored at its point nearest to p, the least-squares point of all
+    of them (rows normalised): anchors then do not depend on where the origin is (the
+    point nearest 0 of {x1 = 1e20} in the plane is (1e20, 0), whatever x2 the other
+    terms want)."""
     f = F.float_data()
-    anchors = [-bj * a / (a @ a) for a, bj in zip(f["A"], f["b"], strict=True) if a.any()]
+    systems = [(a[None, :], np.array([-bj])) for a, bj in zip(f["A"], f["b"], strict=True)
+               if a.any()]
     if f["H"].any():
-        anchors.append(np.linalg.lstsq(f["H"], -f["g"], rcond=None)[0])
-    anchors += [np.linalg.lstsq(A, c, rcond=None)[0] for A, c in f["norms"]]
-    P = np.array(anchors).reshape(-1, F.d)
+        systems.append((f["H"], -f["g"]))
+    systems += list(f["norms"])
+    with np.errstate(all="ignore"):
+        systems = [(M[k] / n[k, None], r[k] / n[k]) for M, r in systems
+                   if (k := (n := np.linalg.norm(M, axis=1)) > 0).any()]
+        p = (np.linalg.lstsq(np.vstack([M for M, _ in systems]),
+                             np.concatenate([r for _, r in systems]), rcond=None)[0]
+             if systems else np.zeros(F.d))
+        P = np.array([p + np.linalg.lstsq(M, r - M @ p, rcond=None)[0]
+                      for M, r in systems]).reshape(-1, F.d)
+    if not (np.isfinite(p).all() and np.isfinite(P).all()):
+        return np.zeros(F.d), 1.0
     c = np.median(P, axis=0) if len(P) else np.zeros(F.d)
-    spread = max(float(np.abs(P - c).max(initial=0.0)), 2.0**-30 * np.abs(c).max(initial=0.0))
+    spread = max(float(np.abs(P - c).max(initial=0.0)),
+                 2.0**-30 * np.abs(c).max(initial=0.0) if floor else 0.0)
     if not (np.isfinite(c).all() and math.isfinite(spread)):
         return np.zeros(F.d), 1.0
     return c, float(_pow2(spread)) if spread > 0 else 1.0
+
+
+def _centred(F: _pq.PQ) -> tuple[list[Fraction], float]:
+    """(c, s) with c exact, the data centred to the last bit: :func:`_frame` (without
+    the floor) of F(c + y), c the sum of the frames' centres so far (floats, so each
+    round gains ~53 bits: exact data at 1e50 such as 10^50, which no float is, ends up
+    centred within its spread), until the centre found lies within its spread."""
+    c = [Fraction(0)] * F.d
+    for _ in range(40):
+        cf, s = _frame(F, floor=False)
+        if not cf.any():
+            break
+        c = [a + Fraction(float(v)) for a, v in zip(c, cf, strict=True)]
+        F = _framed(F, cf, 1.0)
+        if np.abs(cf).max() <= s:
+            break
+    return c, s
 
 
 def _framed(F: _pq.PQ, c: np.ndarray, s: float) -> _pq.PQ:
@@ -694,20 +763,20 @@ def _pow2_exact(v: Fraction) -> Fraction:
     return Fraction(2) ** (v.numerator.bit_length() - v.denominator.bit_length())
 
 
-def _poly_support(opt: _pq.Optimal, u: np.ndarray
-                  ) -> tuple[float, np.ndarray | None, list[Fraction] | None]:
+def _poly_support(opt: _pq.Optimal, u: np.ndarray) -> _Support:
     """max uᵀy over the certified argmin E ∩ {n·y ≤ h, the canonical ``faces``}: HiGHS on
     y = x̄ + σz (σ the power of two nearest the largest slack h − n·x̄, so the LP is at
     unit scale whatever the argmin's size and position), then the exact point of the
     argmin on the faces tight at HiGHS's solution (:meth:`_pq.Optimal.point_near`; the
-    value is uᵀ of it). Returns (value, float point, exact point or None); (inf, None,
-    None) when unbounded in u."""
+    value is uᵀ of it). Returns a :data:`_Support` (the exact point None when the
+    projection fails: then HiGHS's point, its value exact); (inf, None, None, None)
+    when unbounded in u."""
     from scipy.optimize import linprog
 
     x, d = opt.x, len(opt.x)
     uq = [Fraction(float(v)) for v in u]
     if opt.affine and len(opt.rref) == d:
-        return _float(_pq._dot(uq, x)), _floats(x), x
+        return _float(h := _pq._dot(uq, x)), _floats(x), x, h
     faces = sorted(opt.faces)
     slack = [f[-1] - _pq._dot(f[:-1], x) for f in faces]
     sigma = _pow2_exact(max(slack)) if any(slack) else Fraction(1)
@@ -718,7 +787,7 @@ def _poly_support(opt: _pq.Optimal, u: np.ndarray
                   A_eq=R if len(R) else None, b_eq=np.zeros(len(R)) if len(R) else None,
                   bounds=[(None, None)] * d, method="highs")
     if res.status == 3:
-        return math.inf, None, None
+        return math.inf, None, None, None
     if res.status != 0:
         raise SolverError(f"HiGHS could not compute a support value: {res.message}")
     z = np.asarray(res.x)
@@ -727,15 +796,20 @@ def _poly_support(opt: _pq.Optimal, u: np.ndarray
              if abs(nz - h) <= 1e-7 * (1 + abs(h))]
     y = opt.point_near(tight, guess)
     if y is None:
-        return _float(_pq._dot(uq, guess)), _floats(guess), None
-    return _float(_pq._dot(uq, y)), _floats(y), y
+        return _float(h := _pq._dot(uq, guess)), _floats(guess), None, h
+    return _float(h := _pq._dot(uq, y)), _floats(y), y, h
 
 
 class _Cvx:
     """The numerical path: Σ w_i f_i in CVXPY (w a nonnegative Parameter, so each
-    subset re-solves a compiled problem) with Clarabel."""
+    subset re-solves a compiled problem) with Clarabel, in the frame x = c + s·y of
+    :func:`_centred` (the costs' data transformed exactly, :func:`_to_cvxpy`): costs far
+    from the origin or at any scale are solved at unit scale, and the results mapped
+    back (points c + s·y, supports uᵀc + s·h_y, distances s·dist). CVXPY costs that
+    CVXPY evaluates itself (``.grad``) are used as written: then the frame is (0, 1)."""
 
-    def __init__(self, oracles: list[Any], d: int) -> None:
+    def __init__(self, oracles: list[Any], d: int, frame: tuple[list[Fraction], float]
+                 ) -> None:
         from ..models.backends import require_backend
 
         require_backend("cvxpy", "model")
@@ -744,15 +818,19 @@ class _Cvx:
         self.cp = cp
         xs = {id(g.x): g.x for o in oracles for g in _grad_parts(o)}
         user = next(iter(xs.values())) if len(xs) == 1 else None
-        self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)
+        self.cq, self.s = ([Fraction(0)] * d, 1.0) if xs else frame
+        self.c = np.array([float(v) for v in self.cq])
+        self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)  # y
         self.w = cp.Parameter(len(oracles), nonneg=True)
-        F = sum(self.w[i] * _to_cvxpy(cp, o, self.x) for i, o in enumerate(oracles))
+        F = sum(self.w[i] * _to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s))
+                for i, o in enumerate(oracles))
         self.u, self.level = cp.Parameter(d), cp.Parameter()
         self.p = cp.Parameter(d)
         self.pmin = cp.Problem(cp.Minimize(F))
         self.psup = cp.Problem(cp.Maximize(self.u @ self.x), [F <= self.level])
         self.pdist = cp.Problem(cp.Minimize(cp.norm(self.x - self.p, 2)), [F <= self.level])
         self.fstar: dict[tuple[int, ...], float] = {}
+        self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
 
     def _solve(self, problem: Any) -> None:
         """problem.solve by Clarabel; its status is read by the caller ("inaccurate"
@@ -770,6 +848,10 @@ class _Cvx:
         w[list(members)] = 1.0
         self.w.value = w
 
+    def _offset(self) -> np.ndarray:
+        """s·y at the solution: its x − c, unrounded (x = c + s·y is rounded to c's ulp)."""
+        return self.s * np.array(self.x.value, dtype=float)
+
     def minimise(self, members: tuple[int, ...]) -> tuple[str, np.ndarray | None]:
         self._weights(members)
         self._solve(self.pmin)
@@ -779,7 +861,8 @@ class _Cvx:
             raise SolverError(f"Clarabel could not minimise the sum of agents {members}: "
                               f"{self.pmin.status}")
         self.fstar[members] = float(self.pmin.value)
-        return "optimal", np.array(self.x.value, dtype=float)
+        self.offsets[members] = off = self._offset()
+        return "optimal", self.c + off
 
     def _level(self, members: tuple[int, ...]) -> None:
         """Weights and level F* + LEVEL_TOL (1 + |F*|) of the sum over ``members``."""
@@ -790,27 +873,33 @@ class _Cvx:
         f = self.fstar[members]
         self.level.value = f + LEVEL_TOL * (1.0 + abs(f))
 
-    def support(self, members: tuple[int, ...], u: np.ndarray) -> tuple[float, np.ndarray | None]:
+    def support(self, members: tuple[int, ...], u: np.ndarray
+                ) -> tuple[float, np.ndarray | None, Fraction | None]:
+        """h(u), a point attaining it and h(u) = uᵀc + s·h_y exactly as computed (None:
+        unbounded, h = inf)."""
         self._level(members)
         self.u.value = u
         self._solve(self.psup)
         if self.psup.status in ("unbounded", "unbounded_inaccurate"):
-            return math.inf, None
+            return math.inf, None, None
         if self.psup.status not in ("optimal", "optimal_inaccurate"):
             raise SolverError(f"Clarabel could not compute a support value of agents "
                               f"{members}: {self.psup.status}")
-        return float(self.psup.value), np.array(self.x.value, dtype=float)
+        h = (_pq._dot([Fraction(float(v)) for v in u], self.cq)
+             + Fraction(self.s) * Fraction(float(self.psup.value)))
+        return _float(h), self.c + self._offset(), h
 
     def distance(self, members: tuple[int, ...], p: np.ndarray) -> tuple[float, np.ndarray]:
         """The distance from p to {F ≤ level} for the sum over ``members`` and the
         nearest point."""
         self._level(members)
-        self.p.value = p
+        self.p.value = np.array([float((Fraction(float(v)) - ci) / Fraction(self.s))
+                                 for v, ci in zip(p, self.cq, strict=True)])
         self._solve(self.pdist)
         if self.pdist.status not in ("optimal", "optimal_inaccurate"):
             raise SolverError(f"Clarabel could not compute a distance to the argmin of "
                               f"agents {members}: {self.pdist.status}")
-        return float(self.pdist.value), np.array(self.x.value, dtype=float)
+        return self.s * float(self.pdist.value), self.c + self._offset()
 
 
 def _grad_parts(o: Any) -> Iterator[Any]:
@@ -826,38 +915,69 @@ def _grad_parts(o: Any) -> Iterator[Any]:
         yield from _grad_parts(o.term)
 
 
-def _to_cvxpy(cp: Any, o: Any, x: Any) -> Any:
-    """The CVXPY expression of an atom tree; a CVXPY summand evaluated by ``.grad`` is
-    used as is when it is written in ``x`` (every CVXPY cost in one Variable of shape
-    (d,)). InputError for other oracles."""
+def _to_cvxpy(cp: Any, o: Any, y: Any, c: list[Fraction], s: Fraction) -> Any:
+    """The CVXPY expression of an atom tree at x = c + s·y up to a constant (none is
+    kept: F* and the level sets do not depend on where the origin is), its data
+    transformed exactly before rounding (the rows' A ↦ sA, b ↦ b ∓ Ac; a quadratic
+    ½(x − m)ᵀQ(x − m) + qᵀx ↦ ½ s² yᵀQy + s(Q(c − m) + q)ᵀy; an affine aᵀx ↦ s aᵀy):
+    no cancellation of computing c + s·y in floats. A CVXPY
+    summand evaluated by ``.grad`` is used as is when it is written in ``y`` (every CVXPY
+    cost in one Variable of shape (d,), frame (0, 1)). InputError for other oracles."""
     from . import atoms
     from .cvxpy_adapter import CvxpyGradOracle
 
-    if isinstance(o, CvxpyGradOracle) and o.x is x:
+    if isinstance(o, CvxpyGradOracle) and o.x is y:
         return o.expr
 
+    def arr(v: Any) -> np.ndarray:
+        return np.array(v, dtype=float)
+
     if isinstance(o, atoms.Sum):
-        return sum(_to_cvxpy(cp, t, x) for t in o.terms)
+        return sum(_to_cvxpy(cp, t, y, c, s) for t in o.terms)
     if isinstance(o, atoms.Scaled):
-        return o.coef * _to_cvxpy(cp, o.term, x)
+        return o.coef * _to_cvxpy(cp, o.term, y, c, s)
     if isinstance(o, atoms.MaxOf):
-        return cp.maximum(*[_to_cvxpy(cp, t, x) for t in o.terms])
+        return cp.maximum(*[_to_cvxpy(cp, t, y, c, s) for t in o.terms])
+    ex = getattr(o, "exact", None)
     if isinstance(o, atoms.Quadratic):
-        quad = 0.5 * cp.quad_form(x - o.c, cp.psd_wrap(o.Q)) if o.Q.any() else 0
-        return quad + o.q @ x + o.const
+        Q = arr([[s * s * v for v in row] for row in ex["Q"]])
+        shift = [a - b for a, b in zip(c, ex["c"], strict=True)]
+        q = arr([s * (_pq._dot(row, shift) + qi) for row, qi in zip(ex["Q"], ex["q"],
+                                                                  strict=True)])
+        return (0.5 * cp.quad_form(y, cp.psd_wrap(Q)) if Q.any() else 0) + q @ y
     if isinstance(o, atoms.Affine):
-        return o.a @ x + o.b
-    maps = {atoms.AbsAffine: lambda r: cp.abs(r[0]), atoms.Norm1: cp.norm1,
-            atoms.Norm2: lambda r: cp.norm(r, 2), atoms.NormInf: cp.norm_inf,
-            atoms.Hinge: lambda r: cp.pos(r[0])}
-    if type(o) in maps:
-        return maps[type(o)](o.A @ x - o.b)
-    if isinstance(o, atoms.MaxAffine):
-        return cp.max(o.A @ x + o.b)
-    if isinstance(o, atoms.LogSumExp):
-        return cp.log_sum_exp(o.A @ x + o.b)
-    if isinstance(o, atoms.Huber):
-        return cp.sum(cp.huber(o.A @ x - o.b, o.M))
+        return arr([s * v for v in ex["a"]]) @ y
+    if isinstance(o, atoms._Rows):  # r = A x ∓ b = sA y + (Ac ∓ b)
+        A = arr([[s * v for v in row] for row in ex["A"]])
+        sign = 1 if o.pieces else -1
+        r = A @ y + arr([_pq._dot(row, c) + sign * bi
+                         for row, bi in zip(ex["A"], ex["b"], strict=True)])
+        maps = {atoms.AbsAffine: lambda r: cp.abs(r[0]), atoms.Norm1: cp.norm1,
+                atoms.Norm2: lambda r: cp.norm(r, 2), atoms.NormInf: cp.norm_inf,
+                atoms.Hinge: lambda r: cp.pos(r[0]), atoms.MaxAffine: cp.max,
+                atoms.LogSumExp: cp.log_sum_exp,
+                atoms.Huber: lambda r: cp.sum(cp.huber(r, o.M))}
+        if type(o) in maps:
+            return maps[type(o)](r)
     raise InputError(f"{o.name}: check_redundancy needs costs built of atoms (an expression "
                      f"string, atoms) or CVXPY expressions in one Variable of shape (d,); "
                      f"got a {o.kind} oracle")
+
+
+def _shape(o: Any) -> Any:
+    """An atom tree with the same kinks for :func:`_frame`: Huber rows as |·| rows,
+    log-sum-exp as the max of its pieces (piecewise quadratic, so
+    :func:`_pq.of_oracle` reads their anchors); other atoms unchanged."""
+    from . import atoms
+
+    if isinstance(o, atoms.Huber):
+        return atoms.Norm1(o.exact["A"], o.exact["b"])
+    if isinstance(o, atoms.LogSumExp):
+        return atoms.MaxAffine(o.exact["A"], o.exact["b"])
+    if isinstance(o, atoms.Sum):
+        return atoms.Sum([_shape(t) for t in o.terms])
+    if isinstance(o, atoms.Scaled):
+        return atoms.Scaled(o.exact["coef"], _shape(o.term))
+    if isinstance(o, atoms.MaxOf):
+        return atoms.MaxOf([_shape(t) for t in o.terms])
+    return o
