@@ -33,11 +33,15 @@ from ..errors import InputError
 from ..graphs.named import GENERATORS
 from .clouds import CLOUDS
 
-__all__ = ["EPSILON", "KINDS", "Grid", "read_grid"]
+__all__ = ["EPSILON", "KINDS", "MAX_CELLS", "Grid", "read_grid"]
 
 #: default ε of ε-consensus: steps_to_consensus is the first step k with
 #: diameter(t_k) ≤ ε · diameter(t_0)
 EPSILON = 1e-6
+#: the most cells a grid may have (the axes' product × repetitions): its cells are built
+#: in memory before the first runs, ~1 kB each (a typo such as repetitions = 10⁹ would
+#: take the machine's memory before any check)
+MAX_CELLS = 10**6
 _TABLES = _TOP | set(RMDO_TABLES)
 _RUN = {"kind", "repetitions", "epsilon"}
 _GENERATED = {"generator", "seed", *GENERATORS,
@@ -130,7 +134,7 @@ def read_grid(grid: str | Path | Mapping[str, Any]) -> Grid:
     if bad:
         raise InputError(f"{where} [run]: unknown keys {bad} (allowed: {sorted(_RUN)})")
     kind = run.get("kind", "consensus")
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise InputError(f"{where} [run]: kind must be one of {', '.join(KINDS)}; "
                          f"got {kind!r}")
     tables = KINDS[kind][0]
@@ -148,6 +152,7 @@ def read_grid(grid: str | Path | Mapping[str, Any]) -> Grid:
     axes = {k: _axis(k, v, tables, f"{where} [axes]")
             for k, v in _mapping(data.get("axes", {}), f"{where} [axes]").items()}
     reps = integer("repetitions", run.get("repetitions", 1), low=1)
+    _size(axes, reps, where)
     eps = positive("epsilon", run.get("epsilon", EPSILON), what="number")
     if eps >= 1:
         raise InputError(f"{where} [run]: epsilon must be in (0, 1); got {eps!r}")
@@ -172,11 +177,26 @@ def _mapping(value: Any, where: str) -> Mapping[str, Any]:
     return value
 
 
-def _axis(key: str, values: Any, tables: frozenset[str], where: str) -> list[Any]:
+def _size(axes: Mapping[str, list[Any]], reps: int, where: str) -> None:
+    """Refuse a grid of more than :data:`MAX_CELLS` cells (Π |axis| × repetitions),
+    naming the factors."""
+    cells = reps
+    for values in axes.values():
+        cells *= len(values)
+    if cells > MAX_CELLS:
+        sizes = ", ".join(f"{k!r}: {len(v)}" for k, v in axes.items())
+        raise InputError(f"{where}: {cells} cells (axes {{{sizes}}} × repetitions = "
+                         f"{reps}) exceed the limit of {MAX_CELLS} cells; split the grid")
+
+
+def _axis(key: Any, values: Any, tables: frozenset[str], where: str) -> list[Any]:
     """An axis: "table.key[.key…]" with a table of the kind (or "dos": each value a
     whole [[dos]] array), a known key for the fixed tables (:data:`KEYS`), and a
     non-empty list; a "graph.generator" or "points.generator" axis names known
     generators."""
+    if not isinstance(key, str):
+        raise InputError(f"{where}: axis {key!r} must be a dotted key 'table.key' (a "
+                         f"string); got a {type(key).__name__}")
     table, _, name = key.partition(".")
     named = sorted(tables - {"dos"})
     if not (key == "dos" and "dos" in tables) and not (table in named and name):
