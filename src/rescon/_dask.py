@@ -1,25 +1,33 @@
 """The Dask client shared by everything rescon runs on a cluster (sweeps, split searches).
 
 ``client(scheduler, workers)`` connects to a running scheduler by address, with guards
-against an address where nothing (or no Dask scheduler) answers and a scheduler without
-workers, or starts an embedded ``distributed.LocalCluster`` of worker processes that is
-closed with the client. dask is imported here, on first use, never with rescon.
+against an address where nothing (or no Dask scheduler, or a silent peer) answers and a
+scheduler without workers, or starts an embedded ``distributed.LocalCluster`` of worker
+processes that is closed with the client. :class:`Workers` ends a wait on tasks once
+the cluster has had no worker for ``WORKER_SECONDS``. dask is imported here, on first
+use, never with rescon.
 """
 
 from __future__ import annotations
 
 import os
+import threading
+import time
 from typing import Any
 
 from ._validate import integer
-from .errors import InputError, MissingDependency
+from .errors import InputError, MissingDependency, SolverError
 
-__all__ = ["CONNECT_SECONDS", "WORKER_SECONDS", "check_workers", "client", "require"]
+__all__ = ["CONNECT_SECONDS", "POLL_SECONDS", "WORKER_SECONDS", "Workers", "check_workers",
+           "client", "require"]
 
-#: seconds to reach a scheduler given by address before giving up
+#: seconds to reach a scheduler given by address, handshake included, before giving up
 CONNECT_SECONDS = 5
-#: seconds to wait for a first worker on a scheduler that has none (else: no task runs)
+#: seconds to wait for a first worker on a scheduler that has none (else: no task runs),
+#: and for a worker again on a cluster that lost its last one
 WORKER_SECONDS = 30
+#: seconds between two looks at the cluster while tasks run
+POLL_SECONDS = 0.2
 
 
 def check_workers(scheduler: str | None, workers: int | None) -> int | None:
@@ -52,12 +60,7 @@ def client(scheduler: str | None, workers: int | None) -> Any:
         if not isinstance(scheduler, str) or not scheduler:
             raise InputError(f"scheduler must be an address such as tcp://host:8786; got "
                              f"{scheduler!r}")
-        try:
-            connected = Client(scheduler, timeout=CONNECT_SECONDS)
-        except Exception as exc:  # noqa: BLE001 (whatever answers there may be no Dask
-            # scheduler: an HTTP reply read as a frame length is a MemoryError)
-            raise InputError(f"scheduler {scheduler}: cannot connect ({type(exc).__name__}: "
-                             f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
+        connected = _connect(Client, scheduler)
         try:
             connected.wait_for_workers(1, timeout=WORKER_SECONDS)
         except TimeoutError:
@@ -69,6 +72,72 @@ def client(scheduler: str | None, workers: int | None) -> Any:
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                            dashboard_address=None)
     return _Owned(Client(cluster), cluster)
+
+
+def _connect(Client: Any, scheduler: str) -> Any:
+    """``Client(scheduler)``, or InputError "cannot connect" when it fails or has not
+    connected within CONNECT_SECONDS + 2 s. Client's own timeout bounds reaching the
+    address but not the handshake, which a peer that accepts and never answers (a
+    tarpit, a server waiting for a request) never ends: the attempt runs in a daemon
+    thread, and one that ends after the deadline closes what it made."""
+    lock = threading.Lock()
+    box: dict[str, Any] = {}
+
+    def attempt() -> None:
+        try:
+            made = Client(scheduler, timeout=CONNECT_SECONDS)
+        except Exception as exc:  # noqa: BLE001 (whatever answers there may be no Dask
+            # scheduler: an HTTP reply read as a frame length is a MemoryError)
+            made, box["error"] = None, exc
+        with lock:
+            if "abandoned" not in box:
+                box["client"] = made
+                return
+        if made is not None:
+            made.close()
+
+    thread = threading.Thread(target=attempt, name="rescon-connect", daemon=True)
+    thread.start()
+    thread.join(CONNECT_SECONDS + 2)
+    with lock:
+        if "client" not in box:
+            box["abandoned"] = True
+    if box.get("client") is not None:
+        return box["client"]
+    exc = box.get("error")
+    why = (f"no Dask handshake in {CONNECT_SECONDS + 2} s" if exc is None else
+           f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
+    raise InputError(f"scheduler {scheduler}: cannot connect ({why})")
+
+
+class Workers:
+    """Watches that the cluster still has a worker while the caller waits on its tasks:
+    they would wait forever without one (a worker killed, no nanny to restart it)."""
+
+    def __init__(self, client: Any) -> None:
+        self.client, self.seen = client, time.perf_counter()
+
+    def check(self) -> None:
+        """SolverError once no worker has been seen for ``WORKER_SECONDS`` (the wait
+        :func:`client` allows a scheduler for a first worker)."""
+        now = time.perf_counter()
+        if self.client.nthreads():
+            self.seen = now
+        elif now - self.seen > WORKER_SECONDS:
+            raise SolverError(f"the Dask cluster has had no worker for {WORKER_SECONDS} s: "
+                              "its tasks cannot run")
+
+    def finished(self, running: Any) -> set[Any]:
+        """The futures of ``running`` (an iterable of futures) done within
+        ``POLL_SECONDS``; when none is, the cluster must still have a worker
+        (:meth:`check`) — the caller then checks its deadline."""
+        from distributed import wait
+
+        try:
+            return wait(list(running), timeout=POLL_SECONDS, return_when="FIRST_COMPLETED").done
+        except TimeoutError:
+            self.check()
+            return set()
 
 
 class _Owned:

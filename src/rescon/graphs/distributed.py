@@ -108,6 +108,7 @@ import networkx as nx
 import numpy as np
 
 from .. import _dask
+from .._dask import Workers as _Workers
 from ..errors import InputError, SolverError
 from .search import (
     MAX_SEARCH_NODES,
@@ -135,8 +136,6 @@ COST_TASK_NODES = 2_000_000
 SPLIT_SINGLES = 4
 #: the least tree room a part is granted while running parts hold some (:meth:`_Tree.grant`)
 MIN_GRANT = 1 << 16
-#: seconds between checks of the deadline and ``should_stop`` while tasks run
-POLL_SECONDS = 0.2
 
 
 class _Cluster:
@@ -300,36 +299,6 @@ def _result(fut: Any) -> PartResult:
         first = str(exc).splitlines()[0] if str(exc) else ""
         raise SolverError(f"a search task failed on the Dask cluster "
                           f"({type(exc).__name__}: {first})") from exc
-
-
-class _Workers:
-    """Watches that the cluster still has a worker while a search waits on it: its tasks
-    would wait forever without one (a worker killed, no nanny to restart it)."""
-
-    def __init__(self, client: Any) -> None:
-        self.client, self.seen = client, time.perf_counter()
-
-    def check(self) -> None:
-        """SolverError once no worker has been seen for ``_dask.WORKER_SECONDS`` (the
-        wait rescon._dask allows a scheduler for a first worker)."""
-        now = time.perf_counter()
-        if self.client.nthreads():
-            self.seen = now
-        elif now - self.seen > _dask.WORKER_SECONDS:
-            raise SolverError(f"the Dask cluster has had no worker for "
-                              f"{_dask.WORKER_SECONDS} s: the search's tasks cannot run")
-
-    def finished(self, running: dict[Any, Any]) -> set[Any]:
-        """The futures of ``running`` done within ``POLL_SECONDS``; when none is, the
-        cluster must still have a worker (:meth:`check`) — the caller then checks its
-        deadline."""
-        from distributed import wait
-
-        try:
-            return wait(list(running), timeout=POLL_SECONDS, return_when="FIRST_COMPLETED").done
-        except TimeoutError:
-            self.check()
-            return set()
 
 
 def finish_on_cluster(
