@@ -4,24 +4,34 @@ Output directory (``out``): ``grid.json`` (the grid's canonical SHA-256 and the 
 ``parts/cell-NNNNNN.parquet`` (one file per finished cell, written as it finishes),
 ``results.parquet`` (every finished row, consolidated at the end) and, with matplotlib,
 ``summary.png``. A rerun in the same directory skips the finished cells; a different
-grid there is refused.
+grid there is refused. A row lost to the cluster (:data:`LOST`: the worker running the
+cell died, the task was cancelled) is in the table but not stored as finished, so a
+rerun computes it; a part file that cannot be read is computed again too.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from .._dask import check_workers, client
+from .._dask import Workers, check_workers, client
 from .._progress import progress_bar
 from ..errors import InputError, MissingDependency
 from .cell import METRICS, failed_row, run_cell
 from .grid import Grid, read_grid
 
-__all__ = ["sweep"]
+__all__ = ["LOST", "sweep"]
+
+#: the errors of a row lost to the cluster, not to its cell (run_cell never raises: a
+#: cell's own exception is its row): the cell is computed again on a rerun
+LOST = ("KilledWorker", "CancelledError", "FutureCancelledError", "CommClosedError")
+#: a Parquet integer column holds 64-bit integers
+_INT64 = (-(2**63), 2**63 - 1)
+_PART = re.compile(r"cell-(\d{6})\.parquet")
 
 
 def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
@@ -49,19 +59,21 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
     g = read_grid(grid)
     workers = check_workers(scheduler, workers)
     pd = _pandas()
-    folder = _prepare(out, g) if out is not None else None
     cells = g.cells()
+    as_text = {k for k, values in g.axes.items() if len({type(v) for v in values}) > 1}
+    if out is not None:
+        _storable(cells, as_text)
+    folder = _prepare(out, g) if out is not None else None
     done = _finished(folder) if folder is not None else {}
     todo = [c for c in cells if c["cell"] not in done]
-    as_text = {k for k, values in g.axes.items() if len({type(v) for v in values}) > 1}
     for row in _bar(_execute(todo, scheduler, workers), len(cells), len(done), progress):
         cell = row.pop("cell")
         done[cell] = {k: _encode(v, k in as_text) for k, v in row.items()}
-        if folder is not None:
+        if folder is not None and not _lost(done[cell]):
             _write_part(folder, cell, done[cell])
     table = _frame(pd, g, [done[c["cell"]] for c in cells])
     if folder is not None:
-        table.to_parquet(folder / "results.parquet", index=False)
+        _write(table, folder / "results.parquet")
         _plot(table, g.axes, g.kind, folder)
     return table
 
@@ -86,18 +98,20 @@ def _execute(cells: list[dict[str, Any]], scheduler: str | None,
             yield {"cell": c["cell"], **run_cell(c)}
         return
     with client(scheduler, workers) as connected:
-        from distributed import as_completed
-
         futures = connected.map(run_cell, cells, pure=False)
         index = {f.key: c for f, c in zip(futures, cells, strict=True)}
-        for fut in as_completed(futures):
-            cell = index[fut.key]
-            try:
-                row = fut.result()
-            except Exception as exc:  # noqa: BLE001 (the workers running it died: KilledWorker)
-                row = failed_row(cell, exc)
-            yield {"cell": cell["cell"], **row}
-            fut.release()
+        running = set(futures)
+        watch = Workers(connected)  # no worker for WORKER_SECONDS: SolverError
+        while running:
+            for fut in watch.finished(running):
+                running.discard(fut)
+                cell = index[fut.key]
+                try:
+                    row = fut.result()
+                except Exception as exc:  # noqa: BLE001 (the workers running it died: KilledWorker)
+                    row = failed_row(cell, exc)
+                yield {"cell": cell["cell"], **row}
+                fut.release()
 
 
 def _prepare(out: str | Path, g: Grid) -> Path:
@@ -124,14 +138,42 @@ def _prepare(out: str | Path, g: Grid) -> Path:
     return folder
 
 
+def _storable(cells: list[dict[str, Any]], as_text: set[str]) -> None:
+    """Refuse, before any cell runs, a seed or an integer axis value that the table's
+    64-bit integer columns cannot hold (a seed 2⁶³ − 1 + repetition, say)."""
+    low, high = _INT64
+    for c in cells:
+        for name, value in (("seed", c["seed"]), *c["params"].items()):
+            if (isinstance(value, int) and not isinstance(value, bool)
+                    and name not in as_text and not low <= value <= high):
+                raise InputError(f"{name} = {value} (cell {c['cell']}, repetition "
+                                 f"{c['repetition']}) does not fit the table's 64-bit "
+                                 f"integer column [{low}, {high}]")
+
+
+def _lost(row: Mapping[str, Any]) -> bool:
+    """The row of a cell lost to the cluster (:data:`LOST`), not a result."""
+    return row["status"] == "failed" and str(row["error"]).split(":")[0] in LOST
+
+
 def _finished(folder: Path) -> dict[int, dict[str, Any]]:
-    """The rows already written in ``folder``, by cell index."""
+    """The rows already written in ``folder``, by cell index: the parts named
+    cell-NNNNNN.parquet that can be read, hold one row and are not :func:`_lost` (the
+    others are computed again and their part overwritten)."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
     out = {}
     for part in sorted((folder / "parts").glob("cell-*.parquet")):
-        for row in pq.read_table(part).to_pylist():
-            out[int(part.stem.split("-")[1])] = row
+        match = _PART.fullmatch(part.name)
+        if match is None:
+            continue
+        try:
+            rows = pq.read_table(part).to_pylist()
+        except (pa.ArrowException, OSError):
+            continue
+        if len(rows) == 1 and not _lost(rows[0]):
+            out[int(match.group(1))] = rows[0]
     return out
 
 
@@ -143,8 +185,34 @@ def _write_part(folder: Path, cell: int, row: dict[str, Any]) -> None:
 
     target = folder / "parts" / f"cell-{cell:06d}.parquet"
     tmp = target.with_suffix(".tmp")
-    pq.write_table(pa.Table.from_pylist([row]), tmp)
+    pq.write_table(pa.Table.from_pylist([row], schema=_schema(pa, row)), tmp)
     tmp.replace(target)
+
+
+def _write(table: Any, path: Path) -> None:
+    """The table as Parquet with the fixed types of :data:`_DTYPES` (all-null columns
+    included: the schema does not depend on the outcomes)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    schema = _schema(pa, table)
+    pq.write_table(pa.Table.from_pandas(table, schema=schema, preserve_index=False), path)
+
+
+def _schema(pa: Any, columns: Any) -> Any:
+    """The Arrow schema of a table with ``columns`` (a row or a DataFrame): the types of
+    :data:`_DTYPES` for the result columns, the inferred type (of the grid's values)
+    for the axes and the seed."""
+    fixed = {name: pa.type_for_alias(_ARROW[dtype]) for names, dtype in _DTYPES
+             for name in names}
+    if isinstance(columns, Mapping):
+        inferred = pa.Table.from_pylist([{k: v for k, v in columns.items()
+                                          if k not in fixed}]).schema
+    else:
+        inferred = pa.Schema.from_pandas(columns.drop(columns=list(fixed)),
+                                         preserve_index=False)
+    types = {f.name: f.type for f in inferred}
+    return pa.schema([(name, fixed.get(name) or types[name]) for name in columns])
 
 
 def _encode(value: Any, as_text: bool = False) -> Any:
@@ -165,11 +233,16 @@ def _frame(pd: Any, g: Grid, rows: list[dict[str, Any]]) -> Any:
     return table
 
 
-#: column dtypes (nullable integers and booleans: null where a kind does not fill them)
+#: column dtypes (nullable integers, booleans and strings: null where a kind or a
+#: failed cell does not fill them), the same whatever the cells' outcomes
 _DTYPES = ((("steps_to_consensus", "blocked_links", "repetition", "rho", "s_star", "dim",
              "n_vertices"), "Int64"),
            (("final_diameter", "max_validity", "final_gap", "seconds"), "float64"),
-           (("exact", "certificate_valid", "is_empty"), "boolean"))
+           (("exact", "certificate_valid", "is_empty"), "boolean"),
+           (("status", "error", "method", "certificate_verdict", "rescon_version"),
+            "string"))
+#: the Arrow type of each dtype of :data:`_DTYPES` (pandas' own mapping)
+_ARROW = {"Int64": "int64", "float64": "double", "boolean": "bool", "string": "large_string"}
 
 
 def _bar(rows: Iterator[dict[str, Any]], total: int, done: int,
