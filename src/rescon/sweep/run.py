@@ -55,6 +55,11 @@ def sweep(grid: str | Path | Mapping[str, Any], *, scheduler: str | None = None,
         machine's CPU count), one thread each. ``workers=0``: serially in this process.
     out : directory for ``results.parquet`` (resumable); None: nothing written.
     progress : a bar on stderr (default: when stderr is a terminal).
+
+    Raises InputError for a bad grid (:func:`rescon.sweep.grid.read_grid`) and, with
+    ``out``, for a seed or integer axis value beyond int64 (before anything is written);
+    SolverError when the cluster has had no worker for ``rescon._dask.WORKER_SECONDS``
+    (its tasks cannot run; the finished cells stay in ``out`` for a rerun).
     """
     g = read_grid(grid)
     workers = check_workers(scheduler, workers)
@@ -153,7 +158,7 @@ def _storable(cells: list[dict[str, Any]], as_text: set[str]) -> None:
 
 def _lost(row: Mapping[str, Any]) -> bool:
     """The row of a cell lost to the cluster (:data:`LOST`), not a result."""
-    return row["status"] == "failed" and str(row["error"]).split(":")[0] in LOST
+    return row.get("status") == "failed" and str(row.get("error")).split(":")[0] in LOST
 
 
 def _finished(folder: Path) -> dict[int, dict[str, Any]]:
