@@ -88,11 +88,11 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-# =================================================================== bugs (xfail strict)
+# ======================================== bugs (strict xfails at first; all fixed)
 
 
-@pytest.mark.xfail(strict=True, reason="V25: [run] kind = [...] (a list) is tested with "
-                   "`kind not in KINDS` on a dict: TypeError unhashable, a traceback")
+# Fixed (was a bug: [run] kind = [...] (a list) is tested with `kind not in KINDS` on a
+# dict: TypeError unhashable, a traceback)
 def test_run_kind_that_is_not_a_name_is_a_one_line_error(tmp_path, capsys):
     grid = tmp_path / "g.toml"
     grid.write_text('[run]\nkind = ["consensus"]\n' + GRID2_TOML, encoding="utf-8")
@@ -104,16 +104,15 @@ def test_run_kind_that_is_not_a_name_is_a_one_line_error(tmp_path, capsys):
     assert "kind" in _one_line_error(capsys)
 
 
-@pytest.mark.xfail(strict=True, reason="V25: a non-string axis key in a dict grid reaches "
-                   "key.partition: AttributeError instead of the documented InputError")
+# Fixed (was a bug: a non-string axis key in a dict grid reaches key.partition:
+# AttributeError instead of the documented InputError)
 def test_non_string_axis_key_is_an_input_error():
     with pytest.raises(InputError):
         read_grid({"base": BASE, "axes": {1: [1, 2]}})
 
 
-@pytest.mark.xfail(strict=True, reason="V25: a corrupt parts/cell-*.parquet (or a stray "
-                   "cell-abc.parquet) makes the rerun die in _finished with a pyarrow "
-                   "ArrowInvalid / ValueError traceback (exit 1)")
+# Fixed (was a bug: a corrupt parts/cell-*.parquet (or a stray cell-abc.parquet) makes the
+# rerun die in _finished with a pyarrow ArrowInvalid / ValueError traceback (exit 1))
 @pytest.mark.parametrize("damage", ["truncated", "bad_name"])
 def test_corrupt_part_file_on_rerun_is_not_a_traceback(tmp_path, capsys, damage):
     grid = tmp_path / "g.toml"
@@ -136,10 +135,9 @@ def test_corrupt_part_file_on_rerun_is_not_a_traceback(tmp_path, capsys, damage)
         _one_line_error(capsys)
 
 
-@pytest.mark.xfail(strict=True, reason="V25: scenario.seed = 2**63 - 1 (TOML's largest "
-                   "integer) with 2 repetitions: the grid is accepted and the cells run, "
-                   "then _write_part's pa.Table.from_pylist raises OverflowError on seed "
-                   "2**63 — with out=None the same grid succeeds")
+# Fixed (was a bug: scenario.seed = 2**63 - 1 (TOML's largest integer) with 2 repetitions:
+# the grid is accepted and the cells run, then _write_part's pa.Table.from_pylist raises
+# OverflowError on seed 2**63 — with out=None the same grid succeeds)
 def test_seed_at_the_int64_edge_is_stored_or_refused_before_any_work(tmp_path):
     grid = {"base": {"scenario": {**BASE["scenario"], "seed": 2**63 - 1}},
             "axes": {"scenario.policy": ["hold"]}, "run": {"repetitions": 2}}
@@ -154,9 +152,9 @@ def test_seed_at_the_int64_edge_is_stored_or_refused_before_any_work(tmp_path):
         assert list(table["seed"]) == [2**63 - 1, 2**63]
 
 
-@pytest.mark.xfail(strict=True, reason="V25: _frame fixes numeric dtypes only: `error` is "
-                   "object (Parquet null) when every cell is ok and str (large_string) "
-                   "when one failed, so two results.parquet do not concatenate")
+# Fixed (was a bug: _frame fixes numeric dtypes only: `error` is object (Parquet null) when
+# every cell is ok and str (large_string) when one failed, so two results.parquet do not
+# concatenate)
 def test_table_dtypes_and_schema_do_not_depend_on_outcomes(tmp_path):
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -171,9 +169,9 @@ def test_table_dtypes_and_schema_do_not_depend_on_outcomes(tmp_path):
                       pq.read_table(tmp_path / "mixed" / "results.parquet")])
 
 
-@pytest.mark.xfail(strict=True, reason="V25: a KilledWorker row (the worker died, the cell "
-                   "never finished) is written as a part like a real result, so every "
-                   "rerun skips it: a transient cluster failure becomes permanent")
+# Fixed (was a bug: a KilledWorker row (the worker died, the cell never finished) is written
+# as a part like a real result, so every rerun skips it: a transient cluster failure becomes
+# permanent)
 def test_a_killed_worker_row_is_recomputed_on_rerun(tmp_path, monkeypatch):
     from types import SimpleNamespace
 
@@ -208,9 +206,9 @@ sys.exit(main(sys.argv[1:]))
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="V25: the only worker of a scheduler dies mid-sweep "
-                   "(no nanny): _execute waits in as_completed forever — no failed rows, "
-                   "no error (graphs/distributed.py's _Workers guard is not used here)")
+# Fixed (was a bug: the only worker of a scheduler dies mid-sweep (no nanny): _execute waits
+# in as_completed forever — no failed rows, no error (graphs/distributed.py's _Workers guard
+# is not used here))
 def test_sweep_whose_last_worker_dies_ends(tmp_path):
     dask = shutil.which("dask", path=str(BIN))
     assert dask is not None
@@ -256,11 +254,10 @@ def test_sweep_whose_last_worker_dies_ends(tmp_path):
             p.communicate() if p.stdout else p.wait()
 
 
-@pytest.mark.xfail(strict=True, reason="V25: no bound on a grid's size: [run] repetitions "
-                   "= 1000000000 (a typo) is accepted; Grid.cells' itertools.product "
-                   "materialises range(10**9) (8 GB of pointers) before any check — under "
-                   "a 3 GB limit 'the input is out of range (MemoryError: (no message))' "
-                   "naming nothing, without one the machine swaps or OOM-kills")
+# Fixed (was a bug: no bound on a grid's size: [run] repetitions = 1000000000 (a typo) is
+# accepted; Grid.cells' itertools.product materialises range(10**9) (8 GB of pointers)
+# before any check — under a 3 GB limit 'the input is out of range (MemoryError: (no
+# message))' naming nothing, without one the machine swaps or OOM-kills)
 def test_a_grid_of_a_billion_cells_is_refused_when_read(tmp_path):
     grid = tmp_path / "g.toml"
     grid.write_text(GRID2_TOML + "[run]\nrepetitions = 1000000000\n", encoding="utf-8")
@@ -289,10 +286,9 @@ sys.exit(main(["sweep", sys.argv[1], "--scheduler",
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="V25: a --scheduler address where a TCP peer accepts "
-                   "but never answers (a tarpit, python -m http.server waiting for a "
-                   "line): Client(address, timeout=CONNECT_SECONDS) blocks in its "
-                   "handshake forever — no 'cannot connect' after 5 s")
+# Fixed (was a bug: a --scheduler address where a TCP peer accepts but never answers (a
+# tarpit, python -m http.server waiting for a line): Client(address,
+# timeout=CONNECT_SECONDS) blocks in its handshake forever — no 'cannot connect' after 5 s)
 def test_a_scheduler_that_accepts_and_stays_silent_times_out(tmp_path):
     grid = tmp_path / "g.toml"
     grid.write_text(GRID2_TOML, encoding="utf-8")
