@@ -328,10 +328,9 @@ def test_interrupted_rerun_recomputes_only_the_missing_cells(tmp_path, monkeypat
     pd.testing.assert_frame_equal(_no_seconds(resumed), _no_seconds(fresh))
 
 
-@pytest.mark.xfail(strict=True, reason="V26: results.parquet is written in place "
-                   "(run._write: pq.write_table(path)), unlike the parts (tmp + rename): "
-                   "a rerun interrupted while consolidating destroys the previous table "
-                   "and a concurrent reader sees a truncated file")
+# Fixed (was a bug: results.parquet was written in place (run._write:
+# pq.write_table(path)), unlike the parts (tmp + rename): a rerun interrupted while
+# consolidating destroyed the previous table and a concurrent reader saw a truncated file)
 def test_an_interrupted_consolidation_keeps_the_previous_table(tmp_path, monkeypatch):
     import pyarrow.parquet as pq
 

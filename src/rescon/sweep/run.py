@@ -186,22 +186,29 @@ def _write_part(folder: Path, cell: int, row: dict[str, Any]) -> None:
     """One finished row as parts/cell-NNNNNN.parquet (written under a temporary name,
     then renamed: an interrupted write leaves no half file behind)."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
-    target = folder / "parts" / f"cell-{cell:06d}.parquet"
-    tmp = target.with_suffix(".tmp")
-    pq.write_table(pa.Table.from_pylist([row], schema=_schema(pa, row)), tmp)
-    tmp.replace(target)
+    _replace(pa.Table.from_pylist([row], schema=_schema(pa, row)),
+             folder / "parts" / f"cell-{cell:06d}.parquet")
 
 
 def _write(table: Any, path: Path) -> None:
     """The table as Parquet with the fixed types of :data:`_DTYPES` (all-null columns
-    included: the schema does not depend on the outcomes)."""
+    included: the schema does not depend on the outcomes), written under a temporary
+    name and then renamed: an interrupted rerun leaves the previous table, and a reader
+    never sees a half-written one."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
     schema = _schema(pa, table)
-    pq.write_table(pa.Table.from_pandas(table, schema=schema, preserve_index=False), path)
+    _replace(pa.Table.from_pandas(table, schema=schema, preserve_index=False), path)
+
+
+def _replace(arrow_table: Any, path: Path) -> None:
+    """Write ``arrow_table`` to path.tmp, then rename it to ``path`` (atomic on POSIX)."""
+    import pyarrow.parquet as pq
+
+    tmp = path.with_suffix(".tmp")
+    pq.write_table(arrow_table, tmp)
+    tmp.replace(path)
 
 
 def _schema(pa: Any, columns: Any) -> Any:
