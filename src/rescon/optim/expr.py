@@ -300,6 +300,17 @@ def _float(v: Fraction) -> float:
     return f
 
 
+def _sqrt(p: Fraction) -> Fraction:
+    """√p for a pivot p > 0 of sqrt's LDLᵀ: exact when p is the square of a rational,
+    else the float √p read exactly. A row √p·l of the Norm2 is then a rational multiple
+    of l, so its anchor (the ratios of l's entries, e.g. 10^50 in sqrt((x1 − 1e50)^2))
+    stays exact; only the row's weight may be off by an ulp."""
+    a, b = math.isqrt(p.numerator), math.isqrt(p.denominator)
+    if a * a == p.numerator and b * b == p.denominator:
+        return Fraction(a, b)
+    return Fraction(math.sqrt(_float(p)))
+
+
 def _affine_rows(args: list[Expr], d: int) -> tuple[np.ndarray, np.ndarray]:
     """A, c (object arrays of Fractions, each fitting a float) with
     args[i] = A[i] x + c[i] (affine args)."""
@@ -366,10 +377,13 @@ def _lower_call(call: Call, d: int) -> Oracle:
     if fn == "sqrt":
         fac = atoms.ldl_psd(_homogenised(args[0]))
         n = 1 + max(args[0].variables, default=-1)
-        R = np.zeros((max(len(fac), 1), d + 1))
+        R = np.full((max(len(fac), 1), d + 1), Fraction(0), dtype=object)
         for r, (p, col) in enumerate(fac):
-            R[r, :n] = [_float(v) * math.sqrt(_float(p)) for v in col[:n]]
-            R[r, d] = _float(col[n]) * math.sqrt(_float(p))
+            root = _sqrt(p)
+            R[r, :n] = [root * v for v in col[:n]]
+            R[r, d] = root * col[n]
+            for v in R[r]:
+                _float(v)
         return atoms.Norm2(R[:, :d], -R[:, d])
     if fn == "pos":
         if args[0].degree <= 1:
