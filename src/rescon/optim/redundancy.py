@@ -17,9 +17,10 @@ sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functi
 
 * each A_S is computed by Clarabel and then *certified* in rationals (a minimiser and
   multipliers, or a recession direction when the sum is unbounded below). Clarabel
-  solves in the frame x = c + s·y (c the median of the terms' kinks and centres, s
-  their spread; the data transformed exactly), so argmins at 1e-7 or 1e50 are solved
-  at unit scale; an uncertified solution is re-solved centred on itself, 2^20 times
+  solves in the frame x = c + s·y (c the median of the terms' kinks and centres, exact
+  to the last bit even where no float is (10^50), s their spread: :func:`_centred`;
+  the data transformed exactly), so argmins at 1e-7 or 1e50 are solved at unit
+  scale; an uncertified solution is re-solved centred on itself, 2^20 times
   finer (``ZOOMS`` times). The certificate alone decides: thresholds and roundings
   only choose what is tried. A strongly convex sum (H ≻ 0, exactly) is never taken
   as unbounded below;
@@ -35,14 +36,21 @@ sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functi
 
 Everything else is numerical (``exact=False``): support functions h_A(u) = max_{x∈A} uᵀx
 in the fixed directions ±e_i and ±u_j (j < d, u_j seeded Gaussian unit vectors, seed 0),
-from Clarabel via CVXPY (min F_S, then max uᵀx on {F_S ≤ F_S* + 1e-8(1 + |F_S*|)}) or,
+from Clarabel via CVXPY (min F_S, then max uᵀx on {F_S ≤ F_S* + 1e-10(V + |F_S*|)},
+F_S* the value at the minimiser found, V below) or,
 for certified polyhedral argmins, from HiGHS on their canonical faces (centred and
 scaled), each support point then made exact on the faces it makes tight; when one of
 the two sets is not certified, also the distance from each set's minimiser to the other
 set (Clarabel; supports are +inf in every direction on sets such as parallel lines).
 Sets agree when every support and distance differs by at most ``tolerance`` = 1e-4
-(1 + the largest |h(u) − uᵀc| and ‖x − c‖∞ of the minimisers, c the frame's centre
-below: the same verdict wherever the costs sit). CVXPY solves in the same frame as
+(s + the largest |h(u) − uᵀc| and ‖x − c‖∞ of the minimisers), (c, s) the frame below
+(s the power of two nearest the spread of the kinks and centres around c, 1 when they
+all coincide): the same verdict wherever the costs sit and whatever the unit of x
+(scaling x by t scales the gap by t and the tolerance by t up to the rounding of s to
+a power of two). The level sets' slack is relative to the sum's values: F_S is divided
+by V, the power of two nearest max_j |F_S(c ± s·e_j) − F_S(c)| (its variation over the
+frame; 1 when that is 0), before solving, so scaling the costs' values changes
+nothing. CVXPY solves in the same frame as
 Clarabel (x = c + s·y, the atoms' data transformed exactly; Huber rows and log-sum-exp
 pieces count as kinks for c and s), so costs far from the origin are solved at unit
 scale. The ``gap`` is then the largest of them — a lower bound on the
@@ -70,8 +78,9 @@ from .cost import cost
 
 __all__ = ["RedundancyReport", "check_redundancy"]
 
-REL_TOL = 1e-4  # numerical verdicts: supports agree to REL_TOL (1 + max |h|)
-LEVEL_TOL = 1e-8  # numerical supports: on {F ≤ F* + LEVEL_TOL (1 + |F*|)}
+REL_TOL = 1e-4  # numerical verdicts: supports agree to REL_TOL (s + max |h − uᵀc|)
+LEVEL_TOL = 1e-10  # numerical supports: on {F/V ≤ F*/V + LEVEL_TOL (1 + |F*/V|)}; a
+# quadratic bottom then widens each set by ~1e-5·s, well inside REL_TOL·s
 MAX_PAIRS = 5_000  # pairs of certified subsets tried for an exact witness
 ZOOMS = 3  # re-solves centred at an uncertified solution, each 2^20 times finer
 
@@ -206,7 +215,6 @@ class _Check:
         self.dirs = _directions(d)
         self._cvx: _Cvx | None = None
         self.far: dict[tuple[int, ...], tuple[float, Any, Any]] = {}
-        self._frame: tuple[np.ndarray, float] | None = None
         self._centre: tuple[list[Fraction], float] | None = None
         self._framed: dict[int, _pq.PQ] = {}
 
@@ -238,18 +246,18 @@ class _Check:
             s.status, data = _pq.quadratic_argmin(F)
             s.opt, s.ray = (data, None) if s.status == "optimal" else (None, data)
         else:
-            c, sc = self.frame
+            c, sc = self.centre
             G = self._framed_sum(s.members)
             status, data = _clarabel(G)
             opt = None
             for zoom in range(ZOOMS + 1):  # y to ~1e-8: zoom in on an uncertified solution
                 if status != "optimal":
                     break
-                opt = (_pq.certify(F, c + sc * data[0], data[1], data[2])
+                opt = (_pq.certify(F, _floats(c) + sc * data[0], data[1], data[2])
                        or _certify_framed(F, G, c, sc, data))
                 if opt is not None or zoom == ZOOMS:
                     break
-                c2, s2 = c + sc * data[0], sc * 2.0**-20
+                c2, s2 = _moved(c, sc, data[0]), sc * 2.0**-20
                 G2 = _framed(F, c2, s2)
                 st2, data2 = _clarabel(G2)
                 if st2 != "optimal":
@@ -259,7 +267,7 @@ class _Check:
                 s.opt = opt
                 if s.opt is not None and not s.opt.describable:
                     s.opt = None  # a norm term with |μ| = 1: not described by linear data
-                s.status, s.point = "optimal", c + sc * data[0]
+                s.status, s.point = "optimal", _floats(_moved(c, sc, data[0]))
             elif status == "unbounded":
                 s.ray = _pq.recession(F, data)
                 s.status = "unbounded"
@@ -269,16 +277,10 @@ class _Check:
             s.point = _floats(s.opt.x)
 
     @property
-    def frame(self) -> tuple[np.ndarray, float]:
-        """(c, s) for Clarabel on the exact path (:func:`_frame`), from every cost that
-        is piecewise quadratic or whose :func:`_shape` is (Huber, log-sum-exp)."""
-        if self._frame is None:
-            self._frame = _frame(self._shapes())
-        return self._frame
-
-    @property
     def centre(self) -> tuple[list[Fraction], float]:
-        """(c, s) of :func:`_centred` for CVXPY and the tolerance: c exact."""
+        """(c, s) of :func:`_centred` (c exact) for Clarabel on the exact path, CVXPY and
+        the tolerance, from every cost that is piecewise quadratic or whose
+        :func:`_shape` is (Huber, log-sum-exp)."""
         if self._centre is None:
             self._centre = _centred(self._shapes())
         return self._centre
@@ -297,7 +299,7 @@ class _Check:
         G = _pq.PQ.zero(self.d)
         for i in members:
             if i not in self._framed:
-                self._framed[i] = _framed(self.pq[i], *self.frame)
+                self._framed[i] = _framed(self.pq[i], *self.centre)
             G.add(self._framed[i])
         return G
 
@@ -391,16 +393,18 @@ class _Check:
         return best[0]
 
     def tolerance(self, sets: list[_Set]) -> float:
-        """REL_TOL (1 + the largest finite support or coordinate of a minimiser, both
-        measured from the frame's centre c: |h(u) − uᵀc|, ‖x − c‖∞, so the verdict does
-        not depend on where the costs sit); InputError when a minimiser or a bounded
-        support passes the float range (an exact verdict was not reached, and a
-        numerical one has no scale there)."""
-        cq = self.centre[0]
+        """REL_TOL (s + the largest finite support or coordinate of a minimiser, both
+        measured from the frame's centre c: |h(u) − uᵀc|, ‖x − c‖∞), (c, s) the frame of
+        :func:`_centred` (s the power of two nearest the spread of the costs' kinks and
+        centres around c; 1 when they all coincide): the verdict does not depend on
+        where the costs sit, and scaling x by t scales the tolerance by t. InputError
+        when a minimiser or a bounded support passes the float range (an exact verdict
+        was not reached, and a numerical one has no scale there)."""
+        cq, scale = self.centre
         vals = [abs(_float(hq - _pq._dot([Fraction(float(v)) for v in self.dirs[k]], cq)))
                 for s in sets for k, (_, p, _, hq) in s.supports.items() if p is not None]
         vals += [float(np.abs(self._offset(s)).max()) for s in sets if s.point is not None]
-        tol = REL_TOL * (1.0 + max(vals, default=0.0))
+        tol = REL_TOL * (scale + max(vals, default=0.0))
         if not math.isfinite(tol):
             raise InputError("check_redundancy: an argmin reaches beyond the float range "
                              "(|x| > 1.8e308) and no exact verdict was found; rescale the "
@@ -672,7 +676,7 @@ def _clarabel(G: _pq.PQ) -> tuple[str, Any]:
     return "failed", status
 
 
-def _certify_framed(F: _pq.PQ, G: _pq.PQ, c: np.ndarray, s: float, data: tuple
+def _certify_framed(F: _pq.PQ, G: _pq.PQ, c: list[Fraction], s: float, data: tuple
                     ) -> _pq.Optimal | None:
     """:func:`_pq.certify` in the solver's frame (G(y) = F(c + s·y), at its float solution
     y: thresholds and roundings act at the frame's scale), mapped back exactly
@@ -680,16 +684,15 @@ def _certify_framed(F: _pq.PQ, G: _pq.PQ, c: np.ndarray, s: float, data: tuple
     opt = _pq.certify(G, *data)
     if opt is None:
         return None
-    x = [Fraction(float(ci)) + Fraction(s) * yi for ci, yi in zip(c, opt.x, strict=True)]
+    x = [ci + Fraction(s) * yi for ci, yi in zip(c, opt.x, strict=True)]
     return (_pq.describe(F, x, opt.lam, opt.mu)
             if _pq.check_optimal(F, x, opt.lam, opt.mu) is None else None)
 
 
-def _frame(F: _pq.PQ, *, floor: bool = True) -> tuple[np.ndarray, float]:
+def _frame(F: _pq.PQ) -> tuple[np.ndarray, float]:
     """(c, s) centring and scaling F's data: c the coordinate-wise median of the terms'
-    anchors, s the power of two nearest their largest distance from c (with ``floor``,
-    at least 2^-30 ‖c‖∞: the exact path's points c + s·y are then distinct in floats;
-    CVXPY's path maps its results back exactly or only reports points). A term's zero set (each
+    anchors, s the power of two nearest their largest distance from c (1 when it is 0;
+    the exact path and CVXPY's map their results back exactly). A term's zero set (each
     piece's {aᵀx + b = 0}, the quadratic part's stationary set {Hx = −g}, each norm's
     {A_l x = c_l}) is anchored at its point nearest to p, the least-squares point of all
     of them (rows normalised): anchors then do not depend on where the origin is (the
@@ -712,21 +715,20 @@ def _frame(F: _pq.PQ, *, floor: bool = True) -> tuple[np.ndarray, float]:
     if not (np.isfinite(p).all() and np.isfinite(P).all()):
         return np.zeros(F.d), 1.0
     c = np.median(P, axis=0) if len(P) else np.zeros(F.d)
-    spread = max(float(np.abs(P - c).max(initial=0.0)),
-                 2.0**-30 * np.abs(c).max(initial=0.0) if floor else 0.0)
+    spread = float(np.abs(P - c).max(initial=0.0))
     if not (np.isfinite(c).all() and math.isfinite(spread)):
         return np.zeros(F.d), 1.0
     return c, float(_pow2(spread)) if spread > 0 else 1.0
 
 
 def _centred(F: _pq.PQ) -> tuple[list[Fraction], float]:
-    """(c, s) with c exact, the data centred to the last bit: :func:`_frame` (without
-    the floor) of F(c + y), c the sum of the frames' centres so far (floats, so each
+    """(c, s) with c exact, the data centred to the last bit: :func:`_frame` of F(c + y),
+    c the sum of the frames' centres so far (floats, so each
     round gains ~53 bits: exact data at 1e50 such as 10^50, which no float is, ends up
     centred within its spread), until the centre found lies within its spread."""
     c = [Fraction(0)] * F.d
     for _ in range(40):
-        cf, s = _frame(F, floor=False)
+        cf, s = _frame(F)
         if not cf.any():
             break
         c = [a + Fraction(float(v)) for a, v in zip(c, cf, strict=True)]
@@ -736,11 +738,11 @@ def _centred(F: _pq.PQ) -> tuple[list[Fraction], float]:
     return c, s
 
 
-def _framed(F: _pq.PQ, c: np.ndarray, s: float) -> _pq.PQ:
-    """G(y) = F(c + s·y) up to a constant, exactly (s a power of two): H ↦ s²H,
-    g ↦ s(Hc + g), a ↦ s·a, b ↦ aᵀc + b, A_l ↦ s·A_l, c_l ↦ c_l − A_l c. Stationarity
-    of G at y is s·stationarity of F at c + s·y with the same λ and μ."""
-    cx, sf = [Fraction(float(v)) for v in c], Fraction(s)
+def _framed(F: _pq.PQ, c: Any, s: float) -> _pq.PQ:
+    """G(y) = F(c + s·y) up to a constant, exactly (c floats or Fractions, s a power of
+    two): H ↦ s²H, g ↦ s(Hc + g), a ↦ s·a, b ↦ aᵀc + b, A_l ↦ s·A_l, c_l ↦ c_l − A_l c.
+    Stationarity of G at y is s·stationarity of F at c + s·y with the same λ and μ."""
+    cx, sf = [_fraction(v) for v in c], Fraction(s)
     if not any(cx) and sf == 1:
         return F
     return _pq.PQ(
@@ -750,6 +752,16 @@ def _framed(F: _pq.PQ, c: np.ndarray, s: float) -> _pq.PQ:
          for blk in F.blocks],
         [([tuple(sf * v for v in a) for a in A],
           [ci - _pq._dot(a, cx) for a, ci in zip(A, cl, strict=True)]) for A, cl in F.norms])
+
+
+def _fraction(v: Any) -> Fraction:
+    """A Fraction or a float, exactly."""
+    return v if isinstance(v, Fraction) else Fraction(float(v))
+
+
+def _moved(c: list[Fraction], s: float, y: np.ndarray) -> list[Fraction]:
+    """c + s·y exactly (y floats)."""
+    return [ci + Fraction(s) * Fraction(float(v)) for ci, v in zip(c, y, strict=True)]
 
 
 def _pow2(v: float) -> Fraction:
@@ -822,8 +834,8 @@ class _Cvx:
         self.c = np.array([float(v) for v in self.cq])
         self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)  # y
         self.w = cp.Parameter(len(oracles), nonneg=True)
-        F = sum(self.w[i] * _to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s))
-                for i, o in enumerate(oracles))
+        self.F = F = sum(self.w[i] * _to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s))
+                         for i, o in enumerate(oracles))
         self.u, self.level = cp.Parameter(d), cp.Parameter()
         self.p = cp.Parameter(d)
         self.pmin = cp.Problem(cp.Minimize(F))
@@ -831,6 +843,7 @@ class _Cvx:
         self.pdist = cp.Problem(cp.Minimize(cp.norm(self.x - self.p, 2)), [F <= self.level])
         self.fstar: dict[tuple[int, ...], float] = {}
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
+        self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
 
     def _solve(self, problem: Any) -> None:
         """problem.solve by Clarabel; its status is read by the caller ("inaccurate"
@@ -844,9 +857,30 @@ class _Cvx:
                 raise SolverError(f"Clarabel failed on the numerical path: {e}") from None
 
     def _weights(self, members: tuple[int, ...]) -> None:
+        """Weights 1/V on ``members`` (0 elsewhere), V the power of two nearest the sum's
+        variation over the frame, max_j |F(±e_j) − F(0)| in y (1 when 0 or not finite):
+        the solved sum has values of order 1 whatever the costs' unit, so Clarabel's
+        tolerances and the level sets' slack are relative to the costs' values."""
         w = np.zeros(self.w.size)
         w[list(members)] = 1.0
-        self.w.value = w
+        if members not in self.scales:
+            self.w.value = w
+            self.scales[members] = self._variation()
+        self.w.value = w / self.scales[members]
+
+    def _variation(self) -> float:
+        """V of :meth:`_weights` for the current weights."""
+        d = self.x.shape[0]
+        vals = []
+        for y in [np.zeros(d), *np.eye(d), *-np.eye(d)]:
+            self.x.value = y
+            vals.append(self.F.value)
+        self.x.value = None
+        if any(v is None for v in vals):
+            return 1.0
+        with np.errstate(all="ignore"):
+            v = float(np.max(np.abs(np.asarray(vals[1:], dtype=float) - float(vals[0]))))
+        return float(_pow2(v)) if 0 < v < math.inf else 1.0
 
     def _offset(self) -> np.ndarray:
         """s·y at the solution: its x − c, unrounded (x = c + s·y is rounded to c's ulp)."""
@@ -860,12 +894,16 @@ class _Cvx:
         if self.pmin.status not in ("optimal", "optimal_inaccurate"):
             raise SolverError(f"Clarabel could not minimise the sum of agents {members}: "
                               f"{self.pmin.status}")
-        self.fstar[members] = float(self.pmin.value)
+        at = self.F.value  # F at the solution found: ≥ min F, so the level set is not empty
+        self.fstar[members] = max(float(self.pmin.value),
+                                  float(at) if at is not None else -math.inf)
         self.offsets[members] = off = self._offset()
         return "optimal", self.c + off
 
     def _level(self, members: tuple[int, ...]) -> None:
-        """Weights and level F* + LEVEL_TOL (1 + |F*|) of the sum over ``members``."""
+        """Weights (:meth:`_weights`) and level F* + LEVEL_TOL (1 + |F*|) of the sum over
+        ``members`` divided by its V: the slack is LEVEL_TOL (V + |F*|) in the costs'
+        values."""
         if members not in self.fstar and self.minimise(members)[0] != "optimal":
             raise SolverError(f"Clarabel finds the sum of agents {members} unbounded below, "
                               f"but its argmin was found nonempty")
