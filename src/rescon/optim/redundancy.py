@@ -834,8 +834,8 @@ class _Cvx:
         self.c = np.array([float(v) for v in self.cq])
         self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)  # y
         self.w = cp.Parameter(len(oracles), nonneg=True)
-        self.F = F = sum(self.w[i] * _to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s))
-                         for i, o in enumerate(oracles))
+        self.terms = [_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s)) for o in oracles]
+        F = sum(self.w[i] * t for i, t in enumerate(self.terms))
         self.u, self.level = cp.Parameter(d), cp.Parameter()
         self.p = cp.Parameter(d)
         self.pmin = cp.Problem(cp.Minimize(F))
@@ -844,6 +844,7 @@ class _Cvx:
         self.fstar: dict[tuple[int, ...], float] = {}
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
         self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
+        self.grid: np.ndarray | None = None  # each cost at y = 0, ±e_j (_variation)
 
     def _solve(self, problem: Any) -> None:
         """problem.solve by Clarabel; its status is read by the caller ("inaccurate"
@@ -861,25 +862,25 @@ class _Cvx:
         variation over the frame, max_j |F(±e_j) − F(0)| in y (1 when 0 or not finite):
         the solved sum has values of order 1 whatever the costs' unit, so Clarabel's
         tolerances and the level sets' slack are relative to the costs' values."""
-        w = np.zeros(self.w.size)
-        w[list(members)] = 1.0
         if members not in self.scales:
-            self.w.value = w
-            self.scales[members] = self._variation()
-        self.w.value = w / self.scales[members]
+            self.scales[members] = self._variation(members)
+        w = np.zeros(self.w.size)
+        w[list(members)] = 1.0 / self.scales[members]
+        self.w.value = w
 
-    def _variation(self) -> float:
-        """V of :meth:`_weights` for the current weights."""
-        d = self.x.shape[0]
-        vals = []
-        for y in [np.zeros(d), *np.eye(d), *-np.eye(d)]:
-            self.x.value = y
-            vals.append(self.F.value)
-        self.x.value = None
-        if any(v is None for v in vals):
-            return 1.0
+    def _variation(self, members: tuple[int, ...]) -> float:
+        """V of :meth:`_weights` from each cost's values at y = 0, ±e_j (computed once)."""
+        if self.grid is None:
+            d = self.x.shape[0]
+            rows = []
+            for y in [np.zeros(d), *np.eye(d), *-np.eye(d)]:
+                self.x.value = y
+                rows.append([_value(t) for t in self.terms])
+            self.x.value = None
+            self.grid = np.array(rows, dtype=float)
         with np.errstate(all="ignore"):
-            v = float(np.max(np.abs(np.asarray(vals[1:], dtype=float) - float(vals[0]))))
+            F = self.grid[:, list(members)].sum(axis=1)
+            v = float(np.abs(F[1:] - F[0]).max())
         return float(_pow2(v)) if 0 < v < math.inf else 1.0
 
     def _offset(self) -> np.ndarray:
@@ -894,9 +895,8 @@ class _Cvx:
         if self.pmin.status not in ("optimal", "optimal_inaccurate"):
             raise SolverError(f"Clarabel could not minimise the sum of agents {members}: "
                               f"{self.pmin.status}")
-        at = self.F.value  # F at the solution found: ≥ min F, so the level set is not empty
-        self.fstar[members] = max(float(self.pmin.value),
-                                  float(at) if at is not None else -math.inf)
+        at = sum(_value(self.terms[i]) for i in members) / self.scales[members]
+        self.fstar[members] = max(float(self.pmin.value), at)  # F(x*) ≥ min F: a level
         self.offsets[members] = off = self._offset()
         return "optimal", self.c + off
 
@@ -938,6 +938,13 @@ class _Cvx:
             raise SolverError(f"Clarabel could not compute a distance to the argmin of "
                               f"agents {members}: {self.pdist.status}")
         return self.s * float(self.pdist.value), self.c + self._offset()
+
+
+def _value(e: Any) -> float:
+    """A CVXPY expression's (or a number's) value at the variables' values; nan when
+    it has none."""
+    v = e.value if hasattr(e, "value") else e
+    return math.nan if v is None else float(v)
 
 
 def _grad_parts(o: Any) -> Iterator[Any]:
