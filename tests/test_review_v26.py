@@ -13,7 +13,9 @@ grid serially and on a LocalCluster, reruns (same table), a failed connection (c
 port, silent peer) followed by a sweep and a robustness search in the same process,
 interrupted rewrites of the consolidated table.
 
-Bugs are strict xfails (reason "V26: ..."); the other tests are attacks that held.
+Bugs were strict xfails (reason "V26: ..."); five are fixed (comments "Fixed (was a bug:
+...)"), one stays: Huber agents 1e8 or more apart end in a one-line SolverError.
+The other tests are attacks that held.
 """
 
 from __future__ import annotations
@@ -83,9 +85,9 @@ def _huber3(c0: str = "0", sx: float = 1.0) -> list[str]:
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="V26: numerical verdict depends on the cost's scale: "
-                   "the level set {F <= F* + 1e-8(1 + |F*|)} is absolute, so identical "
-                   "costs scaled by 1e-8 get different level sets for 2 and 3 of them")
+# Fixed (was a bug: numerical verdict depends on the cost's scale: the level set {F <= F* +
+# 1e-8(1 + |F*|)} is absolute, so identical costs scaled by 1e-8 get different level sets
+# for 2 and 3 of them)
 def test_identical_huber_costs_scaled_by_1e_8_are_redundant():
     """Three copies of 1e-8·huber(x1, 1): every sum has argmin {0}; unscaled the
     verdict is 'holds'. Scaled by 1e-8 it is a violation with gap 0.13."""
@@ -94,9 +96,8 @@ def test_identical_huber_costs_scaled_by_1e_8_are_redundant():
     assert holds is True and gap < 1e-3
 
 
-@pytest.mark.xfail(strict=True, reason="V26: numerical tolerance REL_TOL*(1 + |h - u'c|) "
-                   "has an absolute 1: the same violation with x scaled by 1e-8 (gap "
-                   "5e-9) is called 'holds'")
+# Fixed (was a bug: numerical tolerance REL_TOL*(1 + |h - u'c|) has an absolute 1: the same
+# violation with x scaled by 1e-8 (gap 5e-9) is called 'holds')
 def test_huber_violation_scaled_down_by_1e_8_is_kept():
     base = rescon.check_redundancy(_huber3(), r=1)
     small = rescon.check_redundancy(_huber3(sx=1e-8), r=1)
@@ -105,10 +106,9 @@ def test_huber_violation_scaled_down_by_1e_8_is_kept():
     assert (small.holds, small.exact) == (False, False)
 
 
-@pytest.mark.xfail(strict=True, reason="V26: the exact path's Clarabel frame (_frame with "
-                   "the 2^-30·|c| floor, c a float) is not the exactly centred one: at "
-                   "1e50 a unit-length segment argmin is not certified, the verdict "
-                   "becomes numerical")
+# Fixed (was a bug: the exact path's Clarabel frame (_frame with the 2^-30·|c| floor, c a
+# float) is not the exactly centred one: at 1e50 a unit-length segment argmin is not
+# certified, the verdict becomes numerical)
 def test_abs_costs_translated_by_1e50_keep_their_exact_verdict():
     """|x − c − 1|, |x − c|, |x − c| with r = 1: A_{01} = A_{02} = [c, c + 1],
     A_{12} = {c}: an exact violation with gap 1 at c = 0, 1e8, 1e20, 3; numerical
@@ -121,10 +121,9 @@ def test_abs_costs_translated_by_1e50_keep_their_exact_verdict():
             (False, True, 1.0)
 
 
-@pytest.mark.xfail(strict=True, reason="V26: sqrt(q) is lowered in floats "
-                   "(expr._lower_call: _float(v)*math.sqrt(_float(p))): its anchor is "
-                   "float(1e50), not 10^50 as in abs(x1 - 1e50); the argmins differ by "
-                   "7.6e33 and the numerical path raises SolverError")
+# Fixed (was a bug: sqrt(q) is lowered in floats (expr._lower_call:
+# _float(v)*math.sqrt(_float(p))): its anchor is float(1e50), not 10^50 as in abs(x1 -
+# 1e50); the argmins differ by 7.6e33 and the numerical path raises SolverError)
 def test_sqrt_and_abs_translated_by_1e50_agree_as_at_the_origin():
     for c in ("0", "3", "1e20"):
         costs = [f"sqrt((x1 - {c})^2)", f"abs(x1 - {c})", f"abs(x1 - {c})"]
