@@ -845,6 +845,7 @@ class _Cvx:
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
         self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
         self.grid: np.ndarray | None = None  # each cost at y = 0, ±e_j (_variation)
+        self.posed: tuple[int, ...] | None = None  # whose weights and level are set
 
     def _solve(self, problem: Any) -> None:
         """problem.solve by Clarabel; its status is read by the caller ("inaccurate"
@@ -867,6 +868,7 @@ class _Cvx:
         w = np.zeros(self.w.size)
         w[list(members)] = 1.0 / self.scales[members]
         self.w.value = w
+        self.posed = None  # the level is not set for these weights
 
     def _variation(self, members: tuple[int, ...]) -> float:
         """V of :meth:`_weights` from each cost's values at y = 0, ±e_j (computed once)."""
@@ -904,12 +906,15 @@ class _Cvx:
         """Weights (:meth:`_weights`) and level F* + LEVEL_TOL (1 + |F*|) of the sum over
         ``members`` divided by its V: the slack is LEVEL_TOL (V + |F*|) in the costs'
         values."""
+        if self.posed == members:  # set by the previous call (CVXPY validates each set)
+            return
         if members not in self.fstar and self.minimise(members)[0] != "optimal":
             raise SolverError(f"Clarabel finds the sum of agents {members} unbounded below, "
                               f"but its argmin was found nonempty")
         self._weights(members)
         f = self.fstar[members]
         self.level.value = f + LEVEL_TOL * (1.0 + abs(f))
+        self.posed = members
 
     def support(self, members: tuple[int, ...], u: np.ndarray
                 ) -> tuple[float, np.ndarray | None, Fraction | None]:
