@@ -97,53 +97,56 @@ def test_a_vertex_lost_by_the_halves_is_found_on_the_whole(monkeypatch):
 
 
 def test_a_half_qhull_fails_on_is_cut_again_across_the_next_axis(monkeypatch):
-    """qhull failing on the lower half across x_1 with every option (its retry too):
+    """qhull failing on the upper half P ∩ {x_1 ≥ c} with every option (its retry too):
     the halves are cut across x_2, and the kernel is the exact clipping's."""
     X, F = _cloud("gaussian", 5, 18, 2), 2
     real, seen = fastpath._qhull, []
 
     def failing(A, b, x0, options):
-        lower_x1 = len(A) and A[-1, 0] == -1.0 and not A[-1, 1:].any()
-        seen.append(bool(lower_x1))
-        return None if lower_x1 else real(A, b, x0, options)
+        seen.append(_upper_x1(A))
+        return None if seen[-1] else real(A, b, x0, options)
 
-    axes, halves = [], fastpath._halves
-
-    def spy(*args):
-        axes.append(args[-1])
-        return halves(*args)
-
-    monkeypatch.setattr(fastpath, "_qhull", failing)
-    monkeypatch.setattr(fastpath, "_halves", spy)
+    axes = _axes_with(failing, monkeypatch)
     _same_as_clipping(X, F, monkeypatch)
     assert axes[:2] == [0, 1] and any(seen)
 
 
 def test_a_half_qhull_fails_on_with_the_merged_option_is_retried_at_once(monkeypatch):
-    """qhull failing on the lower half across x_1 with the merged options only (as
+    """qhull failing on the upper half P ∩ {x_1 ≥ c} with the merged options only (as
     "C-0 Q14" does on sphere(5, 30, 3)): that half is retried with HALF_RETRY_OPTIONS,
     the cut stays across x_1, and the kernel is the exact clipping's."""
     X, F = _cloud("gaussian", 5, 18, 2), 2
     real, retried = fastpath._qhull, []
 
     def failing(A, b, x0, options):
-        lower_x1 = len(A) and A[-1, 0] == -1.0 and not A[-1, 1:].any()
-        if lower_x1 and options == fastpath.HALF_RETRY_OPTIONS:
+        if _upper_x1(A) and options == fastpath.HALF_RETRY_OPTIONS:
             retried.append(options)
-        elif lower_x1:
+        elif _upper_x1(A):
             return None
         return real(A, b, x0, options)
 
+    axes = _axes_with(failing, monkeypatch)
+    _same_as_clipping(X, F, monkeypatch)
+    assert retried and axes and set(axes) == {0}
+
+
+def _upper_x1(A: np.ndarray) -> bool:
+    """Whether the rows are the half P ∩ {x_1 ≥ c}: P's, then the cut −x_1 ≤ −c."""
+    return bool(len(A) and A[-1, 0] == -1.0 and not A[-1, 1:].any())
+
+
+def _axes_with(qhull, monkeypatch) -> list[int]:
+    """fastpath._qhull replaced by ``qhull``; returns the list (filled as the kernel
+    runs) of the axes across which the halves are cut, in order."""
     axes, halves = [], fastpath._halves
 
     def spy(*args):
         axes.append(args[-1])
         return halves(*args)
 
-    monkeypatch.setattr(fastpath, "_qhull", failing)
+    monkeypatch.setattr(fastpath, "_qhull", qhull)
     monkeypatch.setattr(fastpath, "_halves", spy)
-    _same_as_clipping(X, F, monkeypatch)
-    assert retried and axes and set(axes) == {0}
+    return axes
 
 
 @pytest.mark.parametrize("threads", [1, 2])
