@@ -383,7 +383,7 @@ def _lower_call(call: Call, d: int) -> Oracle:
             R[r, :n] = [root * v for v in col[:n]]
             R[r, d] = root * col[n]
             for v in R[r]:
-                _float(v)
+                _float(v)  # each entry must fit a float: else ExprError
         return atoms.Norm2(R[:, :d], -R[:, d])
     if fn == "pos":
         if args[0].degree <= 1:
