@@ -179,6 +179,28 @@ def test_rmdo_numerical_optimum_far_argmin():
     assert (gap >= -1e-12 * np.abs(tr.metrics["cost"]).max()).all(), gap.min()
 
 
+@pytest.mark.xfail(strict=True, reason="V27: RandomDoS.active(t) rebuilds the list of "
+                   "every merged window up to t (windows(): [w[0] for w in merged] and a "
+                   "copy) at each call, so a run is O(K^2): 8000 steps spend 5 s in "
+                   "blocked_mask, 200 checks near t = 2e5 take ~5 s")
+def test_random_dos_active_is_not_linear_in_t():
+    from rescon.consensus.dos import RandomDoS
+
+    def boom(*_):
+        raise TimeoutError("RandomDoS.active too slow")
+
+    s = RandomDoS(rate=1.0, mean_duration=0.2, seed=1)
+    s.windows(2e5)  # ~1.7e5 windows, built once (0.2 s)
+    old = signal.signal(signal.SIGALRM, boom)
+    signal.setitimer(signal.ITIMER_REAL, 2.0)
+    try:
+        for k in range(200):
+            s.active(1.9e5 + k)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
 # ---------------------------------------------------------------- attacks that held
 
 
