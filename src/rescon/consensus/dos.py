@@ -317,7 +317,7 @@ class RandomDoS(Schedule):
         c = self._cache
         if not c:
             c.update(rng=np.random.default_rng(self.seed), last=0.0, pending=[],
-                     merged=[], done_until=-1.0)
+                     merged=[], starts=[], done_until=-1.0)
         merged: list[list[float]] = c["merged"]
         while c["done_until"] < horizon:
             if not c["pending"]:
@@ -334,18 +334,22 @@ class RandomDoS(Schedule):
                 # every window before this one is final: no later arrival reaches it
                 c["done_until"] = s
                 merged.append([s, e])
+                c["starts"].append(s)
         return merged
 
     def windows(self, horizon: float) -> list[tuple[float, float]]:
         horizon = nonnegative("horizon", horizon)
         merged = self._extend(horizon)
-        k = bisect.bisect_left([w[0] for w in merged], horizon)
+        k = bisect.bisect_left(self._cache["starts"], horizon)
         return [(s, e) for s, e in merged[:k]]
 
     def active(self, t: float) -> bool:
+        """O(log K): bisect the cached window starts (every window starting at or
+        before ``t`` is final once ``_extend`` passed ``t``)."""
         t = nonnegative("t", t)
-        ws = self.windows(math.nextafter(t, math.inf))
-        return bool(ws) and ws[-1][0] <= t < ws[-1][1]
+        merged = self._extend(math.nextafter(t, math.inf))
+        k = bisect.bisect_right(self._cache["starts"], t) - 1
+        return k >= 0 and merged[k][0] <= t < merged[k][1]
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": "random", "rate": self.rate, "mean_duration": self.mean_duration,
