@@ -119,7 +119,18 @@ class ConvexStep:
         self.residual = residual
 
     def __call__(self, k: int, t: float, z: np.ndarray, agents: np.ndarray) -> np.ndarray:
-        return z + self.residual(t)
+        """z + ε(t)·1; InputError when ε(t) is not a finite real (a user's callable
+        returning NaN, inf or an array) or the sum passes the float range."""
+        eps = self.residual(t)
+        if (isinstance(eps, bool) or not isinstance(eps, (int, float, np.integer, np.floating))
+                or not np.isfinite(eps)):
+            raise InputError(f"the residual ε(t) at t = {t:g} is {eps!r}: it must be a "
+                             f"finite real number")
+        out = z + eps
+        if not np.isfinite(out).all():
+            raise InputError(f"the states at step {k} (t = {t:g}) pass the float range after "
+                             f"adding the residual ε(t) = {eps:g}: they diverged")
+        return out
 
 
 class ConsensusMonitor:
@@ -486,7 +497,8 @@ def _baseline_auxiliary(sc, links, x, values, usable, benign, d):
         for L in np.unique(hi - lo):
             r, p = np.nonzero(hi - lo == L)
             kept = V[r[:, None], lo[r, p][:, None] + np.arange(L), p[:, None]]
-            aux[rows[r], p] = np.concatenate([kept, own[r, p][:, None]], axis=1).mean(axis=1)
+            aux[rows[r], p] = _scaled_mean(np.concatenate([kept, own[r, p][:, None]], axis=1),
+                                           axis=1)
     return aux
 
 

@@ -86,16 +86,18 @@ def _memory_bytes() -> int:
         return 2**36
 
 
-def _check_trajectory_size(steps: int, n: int, d: int) -> None:
+def _check_trajectory_size(steps: int, n: int, d: int, adversaries: int) -> None:
     """Refuse a run whose trajectory cannot fit in memory: it holds K + 1 states of
-    N·d floats, plus per step the spread (d), per-agent validity (≤ N) and 4 scalars,
-    i.e. 8·(K + 1)·(N·d + N + d + 4) bytes."""
-    need = 8 * (steps + 1) * (n * d + n + d + 4)
+    N·d floats, plus per step the spread (d), per-agent validity (≤ N), 4 scalars and
+    the range (low, high) of what each of the |A| adversaries sent (2·|A|·d), i.e.
+    8·(K + 1)·(N·d + N + d + 4 + 2·|A|·d) bytes."""
+    need = 8 * (steps + 1) * (n * d + n + d + 4 + 2 * adversaries * d)
     have = _memory_bytes()
     if need > have:
         raise InputError(f"steps = {steps}: the trajectory would need {_bytes(need)} "
-                         f"(8·(steps+1)·(N·d + N + d + 4) bytes, N = {n}, d = {d}), more "
-                         f"than this machine's {_bytes(have)} of memory")
+                         f"(8·(steps+1)·(N·d + N + d + 4 + 2·|A|·d) bytes, N = {n}, d = {d}, "
+                         f"|A| = {adversaries}), more than this machine's {_bytes(have)} of "
+                         f"memory")
 
 
 def _bytes(b: float) -> str:
@@ -209,8 +211,14 @@ class Scenario:
         object.__setattr__(self, "x0", self._states(nodes))
         for name in ("F", "steps", "seed"):
             object.__setattr__(self, name, integer(name, getattr(self, name), low=0))
-        _check_trajectory_size(self.steps, len(nodes), self.d)
         object.__setattr__(self, "T", positive("T", self.T, what="number of seconds"))
+        try:
+            horizon = self.steps * self.T
+        except OverflowError:  # steps beyond the float range
+            horizon = math.inf
+        if not math.isfinite(horizon):
+            raise InputError(f"steps·T = {self.steps}·{self.T:g} passes the float range: the "
+                             f"step times t_k = k·T must be finite numbers of seconds")
         if not isinstance(self.check_robustness, bool):
             raise InputError(f"check_robustness must be True or False; got "
                              f"{self.check_robustness!r}")
@@ -242,6 +250,7 @@ class Scenario:
         object.__setattr__(self, "alpha", self._alphas(nodes))
         object.__setattr__(self, "residual", _residual(self.residual))
         benign = [v for v in nodes if v not in self.adversaries]
+        _check_trajectory_size(self.steps, len(nodes), self.d, len(nodes) - len(benign))
         low = [v for v in benign if self.graph.in_degree(v) <= self.F]
         if low:
             raise InputError(f"F = {self.F} must be below every benign agent's in-degree; "
