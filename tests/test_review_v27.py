@@ -61,17 +61,20 @@ def _frac_hull_dist_1d(x: float, pts: list[float]) -> Fraction:
 # ---------------------------------------------------------------- bugs (xfail strict)
 
 
-@pytest.mark.xfail(strict=True, reason="V27: T*steps past the float range puts inf in "
-                   "Trajectory.times; trajectory.json then holds 'Infinity' (invalid JSON)")
+# Fixed (was a bug: T*steps past the float range puts inf in Trajectory.times;
+# trajectory.json then holds 'Infinity' (invalid JSON))
 def test_huge_T_times_are_finite_json():
-    tr = rescon.simulate(_sc(F=1, steps=3, T=1e308))
+    try:  # refused when read (a one-line InputError), or finite times
+        tr = rescon.simulate(_sc(F=1, steps=3, T=1e308))
+    except InputError as exc:
+        assert "steps·T" in str(exc)
+        return
     assert np.isfinite(tr.times).all()
     json.dumps(tr.to_json(), allow_nan=False)
 
 
-@pytest.mark.xfail(strict=True, reason="V27: a residual callable returning NaN reaches the "
-                   "states unchecked (ConvexStep adds it blindly); with metrics=[] the run "
-                   "completes with NaN states")
+# Fixed (was a bug: a residual callable returning NaN reaches the states unchecked
+# (ConvexStep adds it blindly); with metrics=[] the run completes with NaN states)
 def test_nan_residual_refused():
     sc = _sc(F=1, steps=3, residual=lambda t: float("nan"))
     try:
@@ -81,9 +84,9 @@ def test_nan_residual_refused():
     assert np.isfinite(tr.states[:, tr.benign]).all()
 
 
-@pytest.mark.xfail(strict=True, reason="V27: W-MSR averages kept values with a plain "
-                   ".mean (engine._baseline_auxiliary): two adversaries at 1.7e308 with "
-                   "F = 0 make benign states inf")
+# Fixed (was a bug: W-MSR averages kept values with a plain .mean
+# (engine._baseline_auxiliary): two adversaries at 1.7e308 with F = 0 make benign states
+# inf)
 def test_wmsr_huge_adversaries_states_finite():
     sc = _sc(F=0, steps=3, algorithm="wmsr",
              adversaries={0: Constant([1.7e308]), 1: Constant([1.7e308])})
@@ -94,9 +97,9 @@ def test_wmsr_huge_adversaries_states_finite():
     assert np.isfinite(tr.states[:, tr.benign]).all()
 
 
-@pytest.mark.xfail(strict=True, reason="V27: with metrics on, the same W-MSR run stops "
-                   "with a misleading validity-monitor message ('x must be a finite "
-                   "point') instead of the documented 'diverged' error")
+# Fixed (was a bug: with metrics on, the same W-MSR run stops with a misleading
+# validity-monitor message ('x must be a finite point') instead of the documented 'diverged'
+# error)
 def test_wmsr_huge_adversaries_diverged_message():
     sc = _sc(F=0, steps=3, algorithm="wmsr",
              adversaries={0: Constant([1.7e308]), 1: Constant([1.7e308])})
@@ -108,19 +111,26 @@ def test_wmsr_huge_adversaries_diverged_message():
         pass
 
 
-@pytest.mark.xfail(strict=True, reason="V27: the trajectory-size check "
-                   "(8(K+1)(Nd+N+d+4) bytes) omits the adversaries' sent band "
-                   "(K+1, |A|, 2, d): a run it admits allocates ~2x its estimate")
-def test_memory_estimate_covers_sent_band():
+# Fixed (was a bug: the trajectory-size check (8(K+1)(Nd+N+d+4) bytes) omits the
+# adversaries' sent band (K+1, |A|, 2, d): a run it admits allocates ~2x its estimate)
+def test_memory_estimate_covers_sent_band(monkeypatch):
+    # (integrator: the check is that the estimate covers what the run allocates — with
+    # the machine's memory just below the allocation, the scenario is refused)
+    from rescon.consensus import scenario as scenario_module
+
     n, d, K = 10, 4, 200
-    need = 8 * (K + 1) * (n * d + n + d + 4)
     x0 = [[float(i + p) for p in range(d)] for i in range(n)]
     advs = {i: Constant([0.5] * d) for i in range(1, n)}
-    sc = Scenario(graph=_complete(n), x0=x0, F=0, steps=K, adversaries=advs,
-                  check_robustness=False)
-    tr = rescon.simulate(sc)
+
+    def make():
+        return Scenario(graph=_complete(n), x0=x0, F=0, steps=K, adversaries=advs,
+                        check_robustness=False)
+
+    tr = rescon.simulate(make())
     used = tr.states.nbytes + tr.sent.nbytes + sum(v.nbytes for v in tr.metrics.values())
-    assert used <= need, (used, need)
+    monkeypatch.setattr(scenario_module, "_memory_bytes", lambda: used - 1)
+    with pytest.raises(InputError, match="trajectory would need"):
+        make()
 
 
 @pytest.mark.xfail(strict=True, reason="V27: rmdo's distance_to_optimum is "
