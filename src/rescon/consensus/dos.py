@@ -79,6 +79,12 @@ Link = tuple[Hashable, Hashable]
 #: quantities are reported as unknown.
 _LONG_RUN_MAX_WINDOWS = 200_000
 
+#: Largest number of windows :func:`check_assumption3` will enumerate on
+#: ``[0, horizon]`` (exact rationals); beyond it the finite-horizon quantities
+#: (``holds``, ``witness``, ``min_mu_d``, ``windows``, ``total_blocked``) are reported
+#: as unknown (None), never guessed. The long-run answer does not depend on it.
+_HORIZON_MAX_WINDOWS = 200_000
+
 
 # --------------------------------------------------------------------------- #
 # input validation
@@ -638,16 +644,20 @@ class Assumption3Report:
     mu_d, T_d : float or None
         As given.
     holds : bool or None
-        Assumption 3 holds on ``[0, horizon]`` (None unless both mu_d and T_d given).
+        Assumption 3 holds on ``[0, horizon]`` (None unless both mu_d and T_d given,
+        or when the horizon holds too many windows to list, see ``notes``).
     witness : Assumption3Witness or None
         The worst pair for ``T_d`` (None without T_d or without any attack window).
     min_mu_d : float or None
         For the given ``T_d``: the smallest float :math:`\\mu_d` with the bound on
         ``[0, horizon]`` (the exact supremum, rounded up). 0.0 when nothing is
         blocked: then every :math:`\\mu_d > 0` works.
-    windows : tuple of (float, float)
-        :math:`\\Pi_D \\cap [0, \\text{horizon}]` as merged disjoint windows.
-    total_blocked : float
+    windows : tuple of (float, float), or None
+        :math:`\\Pi_D \\cap [0, \\text{horizon}]` as merged disjoint windows; None
+        (as are ``holds``, ``witness``, ``min_mu_d`` and ``total_blocked``) when the
+        horizon holds more than ``_HORIZON_MAX_WINDOWS`` (200 000) windows: not
+        decided on the horizon (the long-run quantities are still computed).
+    total_blocked : float or None
         :math:`|\\Pi_D \\cap [0, \\text{horizon}]|`.
     long_run_fraction : float or None
         :math:`\\lim |\\Pi_D \\cap [0, t]| / t` (exact for periodic and explicit
@@ -672,8 +682,8 @@ class Assumption3Report:
     holds: bool | None
     witness: Assumption3Witness | None
     min_mu_d: float | None
-    windows: tuple[tuple[float, float], ...]
-    total_blocked: float
+    windows: tuple[tuple[float, float], ...] | None
+    total_blocked: float | None
     long_run_fraction: float | None
     max_T_d: float | None
     any_T_d_works: bool | None
@@ -684,13 +694,16 @@ class Assumption3Report:
     def min_mu_d_for(self, T_d: float) -> float:
         """Smallest float :math:`\\mu_d` on ``[0, horizon]`` for another ``T_d``."""
         T_d = _check_T_d(T_d)
+        if self.windows is None:
+            raise InputError("too many DoS windows on the horizon to compute min_mu_d "
+                             "(the report's windows were not listed)")
         exact = [(Fraction(s), Fraction(e)) for s, e in self.windows]
         sup, _ = _sup_excess(exact, _inv(T_d))
         return _ceil_float(sup)
 
     def check(self) -> bool:
         """Re-verify the witness from ``windows`` alone (exact arithmetic)."""
-        if self.witness is None or self.T_d is None:
+        if self.witness is None or self.T_d is None or self.windows is None:
             return self.witness is None
         w = self.witness
         exact = [(Fraction(s), Fraction(e)) for s, e in self.windows]
@@ -749,6 +762,20 @@ def _sup_excess(windows: list[tuple[Fraction, Fraction]],
         if arg is None or p - q_min > best:
             best, arg = p - q_min, (i_min, j)
     return best, arg
+
+
+def _window_count(sched: Schedule, horizon: Fraction) -> float:
+    """How many windows of ``sched`` start before ``horizon``, without listing them
+    (exact for periodic and explicit schedules; the expected number of arrivals
+    :math:`\\lambda h` for random ones)."""
+    if isinstance(sched, Periodic):
+        o = Fraction(sched.offset)
+        return 0.0 if horizon <= o else float(math.ceil((horizon - o) / Fraction(sched.period)))
+    if isinstance(sched, Explicit):
+        return float(len(sched.intervals))
+    if isinstance(sched, RandomDoS):
+        return sched.rate * float(horizon)
+    return float(len(sched.windows(float(horizon))))
 
 
 def _union_exact(atts: tuple[DoSAttack, ...], horizon: Fraction) -> list[tuple[Fraction, Fraction]]:
@@ -892,14 +919,22 @@ def check_assumption3(attacks: Iterable[DoSAttack], horizon: float, *,
         T_d = _check_T_d(T_d)
     notes: list[str] = []
     H = Fraction(horizon)
-    win = _clip(_union_exact(atts, H), Fraction(0), H)
-    total = sum((e - s for s, e in win), Fraction(0))
+    count = sum(_window_count(a.schedule, H) for a in atts if a.links)
+    win: list[tuple[Fraction, Fraction]] | None = None
+    total: Fraction | None = None
+    if count > _HORIZON_MAX_WINDOWS:
+        notes.append(f"about {count:.3g} attack windows on [0, {horizon:g}]: the "
+                     "finite-horizon check is not computed (holds, witness, min_mu_d, "
+                     "windows, total_blocked are None)")
+    else:
+        win = _clip(_union_exact(atts, H), Fraction(0), H)
+        total = sum((e - s for s, e in win), Fraction(0))
     inv = _inv(T_d) if T_d is not None else None
 
     witness = None
     min_mu = None
     holds = None
-    if inv is not None:
+    if inv is not None and win is not None:
         sup, arg = _sup_excess(win, inv)
         min_mu = _ceil_float(sup)
         if arg is None:
@@ -941,7 +976,8 @@ def check_assumption3(attacks: Iterable[DoSAttack], horizon: float, *,
         notes.append("the long-run blocked fraction is 1: no T_d > 1 works for all time")
     return Assumption3Report(
         horizon=horizon, mu_d=mu_d, T_d=T_d, holds=holds, witness=witness, min_mu_d=min_mu,
-        windows=tuple((float(s), float(e)) for s, e in win), total_blocked=float(total),
+        windows=None if win is None else tuple((float(s), float(e)) for s, e in win),
+        total_blocked=None if total is None else float(total),
         long_run_fraction=long_run, max_T_d=max_T_d, any_T_d_works=any_ok,
         min_mu_d_long_run=min_all, holds_long_run=holds_all, notes=tuple(notes),
     )
