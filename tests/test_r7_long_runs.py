@@ -4,18 +4,26 @@
   DoS masks cost O(K log K), not O(K^2).
 * ``check_assumption3`` lists at most ``_HORIZON_MAX_WINDOWS`` windows on the
   horizon; beyond, the finite-horizon answer is None ("not decided"), never wrong.
+* RMDO's ``distance_to_optimum`` is computed without overflow (an optimum at 1e200),
+  ``cost_rate`` exactly when the float quotient overflows, else a one-line InputError.
 """
 
 from __future__ import annotations
 
 import signal
 import time
+from fractions import Fraction
 
+import networkx as nx
 import numpy as np
 import pytest
 
+import rescon
+from rescon import Scenario
 from rescon.consensus.dos import DoSAttack, Periodic, RandomDoS, check_assumption3
 from rescon.errors import InputError
+
+pytestmark = pytest.mark.filterwarnings("ignore:Assumption 5")
 
 
 def test_random_dos_active_logarithmic_and_consistent():
@@ -59,3 +67,46 @@ def test_assumption3_many_windows_not_decided_on_horizon_but_long_run_exact():
     # a horizon under the cap is still decided exactly
     small = check_assumption3([a], 1e-4, mu_d=1.0, T_d=1.5)
     assert small.holds is True and small.windows is not None
+
+
+def _sc(n=4, **kw):
+    kw.setdefault("check_robustness", False)
+    return Scenario(graph=nx.complete_graph(n).to_directed(),
+                    x0=[[float(i)] for i in range(n)], **kw)
+
+
+@pytest.mark.parametrize("far", [1e200, -1.7e308])
+def test_rmdo_far_given_optimum_distance_exact(far):
+    tr = rescon.rmdo(_sc(F=0, steps=3), {i: f"0.125 * abs(x1 - {far!r})" for i in range(4)},
+                     optimum=[far], step_size=0.01)
+    dist = tr.metrics["distance_to_optimum"]
+    assert np.isfinite(dist).all()
+    xb = tr.states[:, :, 0]
+    want = [float(max(abs(Fraction(v) - Fraction(far)) for v in row)) for row in xb]
+    np.testing.assert_allclose(dist, want, rtol=1e-15)
+
+
+def test_optimum_distance_2d_far_and_tiny_with_basis():
+    from rescon.optim.rmdo import Optimum
+
+    o = Optimum(np.array([1e300, 1e300]), np.array([[1.0], [0.0]]), 0.0, {})
+    # X* = the line x2 = 1e300: distance |x2 - 1e300|
+    assert o.distance(np.array([[0.0, 0.0], [5.0, -1e300]])).tolist() == [1e300, 2e300]
+    t = Optimum(np.array([0.0, 0.0]), None, 0.0, {})
+    np.testing.assert_allclose(t.distance(np.array([[3e-200, 4e-200]])), [5e-200])
+
+
+def test_cost_rate_exact_when_float_difference_overflows():
+    from rescon.optim.rmdo import _rate
+
+    assert _rate(1e308, -1e308, 4.0, 1) == 5e307
+    assert _rate(3.0, 1.0, 2.0, 1) == 1.0
+    with pytest.raises(InputError, match="cost_rate overflows at step 2"):
+        _rate(1.0, 0.5, 1e-310, 2)
+
+
+def test_rmdo_tiny_T_cost_rate_refused_one_line():
+    with pytest.raises(InputError) as e:
+        rescon.rmdo(_sc(F=0, steps=3, T=1e-310), {i: f"(x1 - {10 * i})^2" for i in range(4)},
+                    step_size=0.01)
+    assert "\n" not in str(e.value)

@@ -298,10 +298,30 @@ class CostMonitor:
         m = self.metrics
         m["cost"][k], m["cost_at_mean"][k] = F[:-1], F[-1]
         if k:
-            m["cost_rate"][k] = (F[-1] - m["cost_at_mean"][k - 1]) / self.T
+            m["cost_rate"][k] = _rate(F[-1], m["cost_at_mean"][k - 1], self.T, k)
         if self.optimum.known:
             m["distance_to_optimum"][k] = self.optimum.distance(xb).max()
             m["optimality_gap"][k] = F[:-1].max() - self.optimum.value
+
+
+def _rate(new: float, old: float, T: float, k: int) -> float:
+    """(new − old)/T, the float nearest the real quotient: computed in floats, and
+    exactly (rationals) when that overflows (ΔF past the float range, T tiny).
+
+    Raises
+    ------
+    InputError
+        The real quotient itself is beyond the float range (|ΔF|/T > 1.8e308)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = (new - old) / T
+    if math.isfinite(r):
+        return r
+    try:
+        return float((Fraction(new) - Fraction(old)) / Fraction(T))
+    except OverflowError:
+        raise InputError(f"cost_rate overflows at step {k}: (F(x̄(t_k)) − F(x̄(t_k−1)))/T "
+                         f"= ({new:g} − {old:g})/{T:g} is beyond the float range; "
+                         "use a larger T") from None
 
 
 def _at(k: int, t: float) -> str:
@@ -352,11 +372,19 @@ class Optimum:
         self.known = point is not None
 
     def distance(self, X: np.ndarray) -> np.ndarray:
-        """‖(x − x₀) − U Uᵀ(x − x₀)‖ for X* = x₀ + range(U) (U orthonormal, maybe empty)."""
+        """‖(x − x₀) − U Uᵀ(x − x₀)‖ for X* = x₀ + range(U) (U orthonormal, maybe empty).
+
+        Each row r = x − x₀ is scaled by 2^-e, e the exponent of max |r| (exact but for
+        subnormal entries), so that the squares neither overflow (x₀ at 1e200) nor
+        underflow; the norm is then scaled back by 2^e (inf only when the distance
+        itself is past the float range)."""
         R = X - self.point
+        e = np.frexp(np.abs(R).max(axis=1))[1]
+        R = np.ldexp(R, -e[:, None])
         if self.basis is not None and self.basis.size:
             R = R - (R @ self.basis) @ self.basis.T
-        return np.linalg.norm(R, axis=1)
+        with np.errstate(over="ignore"):
+            return np.ldexp(np.linalg.norm(R, axis=1), e)
 
     @classmethod
     def find(cls, groups: list[_Group], F: GlobalCost, d: int, given: Any, x0: np.ndarray
