@@ -6,6 +6,8 @@
   horizon; beyond, the finite-horizon answer is None ("not decided"), never wrong.
 * RMDO's ``distance_to_optimum`` is computed without overflow (an optimum at 1e200),
   ``cost_rate`` exactly when the float quotient overflows, else a one-line InputError.
+* RMDO's numerical X* probes the scale first (a far argmin is found), and a numerical
+  X* beaten by a benign state during the run becomes "not found" (metrics NaN).
 """
 
 from __future__ import annotations
@@ -110,3 +112,34 @@ def test_rmdo_tiny_T_cost_rate_refused_one_line():
         rescon.rmdo(_sc(F=0, steps=3, T=1e-310), {i: f"(x1 - {10 * i})^2" for i in range(4)},
                     step_size=0.01)
     assert "\n" not in str(e.value)
+
+
+_FAR = {0: "(x1 - 1e100)^2", 1: "abs(x1 - 3)", 2: "x1^2", 3: "x1^2"}
+
+
+def test_rmdo_numerical_optimum_far_argmin_found():
+    tr = rescon.rmdo(_sc(F=0, steps=10), _FAR, step_size=0.1)
+    opt = tr.info["optimum"]
+    assert opt["method"].startswith("numerical")
+    # F' = 6x - 2e100 + 1 = 0 (x > 3): x* = (2e100 - 1)/6
+    assert abs(opt["point"][0] / ((2e100 - 1) / 6) - 1) < 1e-6
+    gap = tr.metrics["optimality_gap"]
+    assert (gap >= 0).all()
+
+
+def test_rmdo_numerical_optimum_refuted_by_a_state_is_not_found(monkeypatch):
+    from rescon.optim import rmdo as rmdo_mod
+
+    def bad(cls, F, x0):  # a wrong numerical X*: where F looks flat near the mean
+        p = x0.mean(axis=0)
+        val = float(F(p[None])[0])
+        return cls(p, None, val, {"method": "numerical (test)", "exact": False,
+                                  "point": p.tolist(), "value": val})
+
+    monkeypatch.setattr(rmdo_mod.Optimum, "_numerical", classmethod(bad))
+    tr = rescon.rmdo(_sc(F=0, steps=10), _FAR, step_size=0.1)
+    opt = tr.info["optimum"]
+    assert "point" not in opt and "value" not in opt
+    assert "beaten by a benign state at step 1" in opt["reason"]
+    assert np.isnan(tr.metrics["optimality_gap"]).all()
+    assert np.isnan(tr.metrics["distance_to_optimum"]).all()

@@ -299,6 +299,9 @@ class CostMonitor:
         m["cost"][k], m["cost_at_mean"][k] = F[:-1], F[-1]
         if k:
             m["cost_rate"][k] = _rate(F[-1], m["cost_at_mean"][k - 1], self.T, k)
+        if self.optimum.known and self.optimum.refuted_by(k, float(F[:-1].min())):
+            m["distance_to_optimum"][:] = np.nan
+            m["optimality_gap"][:] = np.nan
         if self.optimum.known:
             m["distance_to_optimum"][k] = self.optimum.distance(xb).max()
             m["optimality_gap"][k] = F[:-1].max() - self.optimum.value
@@ -364,12 +367,30 @@ class Optimum:
     ``known`` (X* nonempty and found), ``value`` F* (F at the float point of X* used),
     ``distance(X)`` (rows' distances to X*), ``info`` (JSON-ready: ``method`` "given",
     "exact (quadratic)" or "numerical (...)", ``exact``, ``point``, ``value``, and
-    ``dimension`` of X* or ``reason`` when X* is empty or not found)."""
+    ``dimension`` of X* or ``reason`` when X* is empty or not found).
+
+    A numerical X* is only an estimate: should a benign state reach a lower F during
+    the run (:meth:`refuted_by`), X* becomes "not found" (``point`` and ``value``
+    dropped, ``reason`` says where) and the monitor reports ``distance_to_optimum`` and
+    ``optimality_gap`` as NaN for the whole run rather than wrong (negative) values."""
 
     def __init__(self, point: np.ndarray | None, basis: np.ndarray | None, value: float,
                  info: dict[str, Any]) -> None:
         self.point, self.basis, self.value, self.info = point, basis, value, info
         self.known = point is not None
+
+    def refuted_by(self, k: int, f: float) -> bool:
+        """Is a numerical X* disproved by a benign state with F = ``f`` < F* at step k?
+        If so, X* becomes not found (``known`` False, ``info`` says why)."""
+        if not (self.info.get("method", "").startswith("numerical") and f < self.value):
+            return False
+        for key in ("point", "value", "note"):
+            self.info.pop(key, None)
+        self.info["reason"] = (f"not found: the numerical minimiser (F* = {self.value:g}) "
+                               f"is beaten by a benign state at step {k} (F = {f:g}); "
+                               "distance_to_optimum and optimality_gap are NaN")
+        self.point, self.value, self.known = None, -math.inf, False
+        return True
 
     def distance(self, X: np.ndarray) -> np.ndarray:
         """‖(x − x₀) − U Uᵀ(x − x₀)‖ for X* = x₀ + range(U) (U orthonormal, maybe empty).
@@ -428,26 +449,63 @@ class Optimum:
 
     @classmethod
     def _numerical(cls, F: GlobalCost, x0: np.ndarray) -> Optimum:
-        """Nelder–Mead (scipy) from the benign mean, restarted from its answer until F
-        stops decreasing; X* is taken as the point found (a numerical estimate)."""
+        """Nelder–Mead (scipy) in a scaled frame x = c + s·y, restarted until F stops
+        decreasing; X* is taken as the point found (a numerical estimate).
+
+        F can look flat in floats near the benign mean m when its argmin is far (its
+        ulp there exceeds its change), so the scale is probed first: c is the best of m
+        and m ± s e_i, s = 2^(8j) s₀ (s₀ the power of two just above 1 + max |x0|,
+        while finite), and s the probe step of the best. Each round minimises y ↦ F(c + s y)
+        from y = 0 with the simplex {0, e_1/2, …, e_d/2} and xatol 1e-12 (relative to
+        s), then recentres c on the answer and sets s to the power of two ≥ its move (at
+        least 1e-12 s). Points where F overflows count as +inf (probes also where it
+        fails: a cost's domain may be bounded); a minimiser past |x| ≤
+        :data:`STATE_LIMIT` (where no state can go) is "not found"."""
         from scipy.optimize import minimize
 
-        def Fx(x: np.ndarray) -> float:
-            return float(F(x[None])[0])
+        def Fx(x: np.ndarray, probe: bool = False) -> float:
+            """F(x); +inf where it overflows (and, for a probe, where it fails or is
+            NaN); else a failure or NaN raises the named InputError of ``F``."""
+            if not np.isfinite(x).all():
+                return math.inf
+            try:
+                with np.errstate(all="ignore"):  # far points may overflow: +inf
+                    v = float(F.merged.value(x[None])[0])
+            except Exception:  # noqa: BLE001 (re-evaluated by F, which names the agent)
+                v = math.nan
+            if math.isnan(v) and not probe:
+                v = float(F(x[None])[0])
+            return math.inf if math.isnan(v) else v
 
-        x, best = x0.mean(axis=0), math.inf
-        scale = 1.0 + float(np.abs(x0).max())
+        d = x0.shape[1]
+        s0 = math.ldexp(1.0, math.frexp(1.0 + float(np.abs(x0).max()))[1])
+        x, s = x0.mean(axis=0), s0
+        best = Fx(x)
+        for j in range(0, 1024 - math.frexp(s0)[1], 8):
+            step = math.ldexp(s0, j)
+            for i in range(d):
+                for sign in (1.0, -1.0):
+                    y = x0.mean(axis=0)
+                    y[i] += sign * step
+                    v = Fx(y, probe=True)
+                    if v < best:
+                        x, s, best = y, step, v
+        simplex = np.vstack([np.zeros(d), np.eye(d) / 2])
         for _ in range(10):
-            res = minimize(Fx, x, method="Nelder-Mead",
-                           options={"xatol": 1e-12 * scale, "fatol": 0.0,
-                                    "maxiter": 4000 * len(x), "maxfev": 8000 * len(x)})
+            res = minimize(lambda y, c=x, s=s: Fx(c + s * y), np.zeros(d),
+                           method="Nelder-Mead",
+                           options={"xatol": 1e-12, "fatol": 0.0, "initial_simplex": simplex,
+                                    "maxiter": 4000 * d, "maxfev": 8000 * d})
             if not res.fun < best:
                 break
-            x, best = res.x, float(res.fun)
+            move = s * np.abs(res.x).max()
+            x, best = x + s * res.x, float(res.fun)
+            s = math.ldexp(1.0, math.frexp(max(move, 1e-12 * s))[1])
         info: dict[str, Any] = {"method": "numerical (scipy Nelder-Mead, restarted)",
                                 "exact": False}
-        if not (math.isfinite(best) and np.abs(x).max() < 1e12 * scale):
-            info["reason"] = "no minimiser found: F may be unbounded below"
+        if not (math.isfinite(best) and np.abs(x).max() <= STATE_LIMIT):
+            info["reason"] = ("no minimiser found with |x| <= 1e150 (the state limit): F "
+                              "may be unbounded below")
             return cls(None, None, -math.inf, info)
         info.update(point=x.tolist(), value=best,
                     note="distances are to this point; X* may contain more")
