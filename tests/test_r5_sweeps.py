@@ -220,3 +220,21 @@ def test_grids_beyond_the_cell_budget_are_refused_when_read(tmp_path):
     with pytest.raises(InputError, match="cells"):
         rescon.sweep({**big, "axes": {**big["axes"]}}, workers=0, out=out)
     assert not Path(out).exists()
+
+
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:notaport", "not an address",
+                                     "tcp://hostonly", "tls://127.0.0.1:x1"])
+def test_malformed_tcp_addresses_are_refused_before_any_client(address, monkeypatch):
+    """A tcp / tls address without a host and a numeric port is refused before a Client
+    is made: a Client failing in its constructor is closed by its finaliser, which can
+    wait 10 s for its event loop in whatever thread the garbage collector runs it — in
+    CI a later attempt's thread, which then missed its 7-s deadline (the 'notaport'
+    refusal took 7 s instead of 0.2)."""
+    import distributed
+
+    made = []
+    monkeypatch.setattr(distributed, "Client", lambda *a, **k: made.append(a))
+    with pytest.raises(InputError, match="cannot connect"):
+        rescon.sweep({"base": {"scenario": {"paper_example": True, "steps": 2}}},
+                     scheduler=address)
+    assert made == []

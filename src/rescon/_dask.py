@@ -80,6 +80,7 @@ def _connect(Client: Any, scheduler: str) -> Any:
     address but not the handshake, which a peer that accepts and never answers (a
     tarpit, a server waiting for a request) never ends: the attempt runs in a daemon
     thread, and one that ends after the deadline closes what it made."""
+    _parsed(scheduler)
     lock = threading.Lock()
     box: dict[str, Any] = {}
 
@@ -108,6 +109,21 @@ def _connect(Client: Any, scheduler: str) -> Any:
     why = (f"no Dask handshake in {CONNECT_SECONDS + 2} s" if exc is None else
            f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}")
     raise InputError(f"scheduler {scheduler}: cannot connect ({why})")
+
+
+def _parsed(scheduler: str) -> None:
+    """InputError "cannot connect" for a tcp / tls address without a host and a numeric
+    port, before any Client exists: a Client that fails in its constructor is closed by
+    its finaliser, which can wait 10 s for its event loop — in whichever thread the
+    garbage collector runs it (a later attempt's, which then missed its deadline)."""
+    from distributed.comm import get_address_host_port, parse_address
+
+    try:
+        if parse_address(scheduler)[0] in ("tcp", "tls"):
+            get_address_host_port(scheduler)
+    except ValueError as exc:
+        raise InputError(f"scheduler {scheduler}: cannot connect (ValueError: {exc})"
+                         ) from None
 
 
 class Workers:
