@@ -22,6 +22,7 @@ import pytest
 
 import rescon
 from rescon import Scenario
+from rescon.consensus import dos as dos_mod
 from rescon.consensus.dos import DoSAttack, Periodic, RandomDoS, check_assumption3
 from rescon.errors import InputError
 
@@ -59,16 +60,53 @@ def _within(seconds, fn):
 
 def test_assumption3_many_windows_not_decided_on_horizon_but_long_run_exact():
     a = DoSAttack("a", {(0, 1)}, Periodic(period=1e-6, duration=5e-7))
-    r = _within(3.0, lambda: check_assumption3([a], 10.0, mu_d=1.0, T_d=1.5))
+    b = DoSAttack("b", {(1, 0)}, Periodic(period=2e-6, duration=5e-7, offset=1e-7))
+    r = _within(3.0, lambda: check_assumption3([a, b], 10.0, mu_d=1.0, T_d=1.5))
     assert r.holds is None and r.witness is None and r.min_mu_d is None
     assert r.windows is None and r.total_blocked is None
     assert any("not computed" in n for n in r.notes)
-    assert r.long_run_fraction == 0.5 and r.any_T_d_works is True
+    assert r.any_T_d_works is True
     with pytest.raises(InputError):
         r.min_mu_d_for(2.0)
     # a horizon under the cap is still decided exactly
-    small = check_assumption3([a], 1e-4, mu_d=1.0, T_d=1.5)
+    small = check_assumption3([a, b], 1e-4, mu_d=1.0, T_d=1.5)
     assert small.holds is True and small.windows is not None
+
+
+def test_assumption3_one_fine_periodic_schedule_decided_in_closed_form():
+    a = DoSAttack("a", {(0, 1)}, Periodic(period=1e-6, duration=5e-7))
+    r = _within(3.0, lambda: check_assumption3([a], 10.0, mu_d=1.0, T_d=1.5))
+    assert r.windows is None and r.holds is True and r.long_run_fraction == 0.5
+    assert r.witness is not None and r.total_blocked == pytest.approx(5.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_periodic_closed_form_equals_enumeration(seed, monkeypatch):
+    rng = np.random.default_rng(seed)
+    p = float(rng.choice([0.5, 1.0, 1.5, 2.0, 3.0, 0.3]))
+    tau = float(rng.choice([p, p / 2, p / 4, 0.1 * p]))
+    o = float(rng.choice([0.0, 0.25, 1.0, 2.7]))
+    h = float(rng.uniform(0.0, 12.0))
+    T_d = float(rng.choice([1.2, 1.5, 2.0, 5.0, np.inf]))
+    mu = float(rng.choice([0.1, 0.5, 1.0, 3.0]))
+    a = [DoSAttack("a", {(0, 1)}, Periodic(period=p, duration=tau, offset=o))]
+    listed = check_assumption3(a, h, mu_d=mu, T_d=T_d)
+    monkeypatch.setattr(dos_mod, "_HORIZON_MAX_WINDOWS", 0)
+    closed = check_assumption3(a, h, mu_d=mu, T_d=T_d)
+    assert closed.windows is None or closed.total_blocked == 0.0
+    assert (closed.holds, closed.min_mu_d, closed.total_blocked) == (
+        listed.holds, listed.min_mu_d, listed.total_blocked)
+    if listed.witness is None:
+        assert closed.witness is None
+    else:
+        assert closed.witness.excess == listed.witness.excess
+        # the closed-form pair (exact) is a true worst pair of the exact windows
+        inv = dos_mod._inv(T_d)
+        _, sup, (t1, t2) = dos_mod._periodic_horizon(a[0].schedule, Fraction(h), inv)
+        ex = dos_mod._clip(dos_mod._union_exact(tuple(a), Fraction(h)), Fraction(0),
+                           Fraction(h))
+        assert dos_mod._measure(ex, t1, t2) - (t2 - t1) * inv == sup
+        assert sup == dos_mod._sup_excess(ex, inv)[0]
 
 
 def _sc(n=4, **kw):

@@ -82,7 +82,8 @@ _LONG_RUN_MAX_WINDOWS = 200_000
 #: Largest number of windows :func:`check_assumption3` will enumerate on
 #: ``[0, horizon]`` (exact rationals); beyond it the finite-horizon quantities
 #: (``holds``, ``witness``, ``min_mu_d``, ``windows``, ``total_blocked``) are reported
-#: as unknown (None), never guessed. The long-run answer does not depend on it.
+#: as unknown (None), never guessed, except for a single periodic schedule (closed
+#: form). The long-run answer does not depend on it.
 _HORIZON_MAX_WINDOWS = 200_000
 
 
@@ -656,7 +657,9 @@ class Assumption3Report:
         :math:`\\Pi_D \\cap [0, \\text{horizon}]` as merged disjoint windows; None
         (as are ``holds``, ``witness``, ``min_mu_d`` and ``total_blocked``) when the
         horizon holds more than ``_HORIZON_MAX_WINDOWS`` (200 000) windows: not
-        decided on the horizon (the long-run quantities are still computed).
+        decided on the horizon (the long-run quantities are still computed), except
+        for a single periodic schedule, decided in closed form (only ``windows`` is
+        None then, :func:`_periodic_horizon`).
     total_blocked : float or None
         :math:`|\\Pi_D \\cap [0, \\text{horizon}]|`.
     long_run_fraction : float or None
@@ -776,6 +779,34 @@ def _window_count(sched: Schedule, horizon: Fraction) -> float:
     if isinstance(sched, RandomDoS):
         return sched.rate * float(horizon)
     return float(len(sched.windows(float(horizon))))
+
+
+def _periodic_horizon(sched: Periodic, horizon: Fraction, inv: Fraction | None
+                      ) -> tuple[Fraction, Fraction, tuple[Fraction, Fraction] | None]:
+    """Closed form of (|Π ∩ [0, h]|, sup excess, worst (t1, t2)) for one periodic
+    schedule, without listing its windows.
+
+    With n windows starting before h (the last of length ℓ = min(τ, h − o − (n−1)p))
+    and δ = τ − p·inv, the pair (a_i, b_j) has excess (j − i)δ + τ(1 − inv) when
+    j < n − 1 and (n − 1 − i)δ + ℓ(1 − inv) when j = n − 1 (ℓ ≤ τ, 1 − inv > 0), so
+    the supremum is the largest of the pairs (a_0, b_j), j ∈ {0, n − 2, n − 1}
+    (δ ≤ 0: one window; δ > 0: from the first window to one of the last two)."""
+    p, tau, o = Fraction(sched.period), Fraction(sched.duration), Fraction(sched.offset)
+    if horizon <= o:
+        return Fraction(0), Fraction(0), None
+    n = math.ceil((horizon - o) / p)
+    last = min(tau, horizon - o - (n - 1) * p)
+    total = (n - 1) * tau + last
+    if inv is None:
+        return total, Fraction(0), None
+    best: tuple[Fraction, Fraction, Fraction] | None = None
+    for j in sorted({0, max(n - 2, 0), n - 1}):
+        length = tau if j < n - 1 else last
+        g = j * (tau - p * inv) + length * (1 - inv)
+        if best is None or g > best[0]:
+            best = (g, o, o + j * p + length)
+    assert best is not None
+    return total, best[0], (best[1], best[2])
 
 
 def _union_exact(atts: tuple[DoSAttack, ...], horizon: Fraction) -> list[tuple[Fraction, Fraction]]:
@@ -922,28 +953,41 @@ def check_assumption3(attacks: Iterable[DoSAttack], horizon: float, *,
     count = sum(_window_count(a.schedule, H) for a in atts if a.links)
     win: list[tuple[Fraction, Fraction]] | None = None
     total: Fraction | None = None
-    if count > _HORIZON_MAX_WINDOWS:
+    inv = _inv(T_d) if T_d is not None else None
+    scheds = {a.schedule for a in atts if a.links}
+    closed = None
+    if count > _HORIZON_MAX_WINDOWS and len(scheds) == 1 and isinstance(
+            next(iter(scheds)), Periodic):
+        closed = _periodic_horizon(next(iter(scheds)), H, inv)
+        total = closed[0]
+        notes.append(f"about {count:.3g} attack windows on [0, {horizon:g}]: one periodic "
+                     "schedule, decided in closed form (windows not listed: None)")
+    elif count > _HORIZON_MAX_WINDOWS:
         notes.append(f"about {count:.3g} attack windows on [0, {horizon:g}]: the "
                      "finite-horizon check is not computed (holds, witness, min_mu_d, "
                      "windows, total_blocked are None)")
     else:
         win = _clip(_union_exact(atts, H), Fraction(0), H)
         total = sum((e - s for s, e in win), Fraction(0))
-    inv = _inv(T_d) if T_d is not None else None
 
     witness = None
     min_mu = None
     holds = None
-    if inv is not None and win is not None:
-        sup, arg = _sup_excess(win, inv)
+    if inv is not None and (win is not None or closed is not None):
+        if closed is not None:
+            sup, pair = closed[1], closed[2]
+        else:
+            sup, arg = _sup_excess(win, inv)
+            pair = None if arg is None else (win[arg[0]][0], win[arg[1]][1])
         min_mu = _ceil_float(sup)
-        if arg is None:
+        if pair is None:
             notes.append("nothing is blocked on the horizon: every mu_d > 0 works")
         else:
-            t1, t2 = win[arg[0]][0], win[arg[1]][1]
+            t1, t2 = pair
             allowance = (t2 - t1) * inv
+            blocked = sup + allowance if closed is not None else _measure(win, t1, t2)
             witness = Assumption3Witness(
-                t1=float(t1), t2=float(t2), blocked=float(_measure(win, t1, t2)),
+                t1=float(t1), t2=float(t2), blocked=float(blocked),
                 allowance=float(allowance), excess=_ceil_float(sup),
                 bound=None if mu_d is None else float(Fraction(mu_d) + allowance),
             )
