@@ -58,7 +58,7 @@ def _frac_hull_dist_1d(x: float, pts: list[float]) -> Fraction:
     return max(lo - X, X - hi, Fraction(0))
 
 
-# ---------------------------------------------------------------- bugs (xfail strict)
+# ------------------------------------ bugs (strict xfails at first; all fixed)
 
 
 # Fixed (was a bug: T*steps past the float range puts inf in Trajectory.times;
@@ -133,9 +133,8 @@ def test_memory_estimate_covers_sent_band(monkeypatch):
         make()
 
 
-@pytest.mark.xfail(strict=True, reason="V27: rmdo's distance_to_optimum is "
-                   "np.linalg.norm of x - x*, which overflows to inf for x* = 1e200 "
-                   "(optimum= is only checked finite, not against the state limit)")
+# Fixed (was a bug: rmdo's distance_to_optimum is np.linalg.norm of x - x*, which overflows
+# to inf for x* = 1e200 (optimum= is only checked finite, not against the state limit))
 def test_rmdo_far_optimum_distance_finite():
     sc = _sc(F=0, steps=3)
     try:
@@ -145,10 +144,9 @@ def test_rmdo_far_optimum_distance_finite():
     assert np.isfinite(tr.metrics["distance_to_optimum"]).all()
 
 
-@pytest.mark.xfail(strict=True, reason="V27: Scenario.warn (run by simulate/rmdo) "
-                   "enumerates every DoS window on [0, steps*T] in Fractions "
-                   "(check_assumption3 -> _union_exact -> Periodic._exact_windows): a "
-                   "10-step run with period 1e-5 takes ~75 s and 230 MB (1e-7: hours, GBs)")
+# Fixed (was a bug: Scenario.warn (run by simulate/rmdo) enumerates every DoS window on [0,
+# steps*T] in Fractions (check_assumption3 -> _union_exact -> Periodic._exact_windows): a
+# 10-step run with period 1e-5 takes ~75 s and 230 MB (1e-7: hours, GBs))
 def test_fine_periodic_dos_does_not_hang():
     def boom(*_):
         raise TimeoutError("warn() still running after 3 s")
@@ -164,8 +162,8 @@ def test_fine_periodic_dos_does_not_hang():
         signal.signal(signal.SIGALRM, old)
 
 
-@pytest.mark.xfail(strict=True, reason="V27: rmdo's cost_rate = dF/T overflows to -inf "
-                   "for a valid tiny T (1e-310); no InputError, inf in the metrics")
+# Fixed (was a bug: rmdo's cost_rate = dF/T overflows to -inf for a valid tiny T (1e-310);
+# no InputError, inf in the metrics)
 def test_rmdo_cost_rate_finite_tiny_T():
     sc = _sc(F=0, steps=3, T=1e-310)
     try:
@@ -175,10 +173,9 @@ def test_rmdo_cost_rate_finite_tiny_T():
     assert np.isfinite(tr.metrics["cost_rate"][1:]).all()
 
 
-@pytest.mark.xfail(strict=True, reason="V27: rmdo's numerical X* (Optimum._numerical, "
-                   "Nelder-Mead from the benign mean in the raw frame) stops at 1.5 for a "
-                   "sum whose argmin is ~3.3e99: F looks flat there in floats; the "
-                   "optimality gap then goes negative (-2.8e199)")
+# Fixed (was a bug: rmdo's numerical X* (Optimum._numerical, Nelder-Mead from the benign
+# mean in the raw frame) stops at 1.5 for a sum whose argmin is ~3.3e99: F looks flat there
+# in floats; the optimality gap then goes negative (-2.8e199))
 def test_rmdo_numerical_optimum_far_argmin():
     sc = _sc(F=0, steps=10)
     costs = {0: "(x1 - 1e100)^2", 1: "abs(x1 - 3)", 2: "x1^2", 3: "x1^2"}
@@ -189,10 +186,9 @@ def test_rmdo_numerical_optimum_far_argmin():
     assert (gap >= -1e-12 * np.abs(tr.metrics["cost"]).max()).all(), gap.min()
 
 
-@pytest.mark.xfail(strict=True, reason="V27: RandomDoS.active(t) rebuilds the list of "
-                   "every merged window up to t (windows(): [w[0] for w in merged] and a "
-                   "copy) at each call, so a run is O(K^2): 8000 steps spend 5 s in "
-                   "blocked_mask, 200 checks near t = 2e5 take ~5 s")
+# Fixed (was a bug: RandomDoS.active(t) rebuilds the list of every merged window up to t
+# (windows(): [w[0] for w in merged] and a copy) at each call, so a run is O(K^2): 8000
+# steps spend 5 s in blocked_mask, 200 checks near t = 2e5 take ~5 s)
 def test_random_dos_active_is_not_linear_in_t():
     from rescon.consensus.dos import RandomDoS
 
