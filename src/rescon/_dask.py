@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import threading
 import time
+from collections.abc import Iterator
 from typing import Any
 
 from ._validate import integer
@@ -142,6 +143,25 @@ class Workers:
         elif now - self.seen > WORKER_SECONDS:
             raise SolverError(f"the Dask cluster has had no worker for {WORKER_SECONDS} s: "
                               "its tasks cannot run")
+
+    def as_completed(self, futures: list[Any]) -> Iterator[Any]:
+        """The futures as they finish (distributed's ``as_completed``: callbacks, O(1)
+        per future), checking while none is ready that the cluster still has a worker
+        (:meth:`check`, every POLL_SECONDS; ready ones are looked for every
+        POLL_SECONDS / 10)."""
+        from distributed import as_completed
+
+        ready, idle = as_completed(futures), time.perf_counter()
+        while not ready.is_empty():
+            batch = ready.next_batch(block=False)
+            if batch:
+                idle = time.perf_counter()
+                yield from batch
+                continue
+            time.sleep(POLL_SECONDS / 10)
+            if time.perf_counter() - idle > POLL_SECONDS:
+                self.check()
+                idle = time.perf_counter()
 
     def finished(self, running: Any) -> set[Any]:
         """The futures of ``running`` (an iterable of futures) done within

@@ -105,18 +105,15 @@ def _execute(cells: list[dict[str, Any]], scheduler: str | None,
     with client(scheduler, workers) as connected:
         futures = connected.map(run_cell, cells, pure=False)
         index = {f.key: c for f, c in zip(futures, cells, strict=True)}
-        running = set(futures)
         watch = Workers(connected)  # no worker for WORKER_SECONDS: SolverError
-        while running:
-            for fut in watch.finished(running):
-                running.discard(fut)
-                cell = index[fut.key]
-                try:
-                    row = fut.result()
-                except Exception as exc:  # noqa: BLE001 (the workers running it died: KilledWorker)
-                    row = failed_row(cell, exc)
-                yield {"cell": cell["cell"], **row}
-                fut.release()
+        for fut in watch.as_completed(futures):
+            cell = index[fut.key]
+            try:
+                row = fut.result()
+            except Exception as exc:  # noqa: BLE001 (the workers running it died: KilledWorker)
+                row = failed_row(cell, exc)
+            yield {"cell": cell["cell"], **row}
+            fut.release()
 
 
 def _prepare(out: str | Path, g: Grid) -> Path:
