@@ -20,6 +20,7 @@ oracle (:class:`rescon.optim.atoms.Merged`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -114,8 +115,10 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
     monitor = CostMonitor(F, sc.steps, sc.T, len(benign), opt, reach)
     info = {"assumptions_violated": problems, "update": "rmdo", "step_size": repr(beta),
             "assumption5_violated": violated, "oracles": len(groups), "optimum": opt.info}
-    return run(sc, rule, monitors=[ConsensusMonitor(sc, metrics), monitor], progress=progress,
-               info=info, started=t0)
+    tr = run(sc, rule, monitors=[ConsensusMonitor(sc, metrics), monitor], progress=progress,
+             info=info, started=t0)
+    monitor.remeasure(tr.states[:, tr.benign])
+    return dataclasses.replace(tr, seconds=time.perf_counter() - t0)
 
 
 class _Group:
@@ -167,6 +170,9 @@ def _call(oracle: Oracle, method: str, Z: np.ndarray, who: Callable[[int], Hasha
         raise InputError(f"{method} of the cost of agent {who(r)!r} {where}, point "
                          f"{Z[r].tolist()}: {why}{_divergence_hint(Z[r], reach)}") from exc
 
+
+#: steps per block when distances are re-measured against an improved X*
+REMEASURE_BLOCK = 4096
 
 #: a failing point this many times farther out than every initial state and X* is
 #: reported as a diverging run (only the wording of the error depends on it)
@@ -285,6 +291,7 @@ class CostMonitor:
     def __init__(self, F: GlobalCost, steps: int, T: float, n_benign: int,
                  optimum: Optimum, reach: float | None = None) -> None:
         self.F, self.T, self.optimum, self.reach = F, T, optimum, reach
+        self.improved = False  # the numerical X* was improved by a benign state
         K = steps
         self.metrics = {"cost": np.empty((K + 1, n_benign)), "cost_at_mean": np.empty(K + 1),
                         "cost_rate": np.full(K + 1, np.nan)}
@@ -299,12 +306,24 @@ class CostMonitor:
         m["cost"][k], m["cost_at_mean"][k] = F[:-1], F[-1]
         if k:
             m["cost_rate"][k] = _rate(F[-1], m["cost_at_mean"][k - 1], self.T, k)
-        if self.optimum.known and self.optimum.refuted_by(k, float(F[:-1].min())):
-            m["distance_to_optimum"][:] = np.nan
-            m["optimality_gap"][:] = np.nan
         if self.optimum.known:
+            i = int(np.argmin(F[:-1]))
+            self.improved |= self.optimum.improve(k, xb[i], float(F[i]))
             m["distance_to_optimum"][k] = self.optimum.distance(xb).max()
             m["optimality_gap"][k] = F[:-1].max() - self.optimum.value
+
+    def remeasure(self, states: np.ndarray) -> None:
+        """``distance_to_optimum`` and ``optimality_gap`` of every step against the final
+        X* when a benign state improved it during the run (``states`` (K+1, |B|, d) the
+        benign states); steps are taken in blocks (memory of the distances: one block)."""
+        if not self.improved:
+            return
+        m, B = self.metrics, states.shape[1]
+        m["optimality_gap"][:] = m["cost"].max(axis=1) - self.optimum.value
+        for k in range(0, len(states), REMEASURE_BLOCK):
+            X = states[k:k + REMEASURE_BLOCK]
+            dist = self.optimum.distance(X.reshape(-1, X.shape[2]))
+            m["distance_to_optimum"][k:k + len(X)] = dist.reshape(-1, B).max(axis=1)
 
 
 def _rate(new: float, old: float, T: float, k: int) -> float:
@@ -370,26 +389,29 @@ class Optimum:
     ``dimension`` of X* or ``reason`` when X* is empty or not found).
 
     A numerical X* is only an estimate: should a benign state reach a lower F during
-    the run (:meth:`refuted_by`), X* becomes "not found" (``point`` and ``value``
-    dropped, ``reason`` says where) and the monitor reports ``distance_to_optimum`` and
-    ``optimality_gap`` as NaN for the whole run rather than wrong (negative) values."""
+    the run, that state becomes the estimate (:meth:`improve`; ``info`` says which
+    state, step and by how much) and :func:`rmdo` measures ``distance_to_optimum`` and
+    ``optimality_gap`` of the whole run against the final estimate
+    (:meth:`CostMonitor.remeasure`): the gap is never negative, and a state that ties
+    F* up to rounding (flat argmins) moves the estimate by no more than that."""
 
     def __init__(self, point: np.ndarray | None, basis: np.ndarray | None, value: float,
                  info: dict[str, Any]) -> None:
         self.point, self.basis, self.value, self.info = point, basis, value, info
         self.known = point is not None
 
-    def refuted_by(self, k: int, f: float) -> bool:
-        """Is a numerical X* disproved by a benign state with F = ``f`` < F* at step k?
-        If so, X* becomes not found (``known`` False, ``info`` says why)."""
+    def improve(self, k: int, x: np.ndarray, f: float) -> bool:
+        """Make the benign state ``x`` (F = ``f``) at step k the estimate of a numerical
+        X* when ``f`` < F*; True if it did (``info`` records the step, the point, the
+        value and the first estimate's value)."""
         if not (self.info.get("method", "").startswith("numerical") and f < self.value):
             return False
-        for key in ("point", "value", "note"):
-            self.info.pop(key, None)
-        self.info["reason"] = (f"not found: the numerical minimiser (F* = {self.value:g}) "
-                               f"is beaten by a benign state at step {k} (F = {f:g}); "
-                               "distance_to_optimum and optimality_gap are NaN")
-        self.point, self.value, self.known = None, -math.inf, False
+        first = self.info.pop("estimated_value", self.value)
+        self.point, self.value = np.array(x, dtype=float), f
+        self.info.update(point=self.point.tolist(), value=f, estimated_value=first,
+                         improved=f"by a benign state at step {k} (Nelder-Mead's value "
+                                  f"{first:.17g}); distances and gaps of the whole run are "
+                                  "measured against it")
         return True
 
     def distance(self, X: np.ndarray) -> np.ndarray:
