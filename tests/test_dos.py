@@ -424,3 +424,66 @@ def test_T_d_infinite_bounds_total_blocked_time():
 def test_doctests():
     res = doctest.testmod(dos_mod, optionflags=doctest.ELLIPSIS)
     assert res.failed == 0 and res.attempted > 10
+
+
+def _random_periodic_report(rng, horizon_scale: float = 50.0):
+    p = float(rng.choice([0.1, 0.3, 0.7, 1 / 3, 0.01]))
+    sched = Periodic(period=p, duration=p * float(rng.uniform(0.01, 1)),
+                     offset=float(rng.uniform(0, 1)))
+    T_d = float(rng.uniform(1.1, 5))
+    att = DoSAttack(name="D", links=[(0, 1)], schedule=sched)
+    return att, check_assumption3([att], float(rng.uniform(1, horizon_scale)), mu_d=1.0,
+                                  T_d=T_d)
+
+
+def test_check_accepts_reports_whose_numbers_are_not_floats():
+    """Windows o + m·p with p = 0.3 are not floats: check() re-verified the witness on the
+    rounded windows and rejected 255 of 300 correct reports."""
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        _, r = _random_periodic_report(rng)
+        assert r.witness is not None and r.check()
+
+
+def test_check_rejects_a_tampered_witness():
+    import dataclasses
+
+    rng = np.random.default_rng(12)
+    for _ in range(50):
+        _, r = _random_periodic_report(rng)
+        w = r.witness
+        for change in ({"blocked": math.nextafter(w.blocked, 0)},
+                       {"excess": math.nextafter(w.excess, math.inf)},
+                       {"t2": math.nextafter(w.t2, math.inf)},
+                       {"allowance": w.allowance * 2}):
+            bad = dataclasses.replace(r, witness=dataclasses.replace(w, **change))
+            assert not bad.check()
+        assert not dataclasses.replace(r, holds=not r.holds).check()
+
+
+def test_periodic_closed_form_report_checks_and_answers_other_T_d(monkeypatch):
+    """Past the window cap a single periodic schedule is decided in closed form: its
+    report's check() said False (no windows to re-verify from) and min_mu_d_for raised;
+    both now use the closed form, and agree with the enumeration (cap lifted)."""
+    rng = np.random.default_rng(13)
+    for _ in range(40):
+        att, full = _random_periodic_report(rng, horizon_scale=20.0)
+        monkeypatch.setattr(dos_mod, "_HORIZON_MAX_WINDOWS", 0)
+        closed = check_assumption3([att], full.horizon, mu_d=1.0, T_d=full.T_d)
+        monkeypatch.undo()
+        assert closed.windows is None and closed.periodic is not None
+        assert closed.check()
+        assert (closed.witness, closed.min_mu_d, closed.holds) == (
+            full.witness, full.min_mu_d, full.holds)
+        for T_d in (1.5, 3.0, math.inf):
+            assert closed.min_mu_d_for(T_d) == full.min_mu_d_for(T_d)
+
+
+def test_periodic_measure_matches_the_windows():
+    rng = np.random.default_rng(14)
+    for _ in range(300):
+        att, r = _random_periodic_report(rng, horizon_scale=10.0)
+        H = Fraction(r.horizon)
+        t1, t2 = sorted(Fraction(float(v)) for v in rng.uniform(-1, 12, 2))
+        assert dos_mod._periodic_measure(att.schedule, H, t1, t2) == dos_mod._measure(
+            list(r.exact_windows), t1, t2)

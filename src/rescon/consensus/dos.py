@@ -693,26 +693,48 @@ class Assumption3Report:
     min_mu_d_long_run: float | None
     holds_long_run: bool | None
     notes: tuple[str, ...]
+    #: what the finite-horizon answer was computed from, exactly: Π_D ∩ [0, horizon]
+    #: (``windows`` are its endpoints rounded), or the one periodic schedule decided in
+    #: closed form; and the witness's (t1, t2) before rounding
+    exact_windows: tuple[tuple[Fraction, Fraction], ...] | None = field(
+        default=None, repr=False, compare=False)
+    periodic: Periodic | None = field(default=None, repr=False, compare=False)
+    exact_pair: tuple[Fraction, Fraction] | None = field(default=None, repr=False,
+                                                         compare=False)
 
     def min_mu_d_for(self, T_d: float) -> float:
         """Smallest float :math:`\\mu_d` on ``[0, horizon]`` for another ``T_d``."""
         T_d = _check_T_d(T_d)
-        if self.windows is None:
+        H = Fraction(self.horizon)
+        if self.periodic is not None:
+            return _ceil_float(_periodic_horizon(self.periodic, H, _inv(T_d))[1])
+        if self.exact_windows is None:
             raise InputError("too many DoS windows on the horizon to compute min_mu_d "
                              "(the report's windows were not listed)")
-        exact = [(Fraction(s), Fraction(e)) for s, e in self.windows]
-        sup, _ = _sup_excess(exact, _inv(T_d))
+        sup, _ = _sup_excess(list(self.exact_windows), _inv(T_d))
         return _ceil_float(sup)
 
     def check(self) -> bool:
-        """Re-verify the witness from ``windows`` alone (exact arithmetic)."""
-        if self.witness is None or self.T_d is None or self.windows is None:
-            return self.witness is None
+        """Re-verify the witness in exact arithmetic from what the answer was computed
+        from (the exact windows, or the periodic schedule's closed form): its endpoints
+        are the roundings of an exact pair (t1, t2), the blocked time on [t1, t2], the
+        allowance (t2 − t1)/T_d and the excess round to the witness's values, and
+        ``holds`` and ``min_mu_d`` agree with the excess."""
         w = self.witness
-        exact = [(Fraction(s), Fraction(e)) for s, e in self.windows]
-        blocked = _measure(exact, Fraction(w.t1), Fraction(w.t2))
-        excess = blocked - (Fraction(w.t2) - Fraction(w.t1)) * _inv(self.T_d)
-        ok = float(blocked) == w.blocked and _ceil_float(excess) == w.excess
+        if w is None or self.T_d is None or self.exact_pair is None:
+            return w is None
+        t1, t2 = self.exact_pair
+        if self.periodic is not None:
+            blocked = _periodic_measure(self.periodic, Fraction(self.horizon), t1, t2)
+        elif self.exact_windows is not None:
+            blocked = _measure(list(self.exact_windows), t1, t2)
+        else:
+            return False
+        allowance = (t2 - t1) * _inv(self.T_d)
+        excess = blocked - allowance
+        ok = ((float(t1), float(t2)) == (w.t1, w.t2) and float(blocked) == w.blocked
+              and float(allowance) == w.allowance and _ceil_float(excess) == w.excess
+              and self.min_mu_d == w.excess)
         if self.holds is not None and self.mu_d is not None:
             ok = ok and self.holds == (Fraction(self.mu_d) >= excess)
         return ok
@@ -807,6 +829,23 @@ def _periodic_horizon(sched: Periodic, horizon: Fraction, inv: Fraction | None
             best = (g, o, o + j * p + length)
     assert best is not None
     return total, best[0], (best[1], best[2])
+
+
+def _periodic_measure(sched: Periodic, horizon: Fraction, t1: Fraction, t2: Fraction
+                      ) -> Fraction:
+    """|Π ∩ [0, h] ∩ [t1, t2]| for one periodic schedule in closed form: M(b) − M(a)
+    with M(t) = |Π ∩ [0, t]| = nτ + min(r, τ) (t − o = np + r, 0 ≤ r < p) for t > o,
+    a, b the clips of t1, t2 to [0, h]."""
+    p, tau, o = Fraction(sched.period), Fraction(sched.duration), Fraction(sched.offset)
+
+    def upto(t: Fraction) -> Fraction:
+        if t <= o:
+            return Fraction(0)
+        n = math.floor((t - o) / p)
+        return n * tau + min(t - o - n * p, tau)
+
+    a, b = (min(max(t, Fraction(0)), horizon) for t in (t1, t2))
+    return upto(b) - upto(a) if a < b else Fraction(0)
 
 
 def _union_exact(atts: tuple[DoSAttack, ...], horizon: Fraction) -> list[tuple[Fraction, Fraction]]:
@@ -1022,6 +1061,9 @@ def check_assumption3(attacks: Iterable[DoSAttack], horizon: float, *,
         horizon=horizon, mu_d=mu_d, T_d=T_d, holds=holds, witness=witness, min_mu_d=min_mu,
         windows=None if win is None else tuple((float(s), float(e)) for s, e in win),
         total_blocked=None if total is None else float(total),
+        exact_windows=None if win is None else tuple(win),
+        periodic=None if closed is None else next(iter(scheds)),
+        exact_pair=None if witness is None else pair,
         long_run_fraction=long_run, max_T_d=max_T_d, any_T_d_works=any_ok,
         min_mu_d_long_run=min_all, holds_long_run=holds_all, notes=tuple(notes),
     )
