@@ -228,3 +228,13 @@ def test_paper_example_numerical_optimum_stays_cheap(monkeypatch):
     tr = rescon.rmdo(rescon.Scenario.paper_example(steps=5), rescon.optim.paper_costs())
     assert tr.info["optimum"]["point"] == [0.0, 0.0]
     assert evaluations and sum(evaluations) < 2000, evaluations
+
+
+def test_rmdo_global_cost_overflow_is_named():
+    """Four finite terms 1.7e308 sum to inf: the run stopped with 'cost_rate overflows
+    ... use a larger T' (inf − inf), blaming T for an overflowing F."""
+    with pytest.raises(InputError, match=r"global cost F = Σ f_j overflows at step 0 .*"
+                                         r"rescale the costs") as e:
+        rescon.rmdo(_sc(F=0, steps=5), {i: "abs(x1 + 1.7e308)" for i in range(4)},
+                    step_size=0.1)
+    assert "\n" not in str(e.value)

@@ -362,9 +362,33 @@ class GlobalCost:
 
     def __call__(self, P: np.ndarray, where: str = "while computing X*",
                  reach: float | None = None) -> np.ndarray:
+        """F at the rows of P, finite.
+
+        Raises
+        ------
+        InputError
+            An oracle fails or answers NaN/inf (naming the agent), or the terms are
+            finite but their sum passes the float range (naming the point)."""
+        F = self.values(P, where, reach)
+        bad = np.flatnonzero(~np.isfinite(F))
+        if bad.size:
+            raise InputError(f"the global cost F = Σ f_j overflows {where} at the point "
+                             f"{P[int(bad[0])].tolist()}: every f_j is finite there but "
+                             "their sum passes the float range (1.8e308); rescale the costs")
+        return F
+
+    def values(self, P: np.ndarray, where: str = "while computing X*",
+               reach: float | None = None) -> np.ndarray:
+        """F at the rows of P, ±inf or NaN where the finite terms' sum overflows
+        (InputError when an oracle fails or answers NaN/inf)."""
         try:
-            return self.merged.value(P)
+            with np.errstate(all="ignore"):
+                F = self.merged.value(P)
+            if np.isfinite(F).all():
+                return F
         except Exception:  # noqa: BLE001 (re-evaluated below, which names the agent)
+            pass
+        with np.errstate(all="ignore"):
             return global_cost(self.groups, P, where, reach)
 
 
@@ -487,17 +511,17 @@ class Optimum:
         from scipy.optimize import minimize
 
         def Fx(x: np.ndarray, probe: bool = False) -> float:
-            """F(x); +inf where it overflows (and, for a probe, where it fails or is
-            NaN); else a failure or NaN raises the named InputError of ``F``."""
+            """F(x); +inf where it overflows (and, for a probe, where an oracle fails
+            or answers NaN: a cost's domain may be bounded); else such an oracle
+            raises the named InputError of :meth:`GlobalCost.values`."""
             if not np.isfinite(x).all():
                 return math.inf
             try:
-                with np.errstate(all="ignore"):  # far points may overflow: +inf
-                    v = float(F.merged.value(x[None])[0])
-            except Exception:  # noqa: BLE001 (re-evaluated by F, which names the agent)
+                v = float(F.values(x[None])[0])
+            except InputError:
+                if not probe:
+                    raise
                 v = math.nan
-            if math.isnan(v) and not probe:
-                v = float(F(x[None])[0])
             return math.inf if math.isnan(v) else v
 
         d = x0.shape[1]
