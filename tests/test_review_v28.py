@@ -16,7 +16,8 @@ Attacked:
   (duration == period, offsets past the horizon, horizons ending inside a window,
   T_d = inf); tiny periods with huge horizons; ``check()`` on tampered reports.
 
-Bugs found (xfail strict): ``check()`` returns True whenever the witness is None —
+Bugs found (all fixed, markers removed): ``check()`` returns True whenever the witness
+is None —
 so dropping the witness of a failing report (``replace(r, witness=None)``, even with
 ``holds=True``) passes, and on a report with nothing blocked (or without T_d)
 ``holds`` / ``min_mu_d`` can be changed freely; the witness's ``bound`` and the
@@ -130,9 +131,9 @@ def test_improved_estimate_long_run_is_fast(monkeypatch):
     calls = []
     real = rmdo_mod.CostMonitor.remeasure
 
-    def timed(self, states):
+    def timed(self, states, benign):
         t = time.perf_counter()
-        real(self, states)
+        real(self, states, benign)
         calls.append(time.perf_counter() - t)
 
     monkeypatch.setattr(rmdo_mod.CostMonitor, "remeasure", timed)
@@ -149,9 +150,9 @@ def test_seconds_cover_the_remeasurement(monkeypatch):
     _wrong_estimate(monkeypatch)
     real = rmdo_mod.CostMonitor.remeasure
 
-    def slow(self, states):
+    def slow(self, states, benign):
         time.sleep(0.2)
-        real(self, states)
+        real(self, states, benign)
 
     monkeypatch.setattr(rmdo_mod.CostMonitor, "remeasure", slow)
     tr = rescon.rmdo(_sc([[0.0], [1.0], [2.0], [3.0]], steps=5),
@@ -329,58 +330,53 @@ def test_tampered_holds_and_min_mu_d_rejected():
     assert not dataclasses.replace(r, mu_d=5.0).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: check() returns True whenever witness is None")
+# Fixed (was a bug: check() returns True whenever witness is None)
 def test_dropped_witness_rejected():
     r = _report()
     assert not dataclasses.replace(r, witness=None).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: a failing report with witness dropped and "
-                                       "holds flipped to True passes check()")
+# Fixed (was a bug: a failing report with witness dropped and holds flipped to True passes check())
 def test_dropped_witness_and_flipped_holds_rejected():
     r = _report()
     assert not dataclasses.replace(r, witness=None, holds=True, min_mu_d=0.0).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: the witness's bound is never re-verified")
+# Fixed (was a bug: the witness's bound is never re-verified)
 def test_tampered_bound_rejected():
     r = _report()
     w = dataclasses.replace(r.witness, bound=99.0)
     assert not dataclasses.replace(r, witness=w).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: nothing blocked (witness None): holds is "
-                                       "not re-verified")
+# Fixed (was a bug: nothing blocked (witness None): holds is not re-verified)
 def test_nothing_blocked_tampered_holds_rejected():
     r = check_assumption3(_atts([Periodic(1.0, 0.5, 100.0)]), 10.0, mu_d=1.0, T_d=2.0)
     assert r.holds is True and r.witness is None and r.min_mu_d == 0.0 and r.check()
     assert not dataclasses.replace(r, holds=False).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: nothing blocked (witness None): min_mu_d is "
-                                       "not re-verified")
+# Fixed (was a bug: nothing blocked (witness None): min_mu_d is not re-verified)
 def test_nothing_blocked_tampered_min_mu_d_rejected():
     r = check_assumption3(_atts([Periodic(1.0, 0.5, 100.0)]), 10.0, mu_d=1.0, T_d=2.0)
     assert not dataclasses.replace(r, min_mu_d=5.0).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: without T_d, holds / min_mu_d may be set to "
-                                       "anything and check() still passes")
+# Fixed (was a bug: without T_d, holds / min_mu_d may be set to anything and check() still passes)
 def test_without_T_d_tampered_holds_rejected():
     r = check_assumption3(_atts([Periodic(1.0, 0.6, 0.3)]), 10.0, mu_d=1.0)
     assert r.holds is None and r.check()
     assert not dataclasses.replace(r, holds=True).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: total_blocked is never re-verified")
+# Fixed (was a bug: total_blocked is never re-verified)
 def test_tampered_total_blocked_rejected():
     r = _report()
     assert not dataclasses.replace(r, total_blocked=0.0).check()
 
 
-@pytest.mark.xfail(strict=True, reason="V28: rmdo copies every benign state "
-                                       "(tr.states[:, tr.benign]) after each run, even "
-                                       "when nothing is re-measured")
+# Fixed (was a bug: rmdo copies every benign state (tr.states[:, tr.benign]) after each
+# run, even when nothing is re-measured)
 def test_no_copy_of_the_states_after_the_run(monkeypatch):
     """An exact X* is never re-measured, yet ``rmdo`` builds ``tr.states[:, tr.benign]``
     (a fancy-index copy, (K+1)·|B|·d floats) before ``remeasure`` returns early; with

@@ -715,29 +715,52 @@ class Assumption3Report:
         return _ceil_float(sup)
 
     def check(self) -> bool:
-        """Re-verify the witness in exact arithmetic from what the answer was computed
-        from (the exact windows, or the periodic schedule's closed form): its endpoints
-        are the roundings of an exact pair (t1, t2), the blocked time on [t1, t2], the
-        allowance (t2 − t1)/T_d and the excess round to the witness's values, and
-        ``holds`` and ``min_mu_d`` agree with the excess."""
-        w = self.witness
-        if w is None or self.T_d is None or self.exact_pair is None:
-            return w is None
-        t1, t2 = self.exact_pair
+        """Re-verify the finite-horizon answer in exact arithmetic from what it was
+        computed from (the exact windows, or the periodic schedule's closed form):
+        ``windows`` and ``total_blocked`` are their roundings; with ``T_d``, the
+        supremum σ of the excess |Π ∩ [t1, t2]| − (t2 − t1)/T_d gives ``min_mu_d``
+        (rounded up) and ``holds`` (μ_d ≥ σ), and the witness is an exact pair (t1, t2)
+        attaining σ whose endpoints, blocked time, allowance, excess and bound round to
+        its values — no witness exactly when nothing is blocked (σ = 0); without
+        ``T_d`` there is no witness, ``holds`` nor ``min_mu_d``. A horizon not decided
+        (neither) has every finite-horizon field None."""
+        H = Fraction(self.horizon)
+        inv = None if self.T_d is None else _inv(self.T_d)
         if self.periodic is not None:
-            blocked = _periodic_measure(self.periodic, Fraction(self.horizon), t1, t2)
+            sched = self.periodic
+            total, sup, _ = _periodic_horizon(sched, H, inv)
+            ok = self.windows is None
+
+            def blocked_on(a: Fraction, b: Fraction) -> Fraction:
+                return _periodic_measure(sched, H, a, b)
         elif self.exact_windows is not None:
-            blocked = _measure(list(self.exact_windows), t1, t2)
+            wins = list(self.exact_windows)
+            total = sum((e - s for s, e in wins), Fraction(0))
+            sup = _sup_excess(wins, inv)[0] if inv is not None else Fraction(0)
+            ok = self.windows == tuple((float(s), float(e)) for s, e in wins)
+
+            def blocked_on(a: Fraction, b: Fraction) -> Fraction:
+                return _measure(wins, a, b)
         else:
-            return False
-        allowance = (t2 - t1) * _inv(self.T_d)
-        excess = blocked - allowance
-        ok = ((float(t1), float(t2)) == (w.t1, w.t2) and float(blocked) == w.blocked
-              and float(allowance) == w.allowance and _ceil_float(excess) == w.excess
-              and self.min_mu_d == w.excess)
-        if self.holds is not None and self.mu_d is not None:
-            ok = ok and self.holds == (Fraction(self.mu_d) >= excess)
-        return ok
+            return all(v is None for v in (self.windows, self.total_blocked, self.witness,
+                                           self.holds, self.min_mu_d, self.exact_pair))
+        ok = ok and self.total_blocked == float(total)
+        if inv is None:
+            return ok and all(v is None for v in (self.witness, self.holds, self.min_mu_d,
+                                                  self.exact_pair))
+        holds = None if self.mu_d is None else Fraction(self.mu_d) >= sup
+        ok = ok and self.min_mu_d == _ceil_float(sup) and self.holds == holds
+        w = self.witness
+        if w is None or self.exact_pair is None:
+            return ok and w is None and self.exact_pair is None and total == 0
+        t1, t2 = self.exact_pair
+        blocked = blocked_on(t1, t2)
+        allowance = (t2 - t1) * inv
+        bound = None if self.mu_d is None else float(Fraction(self.mu_d) + allowance)
+        return (ok and t1 <= t2 and blocked - allowance == sup
+                and (float(t1), float(t2)) == (w.t1, w.t2) and float(blocked) == w.blocked
+                and float(allowance) == w.allowance and _ceil_float(sup) == w.excess
+                and w.bound == bound)
 
 
 def _check_T_d(T_d: Any) -> float:

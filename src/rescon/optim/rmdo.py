@@ -117,7 +117,7 @@ def rmdo(scenario: Scenario, costs: Mapping[Hashable, Any], *, step_size: Any = 
             "assumption5_violated": violated, "oracles": len(groups), "optimum": opt.info}
     tr = run(sc, rule, monitors=[ConsensusMonitor(sc, metrics), monitor], progress=progress,
              info=info, started=t0)
-    monitor.remeasure(tr.states[:, tr.benign])
+    monitor.remeasure(tr.states, tr.benign)
     return dataclasses.replace(tr, seconds=time.perf_counter() - t0)
 
 
@@ -312,18 +312,19 @@ class CostMonitor:
             m["distance_to_optimum"][k] = self.optimum.distance(xb).max()
             m["optimality_gap"][k] = F[:-1].max() - self.optimum.value
 
-    def remeasure(self, states: np.ndarray) -> None:
+    def remeasure(self, states: np.ndarray, benign: np.ndarray) -> None:
         """``distance_to_optimum`` and ``optimality_gap`` of every step against the final
-        X* when a benign state improved it during the run (``states`` (K+1, |B|, d) the
-        benign states); steps are taken in blocks (memory of the distances: one block)."""
+        X* when a benign state improved it during the run (``states`` (K+1, N, d) every
+        agent's, ``benign`` the rows to measure); steps are taken in blocks (memory: one
+        block of benign states and its distances; nothing when X* was not improved)."""
         if not self.improved:
             return
-        m, B = self.metrics, states.shape[1]
+        m = self.metrics
         m["optimality_gap"][:] = m["cost"].max(axis=1) - self.optimum.value
         for k in range(0, len(states), REMEASURE_BLOCK):
-            X = states[k:k + REMEASURE_BLOCK]
+            X = states[k:k + REMEASURE_BLOCK][:, benign]
             dist = self.optimum.distance(X.reshape(-1, X.shape[2]))
-            m["distance_to_optimum"][k:k + len(X)] = dist.reshape(-1, B).max(axis=1)
+            m["distance_to_optimum"][k:k + len(X)] = dist.reshape(len(X), -1).max(axis=1)
 
 
 def _rate(new: float, old: float, T: float, k: int) -> float:
