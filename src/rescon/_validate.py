@@ -100,6 +100,19 @@ def check_points(X: Any, name: str = "X") -> np.ndarray:
     return arr
 
 
+def check_point(x: Any, d: int, name: str = "x") -> np.ndarray:
+    """x as a finite float64 point of dimension d, each entry exactly a float (as
+    :func:`check_points`), or a one-line InputError naming ``name``."""
+    try:
+        arr = check_points(np.reshape(np.asarray(x, dtype=object), (1, -1)), name)
+    except (InputError, ValueError) as exc:
+        raise InputError(f"{name} must be a finite point of dimension {d}: {exc}") from None
+    if arr.shape != (1, d):
+        raise InputError(f"{name} must be a finite point of dimension {d}; got "
+                         f"{arr.shape[1]} coordinates")
+    return arr[0]
+
+
 def _check_exact_floats(raw: np.ndarray, arr: np.ndarray, name: str) -> None:
     """InputError when a finite entry of ``raw`` is not exactly its float64 ``arr``
     (integer dtypes: only |v| > 2^53 can differ; object: each entry as a Fraction)."""

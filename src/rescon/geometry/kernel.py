@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validate import check_F, check_points
+from .._validate import check_F, check_point, check_points
 from ..errors import EmptyKernel, InputError
 from ._skeleton import vertex_adjacency
 from .emptiness import empty_certificate, empty_from_halfspaces
@@ -38,7 +38,7 @@ from .exact import (
 )
 from .fastpath import certified_kernel
 from .halfspaces import valid_halfspaces
-from .points import kernel_point_of
+from .points import check_choice, kernel_point_of
 from .polytope import ExactPolytope, Farkas, _bits, clip_to_fixpoint
 
 __all__ = ["SafeKernel", "kernel_point", "kernel_points", "safe_kernel"]
@@ -188,10 +188,7 @@ class SafeKernel:
         exact binary values) — so a float rounded from an exact boundary point, such as
         the ``x`` of :meth:`point`, may test False; with tol > 0, up to that distance in
         each (unit-normal) constraint."""
-        xv = np.asarray(x, dtype=np.float64).reshape(-1)
-        if xv.shape != (self.points.shape[1],) or not np.isfinite(xv).all():
-            raise InputError(f"x must be a finite point of dimension {self.points.shape[1]}; "
-                             f"got shape {np.shape(x)}")
+        xv = check_point(x, self.points.shape[1], "x")
         if self.is_empty:
             return False
         if tol == 0.0:
@@ -833,6 +830,7 @@ def kernel_points(batch: Any, F: Any, *, method: str = "project", backend: str =
     from batch[0]'s, is an InputError naming it."""
     if on_empty not in ON_EMPTY:
         raise InputError(f"on_empty must be one of {', '.join(ON_EMPTY)}; got {on_empty!r}")
+    check_choice(method, backend)  # also when no item calls a solver
     try:
         items = list(batch)
     except TypeError:

@@ -6,8 +6,8 @@
   E x = f (aff Ψ) and A_S x = b_S, solved in rationals and accepted only if μ ≥ 0 and
   x ∈ Ψ exactly (KKT). If the guess fails, active sets are enumerated exactly.
   The answer is therefore the same for every backend.
-* ``"chebyshev"``: the centre of the largest ball in Ψ within aff Ψ (LP, floats), moved
-  exactly onto aff Ψ and certified inside.
+* ``"chebyshev"``: the centre of the largest ball in Ψ within aff Ψ (LP, floats: Clarabel
+  for "auto"), moved exactly onto aff Ψ and certified inside.
 * ``"vertex-mean"``: the exact mean of Ψ's vertices.
 """
 
@@ -22,13 +22,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._rounding import MAX_FINITE
+from .._validate import check_point
 from ..errors import EmptyKernel, InputError, SolverError
 from .exact import fraction_str, solve_exact
 
 if TYPE_CHECKING:
     from .kernel import SafeKernel
 
-__all__ = ["METHODS", "kernel_point_of", "point_certificate"]
+__all__ = ["METHODS", "check_choice", "kernel_point_of", "point_certificate"]
 
 METHODS = ("project", "chebyshev", "vertex-mean")
 MAX_ACTIVE_SETS = 200_000
@@ -59,10 +60,27 @@ def point_certificate(K: SafeKernel, x: Vec) -> dict[str, Any]:
             "F": K.F, "x": [fraction_str(v) for v in x], "proof": proof}
 
 
-def kernel_point_of(K: SafeKernel, *, method: str, backend: str, target: Any
-                    ) -> tuple[np.ndarray, dict[str, Any]]:
+def check_choice(method: str, backend: str) -> None:
+    """InputError for an unknown method, SolverNotFound / InputError for a backend the
+    method cannot use (``"auto"``; ``"exact"`` for "project" and "vertex-mean"; else a
+    name of :func:`~rescon.models.qp_backends`, of :func:`~rescon.models.lp_backends`
+    for "chebyshev") — decided before any data is looked at: a kernel of one point,
+    or an empty one, calls no solver."""
     if method not in METHODS:
         raise InputError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
+    if backend == "auto" or (backend == "exact" and method != "chebyshev"):
+        return
+    if backend == "exact":
+        raise InputError("backend='exact' is for method='project' (exact KKT); the "
+                         "Chebyshev centre is an LP: 'auto' or a name of lp_backends()")
+    from ..models.kernel_models import check_backend
+
+    check_backend(backend, "LP" if method == "chebyshev" else "QP")
+
+
+def kernel_point_of(K: SafeKernel, *, method: str, backend: str, target: Any
+                    ) -> tuple[np.ndarray, dict[str, Any]]:
+    check_choice(method, backend)
     if K.is_empty:
         raise EmptyKernel(f"the safe kernel is empty (n = {len(K.points)}, "
                           f"F = {K.F}): no point to return; see the kernel's certificate")
@@ -90,10 +108,7 @@ def _target(K: SafeKernel, target: Any) -> Vec:
         n = len(K.points)
         cols = zip(*K.points.tolist(), strict=True)
         return tuple(sum(map(Fraction, col), Fraction(0)) / n for col in cols)
-    t = np.asarray(target, dtype=np.float64).reshape(-1)
-    if t.shape != (d,) or not np.isfinite(t).all():
-        raise InputError(f"target must be a finite point of dimension {d}; got {target!r}")
-    return tuple(Fraction(float(v)) for v in t)
+    return tuple(Fraction(float(v)) for v in check_point(target, d, "target"))
 
 
 #: up to this many vertices, "auto" guides a projection in dimension ≤ 2 geometrically
@@ -336,13 +351,20 @@ def _kkt(eqs, facets, S, m: Vec) -> Vec | None:
     return None
 
 
+#: the LP backend of method "chebyshev" with backend "auto": Clarabel's interior point
+#: (relative gap 1e-13) keeps kernels down to ~1e-13 of their extent thick, where HiGHS'
+#: absolute tolerances (1e-9 in the unit frame) returned a vertex of a hexagon 2 long
+#: and 2^-30 thick (radius 0 instead of 2^-31; V29)
+CHEBYSHEV_AUTO = "clarabel"
+
+
 def _chebyshev(K: SafeKernel, backend: str) -> Vec:
     from ..models.kernel_models import chebyshev
 
     ex = K._exact
     if K.dim == 0:
         return ex.vertices[0]
-    name = "highs" if backend in ("auto", "exact") else backend
+    name = CHEBYSHEV_AUTO if backend == "auto" else backend
     o, e = _frame(K)
     centre, _ = chebyshev(*_framed(K, o, e)[:4], backend=name)
     centre = _from_frame(centre, o, e)

@@ -36,6 +36,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import io
+import math
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -44,7 +45,7 @@ import numpy as np
 from ..errors import InputError, SolverError, SolverNotFound
 from .backends import available_backends, require_backend, silent_highs, silent_highs_inside
 
-__all__ = ["chebyshev", "lp_backends", "project", "project_batch", "qp_backends"]
+__all__ = ["check_backend", "chebyshev", "lp_backends", "project", "project_batch", "qp_backends"]
 
 #: Tolerance asked of every solver (absolute / relative gap and feasibility).
 TOL = 1e-9
@@ -198,7 +199,8 @@ def project(A, b, origin, basis, target, *, backend="clarabel", solver=None) -> 
         return hull.origin.copy()
     # the minimiser of ½‖u − c/s‖² over G u ≤ h/s is t*/s
     s, scaled = _unit_scale(hull)
-    return hull.lift(s * _SOLVE_QP[name](scaled, _target_t(hull, y) / s, solver))
+    t = _SOLVE_QP[name](scaled, _scaled_target(hull, y, s), solver)
+    return hull.lift(s * _checked(name, scaled, t))
 
 
 def chebyshev(A, b, origin, basis, *, backend="highs", solver=None) -> tuple[np.ndarray, float]:
@@ -245,7 +247,7 @@ def chebyshev(A, b, origin, basis, *, backend="highs", solver=None) -> tuple[np.
         return hull.origin.copy(), 0.0
     s, scaled = _unit_scale(hull)  # max ρ over G u + ρ ≤ h/s is ρ*/s, at t*/s
     t, rho = _SOLVE_LP[name](scaled, solver)
-    return hull.lift(s * t), float(s * rho)
+    return hull.lift(s * _checked(name, scaled, t, float(rho))), float(s * rho)
 
 
 def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None,
@@ -291,6 +293,8 @@ def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None
         ts = [_indexed(i, on_failure, _SOLVE_QP[name], hulls[i], c, solver)
               for i, c in zip(todo, cs)]
     for i, t in zip(todo, ts):
+        if t is not None:
+            t = _indexed(i, on_failure, _checked, name, hulls[i], t)
         out[i] = np.nan if t is None else hulls[i].lift(t)
     return out
 
@@ -376,6 +380,43 @@ def _target_t(hull: _Hull, y: np.ndarray) -> np.ndarray:
     return hull.basis @ (y - hull.origin)
 
 
+def _scaled_target(hull: _Hull, y: np.ndarray, s: float) -> np.ndarray:
+    """c / s, the target in the unit frame of :func:`_unit_scale` (s a power of two),
+    computed as B (y/4 − o/4) · (4/s) so that nothing overflows on the way; SolverError
+    when c / s itself passes the float range (a target some 10^308 polytope sizes away:
+    no float QP resolves the polytope there)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        c = (hull.basis @ (y / 4 - hull.origin / 4)) * (4 / s)
+    if not np.isfinite(c).all():
+        raise SolverError("the target lies beyond the float range in the polytope's unit "
+                          f"frame (the polytope is ~{s:.3g} across): no float QP resolves "
+                          "it; rescon.kernel_point decides such projections exactly")
+    return c
+
+
+#: a backend's answer may violate G t ≤ h (unit rows) by at most this much of the
+#: frame's size (max |h| + max |t|; the solvers are asked for 1e-9): beyond, it is a
+#: wrong answer reported as optimal (cvxpy's OSQP put the projection of (1e10, 5e9) on
+#: the square [−1, 1]² at (−4.48, −2.24); V29) and a SolverError
+FEASIBILITY = 1e-6
+
+
+def _checked(backend: str, hull: _Hull, t: np.ndarray, rho: float = 0.0) -> np.ndarray:
+    """t, once it is finite and G t + ρ ≤ h up to :data:`FEASIBILITY` (ρ ≥ 0 up to it
+    too); else SolverError naming the backend."""
+    t = np.asarray(t, dtype=np.float64)
+    scale = max(float(np.abs(hull.h).max(initial=0.0)), float(np.abs(t).max(initial=0.0)),
+                1e-300)
+    with np.errstate(all="ignore"):
+        excess = max(float((hull.G @ t + rho - hull.h).max(initial=-math.inf)), -rho)
+    if not (np.isfinite(t).all() and math.isfinite(rho) and excess <= FEASIBILITY * scale):
+        raise SolverError(f"{backend}: reported optimal, but its point is "
+                          + ("not finite" if not np.isfinite(t).all() else
+                             f"outside the polytope (by {excess:.3g}, {excess / scale:.2g} of "
+                             "its frame)"))
+    return t
+
+
 def _validate_batch(problems) -> tuple[list[_Hull], list[np.ndarray]]:
     hulls, targets = [], []
     for i, prob in enumerate(problems):
@@ -398,6 +439,13 @@ def _validate_batch(problems) -> tuple[list[_Hull], list[np.ndarray]]:
 # --------------------------------------------------------------------------- #
 # backend resolution
 # --------------------------------------------------------------------------- #
+
+
+def check_backend(backend: str, capability: str) -> None:
+    """InputError / SolverNotFound unless ``backend`` ("name" or "name:solver") is usable
+    for ``capability`` ("QP" or "LP"): what :func:`project` / :func:`chebyshev` would
+    raise, without data."""
+    _resolve(backend, None, capability)
 
 
 def _resolve(backend: str, solver: str | None, capability: str) -> tuple[str, str | None]:
