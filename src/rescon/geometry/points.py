@@ -7,7 +7,7 @@
   x ∈ Ψ exactly (KKT). If the guess fails, active sets are enumerated exactly.
   The answer is therefore the same for every backend.
 * ``"chebyshev"``: the centre of the largest ball in Ψ within aff Ψ (LP, floats: Clarabel
-  for "auto"), moved exactly onto aff Ψ and certified inside.
+  for "auto", HiGHS where it fails), moved exactly onto aff Ψ and certified inside.
 * ``"vertex-mean"``: the exact mean of Ψ's vertices.
 """
 
@@ -351,11 +351,13 @@ def _kkt(eqs, facets, S, m: Vec) -> Vec | None:
     return None
 
 
-#: the LP backend of method "chebyshev" with backend "auto": Clarabel's interior point
-#: (relative gap 1e-13) keeps kernels down to ~1e-13 of their extent thick, where HiGHS'
-#: absolute tolerances (1e-9 in the unit frame) returned a vertex of a hexagon 2 long
-#: and 2^-30 thick (radius 0 instead of 2^-31; V29)
-CHEBYSHEV_AUTO = "clarabel"
+#: the LP backends of method "chebyshev" with backend "auto", the second where the first
+#: fails: Clarabel's interior point (relative gap 1e-13) keeps kernels down to ~1e-13 of
+#: their extent thick, where HiGHS' absolute tolerances (1e-9 in the unit frame)
+#: returned a vertex of a hexagon 2 long and 2^-30 thick (radius 0 instead of 2^-31;
+#: V29); Clarabel in turn ends "AlmostSolved" on some thin kernels (6e-10 of their
+#: extent, V30) where HiGHS finds a point
+CHEBYSHEV_AUTO = ("clarabel", "highs")
 
 
 def _chebyshev(K: SafeKernel, backend: str) -> Vec:
@@ -364,9 +366,15 @@ def _chebyshev(K: SafeKernel, backend: str) -> Vec:
     ex = K._exact
     if K.dim == 0:
         return ex.vertices[0]
-    name = CHEBYSHEV_AUTO if backend == "auto" else backend
     o, e = _frame(K)
-    centre, _ = chebyshev(*_framed(K, o, e)[:4], backend=name)
+    framed = _framed(K, o, e)[:4]
+    if backend == "auto":  # Clarabel, else HiGHS (its point is certified below either way)
+        try:
+            centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[0])
+        except SolverError:
+            centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[1])
+    else:
+        centre, _ = chebyshev(*framed, backend=backend)
     centre = _from_frame(centre, o, e)
     x = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre))
     if ex.contains(x):

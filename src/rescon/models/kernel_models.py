@@ -285,17 +285,26 @@ def project_batch(problems: Sequence[tuple], *, backend="proxsuite", solver=None
     out = np.zeros((len(hulls), hulls[0].origin.size if hulls else 0))
     for i, hull in enumerate(hulls):
         out[i] = hull.origin
-    todo = [i for i, h in enumerate(hulls) if h.k > 0]
-    cs = [_target_t(hulls[i], targets[i]) for i in todo]
+    # each problem in its unit frame (:func:`project`); a target beyond it fails alone
+    scales, scaled, cs, todo = {}, {}, {}, []
+    for i, hull in enumerate(hulls):
+        if hull.k > 0:
+            scales[i], scaled[i] = _unit_scale(hull)
+            cs[i] = _indexed(i, on_failure, _scaled_target, hull, targets[i], scales[i])
+            if cs[i] is None:
+                out[i] = np.nan
+            else:
+                todo.append(i)
     if name in _BATCH_QP:
-        ts = _BATCH_QP[name]([hulls[i] for i in todo], cs, todo, on_failure)
+        ts = _BATCH_QP[name]([scaled[i] for i in todo], [cs[i] for i in todo], todo,
+                             on_failure)
     else:
-        ts = [_indexed(i, on_failure, _SOLVE_QP[name], hulls[i], c, solver)
-              for i, c in zip(todo, cs)]
+        ts = [_indexed(i, on_failure, _SOLVE_QP[name], scaled[i], cs[i], solver)
+              for i in todo]
     for i, t in zip(todo, ts):
         if t is not None:
-            t = _indexed(i, on_failure, _checked, name, hulls[i], t)
-        out[i] = np.nan if t is None else hulls[i].lift(t)
+            t = _indexed(i, on_failure, _checked, name, scaled[i], t)
+        out[i] = np.nan if t is None else hulls[i].lift(scales[i] * t)
     return out
 
 
@@ -394,8 +403,8 @@ def _scaled_target(hull: _Hull, y: np.ndarray, s: float) -> np.ndarray:
     return c
 
 
-#: a backend's answer may violate G t ≤ h (unit rows) by at most this much of the
-#: frame's size (max |h| + max |t|; the solvers are asked for 1e-9): beyond, it is a
+#: a backend's answer may violate G t ≤ h (unit rows, unit frame) by at most this much of
+#: the frame's size (max(1, |h|, |t|); the solvers are asked for 1e-9): beyond, it is a
 #: wrong answer reported as optimal (cvxpy's OSQP put the projection of (1e10, 5e9) on
 #: the square [−1, 1]² at (−4.48, −2.24); V29) and a SolverError
 FEASIBILITY = 1e-6
@@ -406,7 +415,7 @@ def _checked(backend: str, hull: _Hull, t: np.ndarray, rho: float = 0.0) -> np.n
     too); else SolverError naming the backend."""
     t = np.asarray(t, dtype=np.float64)
     scale = max(float(np.abs(hull.h).max(initial=0.0)), float(np.abs(t).max(initial=0.0)),
-                1e-300)
+                1.0)  # the unit frame (h ≡ 0: a cone's apex, s = 1)
     with np.errstate(all="ignore"):
         excess = max(float((hull.G @ t + rho - hull.h).max(initial=-math.inf)), -rho)
     if not (np.isfinite(t).all() and math.isfinite(rho) and excess <= FEASIBILITY * scale):
