@@ -384,14 +384,10 @@ def _unit_scale(hull: _Hull) -> tuple[float, _Hull]:
     return s, _Hull(hull.origin, hull.basis, hull.G, hull.h / s)
 
 
-def _target_t(hull: _Hull, y: np.ndarray) -> np.ndarray:
-    """The target in hull coordinates, c = B (y − o)."""
-    return hull.basis @ (y - hull.origin)
-
-
 def _scaled_target(hull: _Hull, y: np.ndarray, s: float) -> np.ndarray:
-    """c / s, the target in the unit frame of :func:`_unit_scale` (s a power of two),
-    computed as B (y/4 − o/4) · (4/s) so that nothing overflows on the way; SolverError
+    """c / s, c = B (y − o) the target in hull coordinates, in the unit frame of
+    :func:`_unit_scale` (s a power of two), computed as B (y/4 − o/4) · (4/s) so that
+    nothing overflows on the way; SolverError
     when c / s itself passes the float range (a target some 10^308 polytope sizes away:
     no float QP resolves the polytope there)."""
     with np.errstate(over="ignore", invalid="ignore"):
