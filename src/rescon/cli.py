@@ -158,7 +158,7 @@ def _cmd_kernel(args: argparse.Namespace) -> int:
     point = None if K.is_empty else K.point("project")[0]
     _write_certificate(K.certificate, cert_path)
     if plot is not None:
-        K.plot(point=point, path=plot)
+        _draw(lambda: K.plot(point=point, path=plot), plot)
     out = {"n": int(X.shape[0]), "d": int(X.shape[1]), "F": K.F, "empty": K.is_empty,
            "dim": K.dim, "vertices": K.vertices.tolist(), "A": K.A.tolist(),
            "b": K.b.tolist(), "point": None if point is None else point.tolist(),
@@ -175,13 +175,29 @@ def _cmd_kernel(args: argparse.Namespace) -> int:
     return 0
 
 
+def _draw(draw: Callable[[], Any], path: Path) -> None:
+    """``draw()`` (a figure to ``path``); a ValueError raised while drawing (matplotlib
+    refusing what it was given) becomes a one-line error naming the file, not a
+    traceback."""
+    try:
+        draw()
+    except RESCONError:
+        raise
+    except ValueError as exc:
+        raise RESCONError(f"--plot: cannot draw {path}: {exc}") from exc
+
+
 def _run_outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
-    """--out DIR and, with --plot, DIR/trajectory.png: checked before any work."""
+    """--out DIR, its trajectory.json and trajectory.csv and, with --plot,
+    DIR/trajectory.png: each checked (:func:`rescon.io.output_path`) before any work."""
     from .plot import figure_path
 
     if args.plot and not args.out:
         raise RESCONError("--plot needs --out DIR (where the figure is written)")
     out_dir = _output(args.out, "--out", directory=True)
+    if out_dir is not None:
+        for name in ("trajectory.json", "trajectory.csv"):
+            _output(str(out_dir / name), "--out")
     return out_dir, figure_path(out_dir / "trajectory.png", "--plot") if args.plot else None
 
 
@@ -216,7 +232,7 @@ def _run_summary(args: argparse.Namespace, sc: Any, traj: Any, out_dir: Path | N
                                                  encoding="utf-8")
         traj.to_csv(out_dir / "trajectory.csv")
         if plot is not None:
-            traj.plot(plot)
+            _draw(lambda: traj.plot(plot), plot)
         out["out"] = str(out_dir)
     lines = [(f"{sc.algorithm} with policy {sc.policy}: N = {len(sc.nodes)}, d = {sc.d}, "
               f"F = {sc.F}, {sc.steps} steps in {traj.seconds:.2f} s"),

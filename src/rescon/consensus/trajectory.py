@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -83,26 +82,19 @@ class Trajectory:
         return np.setdiff1d(np.arange(len(self.nodes)), self.benign)
 
     def to_json(self) -> dict[str, Any]:
-        """JSON-ready dict (NaN written as null)."""
+        """JSON-ready dict of plain Python types (:func:`rescon.io.to_jsonable`: numpy
+        labels and values as Python scalars, arrays as nested lists, NaN and ±inf as
+        null)."""
+        from ..io import to_jsonable
 
-        def clean(a: np.ndarray) -> Any:
-            return np.where(np.isfinite(a), a, np.nan).astype(object).tolist() if a.size else []
-
-        def nan_to_none(x: Any) -> Any:
-            if isinstance(x, list):
-                return [nan_to_none(v) for v in x]
-            return None if isinstance(x, float) and math.isnan(x) else x
-
-        out = {"nodes": list(self.nodes), "benign": [self.nodes[i] for i in self.benign],
-               "times": self.times.tolist(),
-               "states": nan_to_none(clean(self.states)),
-               "metrics": {k: nan_to_none(clean(v)) for k, v in self.metrics.items()},
-               "info": self.info, "seconds": self.seconds}
+        out: dict[str, Any] = {
+            "nodes": self.nodes, "benign": [self.nodes[i] for i in self.benign],
+            "times": self.times, "states": self.states, "metrics": self.metrics,
+            "info": self.info, "seconds": self.seconds}
         if self.sent is not None:
             out["sent"] = {"nodes": [self.nodes[i] for i in self.adversary_rows],
-                           "min": nan_to_none(clean(self.sent[:, :, 0])),
-                           "max": nan_to_none(clean(self.sent[:, :, 1]))}
-        return out
+                           "min": self.sent[:, :, 0], "max": self.sent[:, :, 1]}
+        return to_jsonable(out)
 
     def to_csv(self, path: str | Path) -> Path:
         """One row per (step, agent): k, t, node, benign, x_1..x_d (missing parent

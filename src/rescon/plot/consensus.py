@@ -10,16 +10,23 @@ benign curves into less than half of a panel, the panel's y-limits follow the be
 agents (adversaries off the scale marked ▲/▼ at the edge) and a second, shorter panel
 shows the full range. A log axis that would have to show an exact 0 stops one decade
 below the smallest positive value (:func:`log_floor`) and marks the zeros there.
+Times, and each coordinate, whose largest magnitude (a coordinate: over the benign
+agents) lies outside [1e-100, 1e100] are drawn in units of 10^k
+(:func:`rescon.plot.unit_exponent`), named in the axis label ("t (×1e-300 s)").
+The legend has one entry per adversary up to :data:`ADVERSARY_ENTRIES` adversaries,
+then one for all; labels longer than :data:`LABEL_CHARS` end in "…", and the legend
+has as many columns (≤ :data:`LEGEND_COLUMNS`) as fit in the figure's width.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
 import numpy as np
 
-from . import figure_path, pyplot
+from . import figure_path, in_units, new_figure, unit_exponent, unit_label
 
 __all__ = ["log_floor", "plot_log_clipped", "plot_trajectory"]
 
@@ -33,6 +40,10 @@ ZOOM_SHARE = 0.5
 #: at most this many markers along one curve (line markers, off-scale marks).
 MARKS = 12
 LEGEND_COLUMNS = 3
+#: up to this many adversaries each get a legend entry; more share one.
+ADVERSARY_ENTRIES = 10
+#: legend labels longer than this end in "…".
+LABEL_CHARS = 40
 
 
 def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -> Any:
@@ -41,11 +52,13 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
     when the run has cost metrics (:func:`rescon.rmdo`), two more: the global cost
     Σ_{i∈B} f_i at the benign mean (with F* when known) and its change rate (the
     paper's Fig. 7). One legend for the figure. Saves to ``path`` if given
-    (:func:`rescon.plot.figure_path`); returns the matplotlib Figure."""
+    (:func:`rescon.plot.figure_path`; a figure of its own, outside pyplot); returns the
+    matplotlib Figure."""
     path = None if path is None else figure_path(path)
-    plt = pyplot(path)
     d = traj.states.shape[2]
-    limits = [_benign_limits(traj, p) for p in range(d)]
+    k_t, ks = _units(traj)
+    view = _drawn(traj, k_t, ks)
+    limits = [_benign_limits(view, p) for p in range(d)]
     rows: list[tuple[str, Any]] = []
     for p in range(d):
         rows.append(("coord", p))
@@ -56,21 +69,22 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
     if "cost_at_mean" in traj.metrics:
         rows += [("cost", None), ("rate", None)]
     heights = [0.6 if kind == "full" else 1.0 for kind, _ in rows]
-    fig, axes = plt.subplots(len(rows), 1, figsize=(7, 0.3 + 2.3 * sum(heights)),
-                             sharex=True, gridspec_kw={"height_ratios": heights},
-                             squeeze=False)
+    fig = new_figure(path, figsize=(7, 0.3 + 2.3 * sum(heights)))
+    axes = fig.subplots(len(rows), 1, sharex=True, gridspec_kw={"height_ratios": heights},
+                        squeeze=False)
+    t = view.times
     for ax, (kind, p) in zip(axes[:, 0], rows, strict=True):
         if kind == "coord":
-            _coordinate_panel(ax, traj, p, limits[p])
+            _coordinate_panel(ax, view, p, limits[p], k=ks[p])
         elif kind == "full":
-            _coordinate_panel(ax, traj, p, None, zoom=limits[p])
+            _coordinate_panel(ax, view, p, None, k=ks[p], zoom=limits[p])
         elif kind == "diameter":
-            _diameter_panel(ax, traj, log_diameter)
+            _diameter_panel(ax, t, traj, log_diameter)
         elif kind == "cost":
-            _cost_panel(ax, traj)
+            _cost_panel(ax, t, traj)
         else:
-            _rate_panel(ax, traj)
-    axes[-1, 0].set_xlabel("t (s)")
+            _rate_panel(ax, t, traj)
+    axes[-1, 0].set_xlabel(unit_label("t", k_t, "s"))
     _figure_legend(fig, axes[:, 0])
     fig.suptitle(_title(traj.info), fontsize=9)
     if path is not None:
@@ -85,6 +99,40 @@ def _title(info: dict[str, Any]) -> str:
     if algorithm and algorithm != "alg1":
         what = f"{what}, filter {algorithm}"
     return f"{what}, policy {info.get('policy', '')}, F = {info.get('F', '')}"
+
+
+# --------------------------------------------------------------------------- units
+
+
+def _units(traj: Any) -> tuple[int, list[int]]:
+    """The exponents of the drawing units (:func:`rescon.plot.unit_exponent`): k_t of
+    the times and, per coordinate p, k_p of the benign states (of every value drawn
+    in p when no benign one is finite), so that ordinary benign values are drawn as
+    they are whatever the adversaries send."""
+    ks = []
+    for p in range(traj.states.shape[2]):
+        benign = traj.states[:, traj.benign, p]
+        ks.append(unit_exponent(benign) if np.isfinite(benign).any()
+                  else unit_exponent(traj.states[:, :, p], *_adversary_values(traj, p)))
+    return unit_exponent(traj.times), ks
+
+
+def _drawn(traj: Any, k_t: int, ks: list[int]) -> Any:
+    """``traj`` with times in units of 10^k_t and coordinate p of ``states`` and
+    ``sent`` in units of 10^k_p (:func:`rescon.plot.in_units`); a value beyond the
+    float limit in these units (an adversary far from the benign scale) is drawn at
+    it, ±1.797e308."""
+    if k_t == 0 and not any(ks):
+        return traj
+    top = np.finfo(float).max
+
+    def scaled(a: np.ndarray) -> np.ndarray:
+        out = np.stack([in_units(a[..., p], k) for p, k in enumerate(ks)], axis=-1)
+        return np.clip(out, -top, top)
+
+    return dataclasses.replace(traj, times=in_units(traj.times, k_t),
+                               states=scaled(traj.states),
+                               sent=None if traj.sent is None else scaled(traj.sent))
 
 
 # --------------------------------------------------------------------------- states
@@ -143,12 +191,15 @@ def _benign_limits(traj: Any, p: int) -> tuple[float, float] | None:
 
 
 def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | None, *,
-                      zoom: tuple[float, float] | None = None) -> None:
-    """x_i(p) against t: benign agents, adversaries (lines or sent bands), initial
-    states; with ``limits`` the y-axis follows the benign agents and off-scale
-    adversary values are marked at the edge; ``zoom`` (on the full-range panel)
-    shades the zoomed window."""
+                      k: int = 0, zoom: tuple[float, float] | None = None) -> None:
+    """x_i(p) against t (``traj`` as drawn, coordinate p in units of 10^k): benign
+    agents, adversaries (lines or sent bands; one legend entry each up to
+    :data:`ADVERSARY_ENTRIES`, else one for all), initial states; with ``limits`` the
+    y-axis follows the benign agents and off-scale adversary values are marked at the
+    edge; ``zoom`` (on the full-range panel) shades the zoomed window."""
     t, X = traj.times, traj.states
+    each = len(traj.adversary_rows) <= ADVERSARY_ENTRIES
+    bands = False
     step = max(1, len(t) // MARKS)
     if zoom is not None:
         _full_scale(ax, traj, p, zoom)
@@ -162,14 +213,15 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
     for j, i in enumerate(traj.adversary_rows):
         colour, ls, marker = _adversary_style(j)
         band = _sent_band(traj, j, p)
-        name = f"adversary {traj.nodes[i]}"
+        bands = bands or band is not None
+        name = f"adversary {traj.nodes[i]}" if each else None
         if band is None:
             ax.plot(t, X[:, i, p], color=colour, ls=ls, lw=1.1, marker=marker, ms=4,
                     markevery=step, label=name)
             start = [X[0, i, p]]
         else:
             ax.fill_between(t, band[0], band[1], color=colour, alpha=0.15, lw=0,
-                            label=f"{name}: range sent")
+                            label=f"{name}: range sent" if each else None)
             for edge in band:
                 ax.plot(t, edge, color=colour, ls=ls, lw=0.7, marker=marker, ms=3,
                         markevery=step)
@@ -180,15 +232,27 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
             hi_vals = X[:, i, p] if band is None else band[1]
             lo_vals = X[:, i, p] if band is None else band[0]
             _mark_off_scale(ax, t, hi_vals, lo_vals, limits, colour)
+    if not each:
+        _collective_entry(ax, len(traj.adversary_rows), bands)
     suffix = (", benign range" if limits is not None
               else ", full range" if zoom is not None else "")
-    ax.set_ylabel(f"x({p + 1}){suffix}")
+    ax.set_ylabel(unit_label(f"x({p + 1})", k) + suffix)
     if limits is not None:
         ax.set_ylim(*limits)
         ax.scatter([], [], marker="^", color="0.4", s=22,
                    label="adversary off the scale (▲ above, ▼ below)")
     if zoom is not None:
         ax.axhspan(*zoom, color="0.5", alpha=0.15, lw=0, zorder=0)
+
+
+def _collective_entry(ax: Any, n: int, bands: bool) -> None:
+    """The one legend entry of n > :data:`ADVERSARY_ENTRIES` adversaries (and of their
+    sent bands): empty artists, nothing drawn."""
+    colour, ls, _ = _adversary_style(0)
+    ax.plot([], [], color=colour, ls=ls, lw=1.1, label=f"{n} adversaries (styles cycled)")
+    if bands:
+        ax.fill_between([], [], [], color=colour, alpha=0.15, lw=0,
+                        label="adversaries: range sent")
 
 
 def _mark_off_scale(ax: Any, t: np.ndarray, hi_vals: np.ndarray, lo_vals: np.ndarray,
@@ -269,17 +333,24 @@ def plot_log_clipped(ax: Any, t: Any, y: Any, floor: float | None, *, label: str
     return line
 
 
-def _diameter_panel(ax: Any, traj: Any, log: bool) -> None:
-    """The benign diameter; on a log axis exact zeros sit at :func:`log_floor`."""
-    t, dia = traj.times, traj.metrics["diameter"]
-    dot = {"marker": "o", "ms": 4} if len(t) == 1 else {}  # a line of one point is invisible
+def _dot(t: Any) -> dict[str, Any]:
+    """Line style keywords that make a one-point line visible (a dot): a line of one
+    point draws nothing."""
+    return {"marker": "o", "ms": 4} if len(t) == 1 else {}
+
+
+def _diameter_panel(ax: Any, t: np.ndarray, traj: Any, log: bool) -> None:
+    """The benign diameter against the drawn times ``t``; on a log axis exact zeros sit
+    at :func:`log_floor`."""
+    dia = traj.metrics["diameter"]
+    dot = _dot(t)
     if log:
         plot_log_clipped(ax, t, dia, log_floor(dia), color="k", lw=1.2,
                          label="benign diameter", **dot)
         zero = np.flatnonzero(dia == 0.0)
         if zero.size:
             ax.text(0.99, 0.95, f"diameter exactly 0 at {zero.size} of {len(t)} steps, "
-                    f"first at t = {t[zero[0]]:g} s", transform=ax.transAxes, ha="right",
+                    f"first at t = {traj.times[zero[0]]:g} s", transform=ax.transAxes, ha="right",
                     va="top", fontsize=7)
     else:
         ax.plot(t, dia, color="k", lw=1.2, label="benign diameter", **dot)
@@ -289,13 +360,14 @@ def _diameter_panel(ax: Any, traj: Any, log: bool) -> None:
 # --------------------------------------------------------------------------- cost
 
 
-def _cost_panel(ax: Any, traj: Any) -> None:
-    """F(x̄(t_k)) and the range of F(x_i) over benign agents, F* dotted when known; a
-    log, symmetric log or linear scale (:func:`_cost_scale`)."""
-    t, m = traj.times, traj.metrics
+def _cost_panel(ax: Any, t: np.ndarray, traj: Any) -> None:
+    """F(x̄(t_k)) and the range of F(x_i) over benign agents against the drawn times
+    ``t``, F* dotted when known; a log, symmetric log or linear scale
+    (:func:`_cost_scale`)."""
+    m = traj.metrics
     ax.fill_between(t, m["cost"].min(axis=1), m["cost"].max(axis=1), color=BENIGN,
                     alpha=0.2, lw=0, label="F(x_i), i benign")
-    ax.plot(t, m["cost_at_mean"], color=BENIGN, label="F(benign mean)")
+    ax.plot(t, m["cost_at_mean"], color=BENIGN, label="F(benign mean)", **_dot(t))
     value = traj.info.get("optimum", {}).get("value")
     shown = [m["cost"], m["cost_at_mean"]]
     if value is not None and np.isfinite(value):
@@ -318,9 +390,10 @@ def _cost_scale(finite: tuple[float, float] | None) -> str:
     return "symlog" if hi >= 0 or lo <= 10 * hi else "linear"
 
 
-def _rate_panel(ax: Any, traj: Any) -> None:
-    """(F(x̄(t_k)) − F(x̄(t_{k−1})))/T on a symmetric log scale."""
-    ax.plot(traj.times, traj.metrics["cost_rate"], color="tab:green", label="change rate")
+def _rate_panel(ax: Any, t: np.ndarray, traj: Any) -> None:
+    """(F(x̄(t_k)) − F(x̄(t_{k−1})))/T against the drawn times ``t`` on a symmetric log
+    scale."""
+    ax.plot(t, traj.metrics["cost_rate"], color="tab:green", label="change rate", **_dot(t))
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.set_yscale("symlog")
     ax.set_ylabel("change rate (1/s)")
@@ -329,15 +402,29 @@ def _rate_panel(ax: Any, traj: Any) -> None:
 # --------------------------------------------------------------------------- legend
 
 
+def _short(label: str) -> str:
+    """``label`` cut to :data:`LABEL_CHARS` characters, the last one "…"."""
+    return label if len(label) <= LABEL_CHARS else label[:LABEL_CHARS - 1] + "…"
+
+
 def _figure_legend(fig: Any, axes: Any) -> None:
     """One legend under the title's place, above the panels (laid out below it; the
-    title comes after the layout): every distinct label once, in drawing order."""
+    title comes after the layout): every distinct label once, in drawing order,
+    shortened (:func:`_short`), in the most columns (≤ :data:`LEGEND_COLUMNS`) that
+    fit in the figure's width."""
     seen: dict[str, Any] = {}
     for ax in axes:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             seen.setdefault(label, handle)
-    legend = fig.legend(list(seen.values()), list(seen), loc="upper center", fontsize=7,
-                        ncol=min(LEGEND_COLUMNS, len(seen)), frameon=False,
-                        bbox_to_anchor=(0.5, 1.0 - 0.36 / fig.get_figheight()))
-    box = legend.get_window_extent(fig.canvas.get_renderer())
+    renderer = fig.canvas.get_renderer()
+    ncol = max(1, min(LEGEND_COLUMNS, len(seen)))
+    while True:
+        legend = fig.legend(list(seen.values()), [_short(s) for s in seen],
+                            loc="upper center", fontsize=7, ncol=ncol, frameon=False,
+                            bbox_to_anchor=(0.5, 1.0 - 0.36 / fig.get_figheight()))
+        box = legend.get_window_extent(renderer)
+        if ncol == 1 or box.width <= fig.bbox.width:
+            break
+        legend.remove()
+        ncol -= 1
     fig.tight_layout(rect=(0, 0, 1, fig.transFigure.inverted().transform(box.p0)[1]))

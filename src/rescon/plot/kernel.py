@@ -2,7 +2,9 @@
 
 Axes are labelled x₁, x₂ (, x₃) and drawn to equal scale; in 3-D the kernel's faces
 are its exact facets (vertex–facet incidence decided in exact rationals), each one
-translucent polygon with its edges, seen from a fixed oblique angle.
+translucent polygon with its edges, seen from a fixed oblique angle. Coordinates whose
+largest magnitude lies outside [1e-100, 1e100] are drawn in units of 10^k, one k for
+every axis (:func:`rescon.plot.unit_exponent`), named in the labels ("x₁ (×1e-300)").
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from . import figure_path, pyplot
+from . import figure_path, in_units, new_figure, unit_exponent, unit_label
 
 __all__ = ["plot_kernel"]
 
@@ -30,14 +32,15 @@ def _ordered_polygon(V: np.ndarray) -> np.ndarray:
     return V[np.argsort(np.arctan2(P[:, 1], P[:, 0]))]
 
 
-def _faces(K: Any) -> list[np.ndarray]:
-    """The 2-faces of a 3-dimensional kernel in R³: for each exact facet a·x ≤ b the
-    vertices with a·v = b exactly (Fractions), in cyclic order."""
+def _faces(K: Any, V: np.ndarray) -> list[np.ndarray]:
+    """The 2-faces of a 3-dimensional kernel in R³ as rows of ``V`` (its vertices, as
+    drawn): for each exact facet a·x ≤ b the vertices with a·v = b exactly
+    (Fractions), in cyclic order."""
     faces = []
     for a, b in K._exact.facets:
         on = [i for i, v in enumerate(K.exact_vertices)
               if sum(ai * vi for ai, vi in zip(a, v, strict=True)) == b]
-        faces.append(_ordered_polygon(K.vertices[on]))
+        faces.append(_ordered_polygon(V[on]))
     return faces
 
 
@@ -62,14 +65,13 @@ def _equal_aspect(ax: Any, X: np.ndarray) -> None:
         axis.set_major_locator(MaxNLocator(max(2, round(6 * share))))
 
 
-def _draw_kernel(ax: Any, K: Any, d: int, label: str) -> None:
-    """Ψ: a filled polygon (dim 2), translucent exact faces (dim 3), a segment or a
-    point (dim 1, 0), or only a legend entry (empty)."""
-    V = K.vertices
+def _draw_kernel(ax: Any, K: Any, V: np.ndarray, d: int, label: str) -> None:
+    """Ψ, its vertices drawn at ``V``: a filled polygon (dim 2), translucent exact faces
+    (dim 3), a segment or a point (dim 1, 0), or only a legend entry (empty)."""
     if K.dim == 3:
         from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-        ax.add_collection3d(Poly3DCollection(_faces(K), alpha=0.25, facecolor=KERNEL,
+        ax.add_collection3d(Poly3DCollection(_faces(K, V), alpha=0.25, facecolor=KERNEL,
                                              edgecolor="navy", linewidths=0.8, label=label))
     elif K.dim == 2:
         P = _ordered_polygon(V)
@@ -91,26 +93,29 @@ def plot_kernel(K: Any, *, ax: Any = None, point: Any = None, path: Any = None,
                 view: tuple[float, float] | None = None) -> Any:
     """Draw K.points, Ψ and ``point`` (d = 2 or 3), axes labelled x₁, x₂ (, x₃) at
     equal scale; in 3-D seen from ``view`` = (elevation, azimuth) in degrees
-    (default :data:`VIEW`). Saves to ``path`` when given
-    (:func:`rescon.plot.figure_path`); returns the matplotlib Axes."""
-    X = K.points
-    d = X.shape[1]
+    (default :data:`VIEW`); coordinates beyond 1e±100 in units of 10^k
+    (:func:`rescon.plot.unit_exponent`, named in the axis labels). Saves to ``path``
+    when given (:func:`rescon.plot.figure_path`; a figure of its own, outside pyplot);
+    returns the matplotlib Axes."""
+    d = K.points.shape[1]
     if d not in (2, 3):
         raise InputError(f"plot draws d = 2 or 3 only; got d = {d}")
     path = None if path is None else figure_path(path)
-    plt = pyplot(path if ax is None else None)
+    point = None if point is None else np.asarray(point, dtype=float).reshape(1, d)
+    k = unit_exponent(K.points, *([] if point is None else [point]))
+    X = in_units(K.points, k)
     if ax is None:
-        fig = plt.figure(figsize=(5.5, 5.5))
+        fig = new_figure(path, figsize=(5.5, 5.5))
         ax = fig.add_subplot(projection="3d" if d == 3 else None)
     extra = {"depthshade": False} if d == 3 else {}
     ax.scatter(*X.T, s=14, c="0.25", label=f"points (n = {len(X)})", **extra)
     label = f"safe kernel Ψ, F = {K.F}" + (" (empty)" if K.is_empty else f", dim {K.dim}")
-    _draw_kernel(ax, K, d, label)
+    _draw_kernel(ax, K, in_units(K.vertices, k), d, label)
     if point is not None:
-        ax.scatter(*np.asarray(point, dtype=float).reshape(d, 1), s=80, marker="*",
-                   c="tab:red", label="kernel point", zorder=5, **extra)
+        ax.scatter(*in_units(point, k).T, s=80, marker="*", c="tab:red",
+                   label="kernel point", zorder=5, **extra)
     for axis, name in zip(("x", "y", "z"), AXIS_LABELS[:d], strict=False):
-        getattr(ax, f"set_{axis}label")(name)
+        getattr(ax, f"set_{axis}label")(unit_label(name, k))
     _equal_aspect(ax, X)
     if d == 3:
         ax.view_init(*(VIEW if view is None else view))
