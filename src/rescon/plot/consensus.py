@@ -43,7 +43,7 @@ LEGEND_COLUMNS = 3
 #: up to this many adversaries each get a legend entry; more share one.
 ADVERSARY_ENTRIES = 10
 #: legend labels longer than this end in "…".
-LABEL_CHARS = 40
+LABEL_CHARS = 48
 
 
 def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -> Any:
