@@ -30,6 +30,7 @@ import subprocess
 import sys
 import textwrap
 import warnings
+from pathlib import Path
 
 import networkx as nx
 import numpy as np
@@ -477,6 +478,24 @@ def test_plot_to_a_file_keeps_the_callers_backend(tmp_path):
     r = subprocess.run([PY, "-c", prog], capture_output=True, text=True, timeout=120, env=env)
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip().lower() == "svg"
+
+
+def test_sweep_summary_keeps_the_callers_backend(tmp_path):
+    """rescon.sweep's summary.png (and rescon.paper's figures) switched the caller's
+    backend to Agg too (pyplot(path)); now drawn on their own canvas."""
+    grid = str(Path(__file__).resolve().parents[1] / "examples" / "sweeps" / "small.toml")
+    prog = textwrap.dedent(f"""\
+        import matplotlib
+        matplotlib.use("svg")
+        import rescon
+        rescon.sweep({grid!r}, workers=0, out={str(tmp_path / "sw")!r}, progress=False)
+        print(matplotlib.get_backend())
+        """)
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+    r = subprocess.run([PY, "-c", prog], capture_output=True, text=True, timeout=300, env=env)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().lower() == "svg"
+    assert (tmp_path / "sw" / "summary.png").stat().st_size > 0
 
 
 # Fixed (was a bug: rescon simulate --out DIR checks only DIR/trajectory.png before the run: a

@@ -125,9 +125,9 @@ def reproduce_paper(out: Any = "out/paper", *, progress: bool | None = None) -> 
     """
     t0 = time.perf_counter()
     out_dir = output_path(out, "out", directory=True)
-    from .plot import pyplot
+    from .plot import figure_path
 
-    pyplot(out_dir / "summary.png")  # matplotlib installed, Agg backend: before any work
+    figure_path(out_dir / "summary.png", "out")  # matplotlib installed: before any work
     run = _Reproduction(out_dir, progress)
     with warnings.catch_warnings():
         # the violated assumptions are recorded (trajectories' info), not printed
@@ -212,10 +212,7 @@ class _Reproduction:
         return entry
 
     def figure(self, name: str, draw: Callable[[Path], Any]) -> str:
-        from .plot import pyplot
-
-        fig = draw(self.out / name)
-        pyplot(self.out / name).close(fig)
+        draw(self.out / name)  # a figure on its own canvas (rescon.plot.new_figure)
         self.figures.append(name)
         return name
 
@@ -565,11 +562,11 @@ def _plot_centres(trajs: dict[str, Any], path: Path) -> Any:
     Cen(Λ) choice (hold-last). The diameter's log axis stops a decade below the
     smallest positive diameter (:func:`rescon.plot.consensus.log_floor`): exact zeros
     are drawn there, ▼ where they start."""
-    from .plot import pyplot
+    from .plot import new_figure
     from .plot.consensus import log_floor, plot_log_clipped
 
-    plt = pyplot(path)
-    fig, (ax_d, ax_v) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    fig = new_figure(path, figsize=(7, 5))
+    ax_d, ax_v = fig.subplots(2, 1, sharex=True)
     floor = log_floor(*(t.metrics["diameter"] for t in trajs.values()))
     for (centre, t), style in zip(trajs.items(), ("-", "--", ":"), strict=False):
         plot_log_clipped(ax_d, t.times, t.metrics["diameter"], floor, ls=style, label=centre)
@@ -587,11 +584,11 @@ def _plot_centres(trajs: dict[str, Any], path: Path) -> Any:
 def _plot_distance(tr: Any, long: Any, path: Path) -> Any:
     """max_i dist(x_i, X*) over time for the paper's horizon and the long run (log
     axes; an exact 0 at :func:`rescon.plot.consensus.log_floor`)."""
-    from .plot import pyplot
+    from .plot import new_figure
     from .plot.consensus import log_floor, plot_log_clipped
 
-    plt = pyplot(path)
-    fig, ax = plt.subplots(figsize=(7, 3))
+    fig = new_figure(path, figsize=(7, 3))
+    ax = fig.subplots()
     dist = long.metrics["distance_to_optimum"], tr.metrics["distance_to_optimum"]
     floor = log_floor(*dist)
     plot_log_clipped(ax, long.times, dist[0], floor, color="tab:gray",

@@ -35,13 +35,10 @@ def _require_matplotlib() -> None:
         raise MissingDependency(f"matplotlib is not installed: {INSTALL}")
 
 
-def pyplot(path: Any = None) -> Any:
-    """``matplotlib.pyplot``; with a file to write, on the non-interactive Agg backend."""
+def pyplot() -> Any:
+    """``matplotlib.pyplot``, on the caller's backend (figures shown, not written: those
+    come from :func:`new_figure` with a path)."""
     _require_matplotlib()
-    import matplotlib
-
-    if path is not None:
-        matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt

@@ -288,17 +288,17 @@ def _plot(table: Any, axes: Mapping[str, list[Any]], kind: str, folder: Path) ->
     robustness: exact with a valid certificate; kernel: non-empty) and a mean
     (consensus: steps to ε-consensus; robustness, kernel: seconds) against the axis
     values, averaged over the other axes and repetitions (when matplotlib is there)."""
-    from ..plot import pyplot
+    from ..plot import new_figure
 
-    try:
-        plt = pyplot(folder / "summary.png")
+    keys = list(axes) or ["repetition"]
+    try:  # its own Agg canvas: the caller's matplotlib backend is left alone
+        fig = new_figure(folder / "summary.png", figsize=(4 * len(keys), 6))
     except MissingDependency:
         return  # the table is the result; the plot is optional
 
     (rate_label, hits), (mean_label, values) = _panels(table, kind)
     values = values.astype("float64")
-    keys = list(axes) or ["repetition"]
-    fig, ax = plt.subplots(2, len(keys), figsize=(4 * len(keys), 6), squeeze=False)
+    ax = fig.subplots(2, len(keys), squeeze=False)
     for j, key in enumerate(keys):
         labels = [str(v) for v in table[key]]
         order = list(dict.fromkeys(labels))
@@ -320,4 +320,3 @@ def _plot(table: Any, axes: Mapping[str, list[Any]], kind: str, folder: Path) ->
                 a.tick_params(axis="x", labelrotation=35)
     fig.tight_layout()
     fig.savefig(folder / "summary.png", dpi=120)
-    plt.close(fig)
