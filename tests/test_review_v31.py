@@ -198,8 +198,8 @@ def test_converged_diameter_exact_zero_on_log_axis(tmp_path):
 def test_subnormal_diameter_floor_is_positive(tmp_path):
     traj = _hand(np.zeros((3, 2, 1)), [0, 1], {"diameter": np.array([5e-324, 0.0, 0.0])})
     fig = traj.plot(tmp_path / "sub.png")
-    ax = next(a for a in fig.axes if a.get_ylabel() == "diameter (benign)")
-    assert ax.get_ylim()[0] > 0
+    ax = next(a for a in fig.axes if a.get_ylabel().startswith("diameter (benign)"))
+    assert ax.get_ylim()[0] > 0  # (in units of 1e-324: the floor is positive there too)
 
 
 def test_d3_trajectory_has_one_panel_per_coordinate(tmp_path):

@@ -445,8 +445,8 @@ def _number_row(p: Path, lineno: int, cells: list[str], width: int, first_line: 
 def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
     """Where an output goes, by one rule for every output (``--plot``,
     ``--certificate``, ``--out``, ``write_json``, figures): missing parent
-    directories are created; a file path that is an existing directory, or a
-    directory path that is an existing file, is refused.
+    directories are created; a file path that is an existing directory, a directory
+    path that is an existing file, and a symbolic link to nothing are refused.
 
     Parameters
     ----------
@@ -463,6 +463,8 @@ def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
     if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
         raise InputError(f"{what} must be a non-empty path; got {path!r}")
     p = Path(path)
+    if p.is_symlink() and not p.exists():
+        raise InputError(f"{what}: {p} is a symbolic link to nothing ({os.readlink(p)})")
     if directory and p.exists() and not p.is_dir():
         raise InputError(f"{what}: {p} exists and is not a directory")
     if not directory and p.is_dir():

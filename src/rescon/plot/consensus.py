@@ -57,7 +57,7 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
     path = None if path is None else figure_path(path)
     d = traj.states.shape[2]
     k_t, ks = _units(traj)
-    view = _drawn(traj, k_t, ks)
+    view, banded = _drawn(traj, k_t, ks), _banded(traj)
     limits = [_benign_limits(view, p) for p in range(d)]
     rows: list[tuple[str, Any]] = []
     for p in range(d):
@@ -75,9 +75,9 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
     t = view.times
     for ax, (kind, p) in zip(axes[:, 0], rows, strict=True):
         if kind == "coord":
-            _coordinate_panel(ax, view, p, limits[p], k=ks[p])
+            _coordinate_panel(ax, view, p, limits[p], banded=banded, k=ks[p])
         elif kind == "full":
-            _coordinate_panel(ax, view, p, None, k=ks[p], zoom=limits[p])
+            _coordinate_panel(ax, view, p, None, banded=banded, k=ks[p], zoom=limits[p])
         elif kind == "diameter":
             _diameter_panel(ax, t, traj, log_diameter)
         elif kind == "cost":
@@ -126,9 +126,9 @@ def _drawn(traj: Any, k_t: int, ks: list[int]) -> Any:
         return traj
     top = np.finfo(float).max
 
-    def scaled(a: np.ndarray) -> np.ndarray:
+    def scaled(a: np.ndarray) -> np.ndarray:  # ±inf as given stays ±inf (undrawn)
         out = np.stack([in_units(a[..., p], k) for p, k in enumerate(ks)], axis=-1)
-        return np.clip(out, -top, top)
+        return np.where(np.isfinite(a), np.clip(out, -top, top), out)
 
     return dataclasses.replace(traj, times=in_units(traj.times, k_t),
                                states=scaled(traj.states),
@@ -143,15 +143,25 @@ def _adversary_style(j: int) -> tuple[Any, Any, str]:
     return ADVERSARY_STYLES[j % len(ADVERSARY_STYLES)]
 
 
-def _sent_band(traj: Any, j: int, p: int) -> tuple[np.ndarray, np.ndarray] | None:
-    """(min, max) over receivers of adversary j's messages in coordinate p per step, or
-    None when it sent one value to everyone at every step (then its row of
-    ``states`` is what it sent)."""
+def _banded(traj: Any) -> np.ndarray:
+    """(|A|, d) booleans: did adversary j send different values to different receivers
+    in coordinate p at some step (its ``sent`` min ≠ max)? Decided on the values as
+    sent, before any drawing unit (where a narrow band can round to one value)."""
+    d = traj.states.shape[2]
     if traj.sent is None:
+        return np.zeros((len(traj.adversary_rows), d), dtype=bool)
+    lo, hi = traj.sent[:, :, 0, :], traj.sent[:, :, 1, :]
+    return ((lo != hi) & np.isfinite(lo) & np.isfinite(hi)).any(axis=0)
+
+
+def _sent_band(traj: Any, j: int, p: int, banded: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray] | None:
+    """(min, max) over receivers of adversary j's messages in coordinate p per step
+    (``traj`` as drawn), or None when it sent one value to everyone at every step
+    (``banded``, :func:`_banded`; then its row of ``states`` is what it sent)."""
+    if not banded[j, p]:
         return None
-    lo, hi = traj.sent[:, j, 0, p], traj.sent[:, j, 1, p]
-    both = np.isfinite(lo) & np.isfinite(hi)
-    return (lo, hi) if np.any(lo[both] != hi[both]) else None
+    return traj.sent[:, j, 0, p], traj.sent[:, j, 1, p]
 
 
 def _finite_range(*arrays: np.ndarray) -> tuple[float, float] | None:
@@ -191,7 +201,8 @@ def _benign_limits(traj: Any, p: int) -> tuple[float, float] | None:
 
 
 def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | None, *,
-                      k: int = 0, zoom: tuple[float, float] | None = None) -> None:
+                      banded: np.ndarray, k: int = 0,
+                      zoom: tuple[float, float] | None = None) -> None:
     """x_i(p) against t (``traj`` as drawn, coordinate p in units of 10^k): benign
     agents, adversaries (lines or sent bands; one legend entry each up to
     :data:`ADVERSARY_ENTRIES`, else one for all), initial states; with ``limits`` the
@@ -212,7 +223,7 @@ def _coordinate_panel(ax: Any, traj: Any, p: int, limits: tuple[float, float] | 
                color=BENIGN, s=28, lw=1.2, zorder=4, label="x_i(0), benign")
     for j, i in enumerate(traj.adversary_rows):
         colour, ls, marker = _adversary_style(j)
-        band = _sent_band(traj, j, p)
+        band = _sent_band(traj, j, p, banded)
         bands = bands or band is not None
         name = f"adversary {traj.nodes[i]}" if each else None
         if band is None:
@@ -340,9 +351,11 @@ def _dot(t: Any) -> dict[str, Any]:
 
 
 def _diameter_panel(ax: Any, t: np.ndarray, traj: Any, log: bool) -> None:
-    """The benign diameter against the drawn times ``t``; on a log axis exact zeros sit
-    at :func:`log_floor`."""
-    dia = traj.metrics["diameter"]
+    """The benign diameter against the drawn times ``t`` (in units of 10^k beyond
+    1e±100, :func:`rescon.plot.unit_exponent`); on a log axis exact zeros sit at
+    :func:`log_floor`."""
+    k = unit_exponent(traj.metrics["diameter"])
+    dia = in_units(traj.metrics["diameter"], k)
     dot = _dot(t)
     if log:
         plot_log_clipped(ax, t, dia, log_floor(dia), color="k", lw=1.2,
@@ -350,11 +363,11 @@ def _diameter_panel(ax: Any, t: np.ndarray, traj: Any, log: bool) -> None:
         zero = np.flatnonzero(dia == 0.0)
         if zero.size:
             ax.text(0.99, 0.95, f"diameter exactly 0 at {zero.size} of {len(t)} steps, "
-                    f"first at t = {traj.times[zero[0]]:g} s", transform=ax.transAxes, ha="right",
-                    va="top", fontsize=7)
+                    f"first at t = {traj.times[zero[0]]:g} s", transform=ax.transAxes,
+                    ha="right", va="top", fontsize=7)
     else:
         ax.plot(t, dia, color="k", lw=1.2, label="benign diameter", **dot)
-    ax.set_ylabel("diameter (benign)")
+    ax.set_ylabel(unit_label("diameter (benign)", k))
 
 
 # --------------------------------------------------------------------------- cost
@@ -362,19 +375,23 @@ def _diameter_panel(ax: Any, t: np.ndarray, traj: Any, log: bool) -> None:
 
 def _cost_panel(ax: Any, t: np.ndarray, traj: Any) -> None:
     """F(x̄(t_k)) and the range of F(x_i) over benign agents against the drawn times
-    ``t``, F* dotted when known; a log, symmetric log or linear scale
-    (:func:`_cost_scale`)."""
+    ``t``, F* dotted when known, in units of 10^k beyond 1e±100; a log, symmetric log
+    or linear scale (:func:`_cost_scale`)."""
     m = traj.metrics
-    ax.fill_between(t, m["cost"].min(axis=1), m["cost"].max(axis=1), color=BENIGN,
-                    alpha=0.2, lw=0, label="F(x_i), i benign")
-    ax.plot(t, m["cost_at_mean"], color=BENIGN, label="F(benign mean)", **_dot(t))
     value = traj.info.get("optimum", {}).get("value")
-    shown = [m["cost"], m["cost_at_mean"]]
-    if value is not None and np.isfinite(value):
-        ax.axhline(value, color="k", ls=":", lw=0.9, label="F*")
-        shown.append(np.asarray([value]))
+    known = value is not None and np.isfinite(value)
+    k = unit_exponent(m["cost"], m["cost_at_mean"], *([[value]] if known else []))
+    cost, at_mean = in_units(m["cost"], k), in_units(m["cost_at_mean"], k)
+    ax.fill_between(t, cost.min(axis=1), cost.max(axis=1), color=BENIGN,
+                    alpha=0.2, lw=0, label="F(x_i), i benign")
+    ax.plot(t, at_mean, color=BENIGN, label="F(benign mean)", **_dot(t))
+    shown = [cost, at_mean]
+    if known:
+        star = in_units(np.asarray([value]), k)
+        ax.axhline(float(star[0]), color="k", ls=":", lw=0.9, label="F*")
+        shown.append(star)
     ax.set_yscale(_cost_scale(_finite_range(*shown)))
-    ax.set_ylabel("global cost")
+    ax.set_ylabel(unit_label("global cost", k))
 
 
 def _cost_scale(finite: tuple[float, float] | None) -> str:
@@ -392,11 +409,13 @@ def _cost_scale(finite: tuple[float, float] | None) -> str:
 
 def _rate_panel(ax: Any, t: np.ndarray, traj: Any) -> None:
     """(F(x̄(t_k)) − F(x̄(t_{k−1})))/T against the drawn times ``t`` on a symmetric log
-    scale."""
-    ax.plot(t, traj.metrics["cost_rate"], color="tab:green", label="change rate", **_dot(t))
+    scale, in units of 10^k beyond 1e±100."""
+    k = unit_exponent(traj.metrics["cost_rate"])
+    ax.plot(t, in_units(traj.metrics["cost_rate"], k), color="tab:green",
+            label="change rate", **_dot(t))
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.set_yscale("symlog")
-    ax.set_ylabel("change rate (1/s)")
+    ax.set_ylabel(unit_label("change rate", k, "1/s"))
 
 
 # --------------------------------------------------------------------------- legend
@@ -416,13 +435,12 @@ def _figure_legend(fig: Any, axes: Any) -> None:
     for ax in axes:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             seen.setdefault(label, handle)
-    renderer = fig.canvas.get_renderer()
     ncol = max(1, min(LEGEND_COLUMNS, len(seen)))
     while True:
         legend = fig.legend(list(seen.values()), [_short(s) for s in seen],
                             loc="upper center", fontsize=7, ncol=ncol, frameon=False,
                             bbox_to_anchor=(0.5, 1.0 - 0.36 / fig.get_figheight()))
-        box = legend.get_window_extent(renderer)
+        box = legend.get_window_extent()  # the figure's renderer, on any canvas
         if ncol == 1 or box.width <= fig.bbox.width:
             break
         legend.remove()
