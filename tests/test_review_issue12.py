@@ -91,11 +91,17 @@ def test_random_states_and_clouds_beyond_the_memory_budget_are_refused():
 
 
 def _summary_figure(monkeypatch, tmp_path, grid):
-    """The summary figure a sweep of ``grid`` draws (caught before it is closed)."""
-    import matplotlib.pyplot as plt
+    """The summary figure a sweep of ``grid`` draws (caught as it is made: it is drawn
+    on its own canvas, outside pyplot)."""
+    import rescon.plot
 
-    figures = []
-    monkeypatch.setattr(plt, "close", figures.append)
+    figures, made = [], rescon.plot.new_figure
+
+    def caught(*args, **kwargs):
+        figures.append(made(*args, **kwargs))
+        return figures[-1]
+
+    monkeypatch.setattr(rescon.plot, "new_figure", caught)
     rescon.sweep(grid, workers=0, out=tmp_path / "out")
     assert len(figures) == 1
     return figures[0]
