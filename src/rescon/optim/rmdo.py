@@ -418,7 +418,8 @@ class Optimum:
     state, step and by how much) and :func:`rmdo` measures ``distance_to_optimum`` and
     ``optimality_gap`` of the whole run against the final estimate
     (:meth:`CostMonitor.remeasure`): the gap is never negative, and a state that ties
-    F* up to rounding (flat argmins) moves the estimate by no more than that."""
+    F* up to rounding (flat argmins) becomes the estimate too — another point of the
+    same argmin, F* changed by that rounding only."""
 
     def __init__(self, point: np.ndarray | None, basis: np.ndarray | None, value: float,
                  info: dict[str, Any]) -> None:
