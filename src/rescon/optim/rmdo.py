@@ -291,7 +291,6 @@ class CostMonitor:
     def __init__(self, F: GlobalCost, steps: int, T: float, n_benign: int,
                  optimum: Optimum, reach: float | None = None) -> None:
         self.F, self.T, self.optimum, self.reach = F, T, optimum, reach
-        self.improved = False  # the numerical X* was improved by a benign state
         K = steps
         self.metrics = {"cost": np.empty((K + 1, n_benign)), "cost_at_mean": np.empty(K + 1),
                         "cost_rate": np.full(K + 1, np.nan)}
@@ -308,7 +307,7 @@ class CostMonitor:
             m["cost_rate"][k] = _rate(F[-1], m["cost_at_mean"][k - 1], self.T, k)
         if self.optimum.known:
             i = int(np.argmin(F[:-1]))
-            self.improved |= self.optimum.improve(k, xb[i], float(F[i]))
+            self.optimum.improve(k, xb[i], float(F[i]))
             m["distance_to_optimum"][k] = self.optimum.distance(xb).max()
             m["optimality_gap"][k] = F[:-1].max() - self.optimum.value
 
@@ -317,7 +316,7 @@ class CostMonitor:
         X* when a benign state improved it during the run (``states`` (K+1, N, d) every
         agent's, ``benign`` the rows to measure); steps are taken in blocks (memory: one
         block of benign states and its distances; nothing when X* was not improved)."""
-        if not self.improved:
+        if "improved" not in self.optimum.info:  # set by Optimum.improve
             return
         m = self.metrics
         m["optimality_gap"][:] = m["cost"].max(axis=1) - self.optimum.value
