@@ -45,6 +45,8 @@ from typing import Any
 MAX_POINTS = 100_000  # resource limit on n
 MAX_DIM = 8  # largest dimension d
 MAX_CONSTRAINTS = 10_000  # halfspaces / equalities / facets per certificate
+#: listed vertices per certificate (each later stage is bounded by its own work limit)
+MAX_VERTICES = 25_000
 MAX_EVAL_WORK = 20_000_000  # (#constraints) * n, evaluating constraints at the points
 MAX_RATIONAL_CHARS = 100_000  # longest "p/q" string (exact vertex means get long)
 #: C(u, k) * (u + #test points + normal cost) for (b); beyond: unchecked
@@ -1519,14 +1521,15 @@ def _float_rows(Fi: list[tuple[list[int], int]]) -> list[tuple[list[float], floa
 
 def _float_vertex(X: list[int], Dv: int) -> tuple[list[float], float] | None:
     """(fl(X / Dv) + [1.0], max |fl(X_i / Dv)|) when every nonzero coordinate has magnitude in
-    [2^-600, 2^300] (int / int is correctly rounded); None otherwise."""
+    [2^-599, 2^299] (int / int is correctly rounded; one float step outward, as the box filter
+    of :func:`_left_by_filters` takes it, stays in [2^-600, 2^300]); None otherwise."""
     try:
         vf = [x / Dv for x in X]
     except OverflowError:
         return None
     vmax = 0.0
     for x, t in zip(X, vf):
-        if x and not 2.0 ** -600 <= abs(t) <= 2.0 ** 300:
+        if x and not 2.0 ** -599 <= abs(t) <= 2.0 ** 299:
             return None
         vmax = max(vmax, abs(t))
     return vf + [1.0], vmax
@@ -1535,7 +1538,8 @@ def _float_vertex(X: list[int], Dv: int) -> tuple[list[float], float] | None:
 def _surely_inside(rows: list[tuple[list[float], float, float]], vf: list[float],
                    vmax: float) -> list[bool]:
     """Per facet a·x <= g: True only when a·v < g holds for the exact v (strictly inside,
-    so neither violated nor tight); False means "decide exactly".
+    so neither violated nor tight); False means "decide exactly".  ``vf``: the floats of v
+    (:func:`_float_vertex`), or an exact float point v (a corner of :func:`_box_left`).
 
     Proof (exact reals a, g, v; s = a·v − g; u = 2^-53).  The entries of a, g are 0 or
     integers of magnitude in [1, 2^600] (:func:`_float_rows`), the coordinates of v are 0
@@ -1555,6 +1559,78 @@ def _surely_inside(rows: list[tuple[list[float], float, float]], vf: list[float]
     fsum, tol = math.fsum, -_FILTER_TOL
     return [(s := fsum(map(mul, afg, vf))) < 0 and s < tol * (a1 * vmax + ag - s)
             for afg, a1, ag in rows]
+
+
+#: vertices per leaf of the box filter's tree (:func:`_left_by_filters`)
+_LEAF_VERTICES = 4
+
+
+def _outward_box(vfs: list[list[float]], d: int) -> tuple[list[float], list[float]]:
+    """(lo, hi) with lo_i <= v_i <= hi_i for the exact v behind each float vertex of
+    ``vfs`` (:func:`_float_vertex`): a nonzero fl(v_i) is the correctly rounded v_i, so
+    v_i lies strictly between its float neighbours; a zero one is exact (X_i = 0).  The
+    extremes are taken one float step outward (math.nextafter is monotone)."""
+    lo, hi = [], []
+    for t in range(d):
+        col = [v[t] for v in vfs]
+        a, b = min(col), max(col)
+        lo.append(math.nextafter(a, -math.inf) if a else 0.0)
+        hi.append(math.nextafter(b, math.inf) if b else 0.0)
+    return lo, hi
+
+
+def _box_left(rows: list[tuple[list[float], float, float]], ups: list[tuple[bool, ...]],
+              cand: list[int], lo: list[float], hi: list[float]) -> list[int]:
+    """The facets of ``cand`` not proved slack on the whole box [lo, hi]: a·v < g for
+    every exact v in it when, for the corner c (c_i = hi_i where a_i > 0, else lo_i;
+    ``ups[j]``: the signs a_i > 0 of facet j), a·v <= a·c on the box and
+    :func:`_surely_inside` proves a·c < g for the exact float point c (its coordinates
+    are 0 or of magnitude in [2^-600, 2^300], :func:`_outward_box`).  Facets with the
+    same signs share their corner: one call per sign pattern."""
+    groups: dict[tuple[bool, ...], list[int]] = {}
+    for j in cand:
+        groups.setdefault(ups[j], []).append(j)
+    slack: set[int] = set()
+    for up, js in groups.items():
+        c = [h if u else w for u, w, h in zip(up, lo, hi)]
+        proved = _surely_inside([rows[j] for j in js], c + [1.0], max(map(abs, c)))
+        slack.update(j for j, ok in zip(js, proved) if ok)
+    return [j for j in cand if j not in slack]
+
+
+def _left_by_filters(rows: list[tuple[list[float], float, float]] | None,
+                     fvs: list[tuple[list[float], float] | None], m: int, d: int,
+                     meter: list[int] | None) -> list[list[int]]:
+    """Per vertex, the facets (indices) the float filters leave to the exact test: all
+    of them without float rows or a float vertex; else those :func:`_surely_inside` does
+    not prove strictly slack, after a tree of boxes (:func:`_outward_box`, split at the
+    median of their widest coordinate down to _LEAF_VERTICES vertices) drops for all of
+    a box's vertices the facets :func:`_box_left` proves slack on the whole box.  The
+    float steps (d per facet and box or vertex) are charged to ``meter`` as they run."""
+    everything = list(range(m))
+    left = [everything] * len(fvs)
+    if rows is None:
+        return left
+    ups = [tuple(a > 0 for a in afg[:d]) for afg, _, _ in rows]
+    stack = [([i for i, fv in enumerate(fvs) if fv is not None], everything)]
+    while stack:
+        ids, cand = stack.pop()
+        if len(ids) <= _LEAF_VERTICES:
+            for i in ids:
+                if meter is not None:
+                    _charge(meter, len(cand) * d, 1)
+                sub = [rows[j] for j in cand]
+                left[i] = [j for j, ok in zip(cand, _surely_inside(sub, *fvs[i])) if not ok]
+            continue
+        if meter is not None:
+            _charge(meter, (len(cand) + len(ids)) * d, 1)
+        lo, hi = _outward_box([fvs[i][0] for i in ids], d)
+        cand = _box_left(rows, ups, cand, lo, hi)
+        axis = max(range(d), key=lambda t: hi[t] - lo[t])
+        ids.sort(key=lambda i: fvs[i][0][axis])
+        half = len(ids) // 2
+        stack += [(ids[:half], cand), (ids[half:], cand)]
+    return left
 
 
 def _rank_at_least_mod_p(rows: Iterable[list[int]], d: int) -> bool:
@@ -1586,8 +1662,9 @@ def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], in
     facets tight at it (the vertex–facet incidence).  Costs #V x #constraints products,
     weighted by bit size; beyond MAX_EVAL_WORK the part is recorded as unchecked and None
     is returned (the vertex enumeration and the skeleton rely on it).  Beyond it with the
-    float filter on, the work is charged as it runs instead: d float steps per facet and
-    vertex (the filter), the exact products only for the slacks it leaves, and the rank."""
+    float filters on, the work is charged as it runs instead: the filters' float steps
+    (:func:`_left_by_filters`), the equalities and the rank, and the exact products only
+    for the slacks the filters leave."""
     SV = [(_int_vector(v), _den_lcm([v])) for v in V]
     bits = max(_bit_size([a + [b] for a, b in Ei + Fi]),
                _bit_size([X + [e] for X, e in SV]))
@@ -1599,36 +1676,24 @@ def _vertices_of_p(Ei: list[tuple[list[int], int]], Fi: list[tuple[list[int], in
                   f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work {work} > "
                   f"{MAX_EVAL_WORK}")
         return None
+    fvs = [_float_vertex(X, Dv) for X, Dv in SV] if rows_f is not None else [None] * len(V)
+    try:
+        left = _left_by_filters(rows_f, fvs, len(Fi), d, meter)
+        if meter is not None:  # the equalities, the rank and the exact slacks left
+            _charge(meter, len(V) * (len(Ei) + d * d) + sum(map(len, left)), 2 * bits)
+    except _OverBudget:
+        ctx.trust("vertex test", f"vertices: each a vertex of P ({len(V)} vertices, "
+                  f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work > "
+                  f"{MAX_EVAL_WORK}")
+        return None
     incidence: list[list[int]] = []
     for i, ((X, Dv), v) in enumerate(zip(SV, V)):
-        over = False
-        if meter is not None:
-            try:  # the filter, the equalities and the rank
-                _charge(meter, len(Fi) * d, 1)
-                _charge(meter, len(Ei) + d * d, 2 * bits)
-            except _OverBudget:
-                over = True
-        if not over:
-            for j, (a, f) in enumerate(Ei):
-                if _dot(a, X) != f * Dv:
-                    raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
-            fv = _float_vertex(X, Dv) if rows_f is not None else None
-            # facets proved strictly slack by the filter are neither violated nor tight
-            inside = _surely_inside(rows_f, *fv) if fv is not None else [False] * len(Fi)
-            if meter is not None:
-                try:  # the exact slacks the filter leaves
-                    _charge(meter, inside.count(False), 2 * bits)
-                except _OverBudget:
-                    over = True
-        if over:
-            ctx.trust("vertex test", f"vertices: each a vertex of P ({len(V)} vertices, "
-                      f"{len(Ei) + len(Fi)} constraints, {bits}-bit numbers) needs work > "
-                      f"{MAX_EVAL_WORK}")
-            return None
+        for j, (a, f) in enumerate(Ei):
+            if _dot(a, X) != f * Dv:
+                raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates equalities[{j}]")
         on: list[int] = []
-        for j, (a, g) in enumerate(Fi):
-            if inside[j]:
-                continue
+        for j in left[i]:  # the facets not proved strictly slack by the filters
+            a, g = Fi[j]
             s = _dot(a, X) - g * Dv
             if s > 0:
                 raise Invalid(f"vertices[{i}] = {_fmtv(v)} violates facets[{j}]")
@@ -1657,9 +1722,9 @@ def kind_safe_kernel(c: dict, ctx: Any) -> str:
     varr = _array(c["vertices"], "vertices")
     if not varr:
         raise Invalid("vertices is empty (an empty kernel needs kind 'kernel_empty')")
-    if len(varr) > MAX_CONSTRAINTS:
+    if len(varr) > MAX_VERTICES:
         raise Unchecked("size limit", f"vertices: {len(varr)} entries exceed the checker's "
-                        f"limit of {MAX_CONSTRAINTS}")
+                        f"limit of {MAX_VERTICES}")
     V = [_vec(v, f"vertices[{i}]", d) for i, v in enumerate(varr)]
     pos: dict[tuple[int, ...], int] = {}  # keyed by the lowest terms (cheap to hash)
     for i, v in enumerate(V):

@@ -280,3 +280,18 @@ def test_vertex_test_meter_runs_past_the_a_priori_estimate(monkeypatch):
     monkeypatch.setattr(kernels, "VERTEX_FILTERS", False)
     ctx = _Ctx()
     assert kernels._vertices_of_p(Ei, Fi, V, d, ctx) is None and ctx.parts
+
+
+@pytest.mark.slow
+def test_d5_n30_certificates_have_their_polytope_checked():
+    """d = 5, n = 30 (issue 13 §4): cube(F = 1), 7 755 vertices, is valid — its vertex test
+    was beyond the work limit when every facet was filtered at every vertex (the box tree
+    of ``kernels._left_by_filters``); sphere(F = 1), 10 428 vertices, was refused by the
+    size limit of 10 000 vertices — now P = conv(V) is checked (vertex test, skeleton)
+    and only the normal fan's work (V ⊆ Ψ) is beyond its limit."""
+    from rescon_certificates.check import check
+
+    assert check(_bench("cube", 5, 30, 1)).verdict == "valid"
+    r = check(_bench("sphere", 5, 30, 1))
+    assert r.verdict == "unchecked"
+    assert len(r.unchecked) == 1 and "normal fan" in r.unchecked[0], r.unchecked

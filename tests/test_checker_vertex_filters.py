@@ -137,6 +137,78 @@ def test_float_vertex_refuses_out_of_range_coordinates():
     assert kernels._float_rows([([2**601, 1], 0)]) is None
 
 
+@pytest.mark.parametrize("seed", range(8))
+def test_box_tree_drops_only_strictly_slack_facets(seed):
+    """_left_by_filters keeps, per vertex, every facet whose exact slack a·v − g is >= 0
+    (violated or tight): clusters of exact vertices around a centre at 2^-400 .. 2^290
+    scales, with exact zeros, and facets through vertices (tight), just beyond them
+    (violated by 2^-200 relative) and far away (the ones the boxes should drop)."""
+    rng = random.Random(100 + seed)
+    d = rng.choice((2, 3, 4, 5))
+    e = rng.choice((-400, -40, 0, 290))
+    unit = Fraction(2) ** e
+    centre = [Fraction(rng.randint(-2**40, 2**40), 2**40) for _ in range(d)]
+    verts = []
+    for _ in range(rng.choice((5, 40, 200))):
+        v = [(c + Fraction(rng.randint(-2**30, 2**30), 2**50)) * unit for c in centre]
+        if rng.random() < 0.2:
+            v[rng.randrange(d)] = Fraction(0)
+        verts.append(v)
+    rows = []
+    for _ in range(60):
+        a = [Fraction(rng.randint(-2**20, 2**20)) for _ in range(d)]
+        through = verts[rng.randrange(len(verts))]
+        top = max(sum(x * y for x, y in zip(a, v)) for v in verts)
+        g = rng.choice((sum(x * y for x, y in zip(a, through)),  # tight at one, violated at others
+                        top,  # tight at the top vertex
+                        top - abs(top) / 2**200,  # violated by a hair
+                        top + abs(top) / 2**200,  # slack by a hair
+                        top + abs(top) + unit))  # far
+        row = kernels._int_constraint(tuple(a), g)
+        if kernels._float_rows([row]) is not None:  # <= 600-bit entries: filtered
+            rows.append(row)
+    rows_f = kernels._float_rows(rows)
+    SV = [(kernels._int_vector(tuple(v)), kernels._den_lcm([tuple(v)])) for v in verts]
+    fvs = [kernels._float_vertex(X, Dv) for X, Dv in SV]
+    assert len(rows) >= 20 and all(fv is not None for fv in fvs)
+    left = kernels._left_by_filters(rows_f, fvs, len(rows), d, None)
+    dropped = 0
+    for v, kept in zip(verts, left):
+        assert kept == sorted(kept)
+        for j, (a, g) in enumerate(rows):
+            if _exact_sign(a, Fraction(g), v) >= 0:
+                assert j in kept
+            dropped += j not in kept
+    assert dropped > 0
+
+
+def test_box_corners_stay_in_the_filter_range():
+    """A float vertex coordinate is accepted in [2^-599, 2^299] only, so the boxes'
+    corners, one float step outward, stay in [2^-600, 2^300] (_surely_inside's range)."""
+    assert kernels._float_vertex([2**299, 1], 1) is not None
+    assert kernels._float_vertex([2**299 + 2**247, 1], 1) is None
+    assert kernels._float_vertex([1, 1], 2**599) is not None
+    assert kernels._float_vertex([1, 1], 2**600) is None
+    lo, hi = kernels._outward_box([[2.0 ** 299, -(2.0 ** -599), 0.0], [1.0, 2.0 ** -599, 0.0]], 3)
+    assert hi[0] <= 2.0 ** 300 and 2.0 ** -600 <= -lo[1] and 2.0 ** -600 <= hi[1]
+    assert lo[2] == hi[2] == 0.0
+
+
+def test_box_tree_keeps_a_large_vertex_test_within_budget(monkeypatch):
+    """sphere(4, 30, 3), 1583 vertices x 288 facets: the float filter vertex by vertex
+    (no boxes: the test as it was) charges more than 10^6 work, with the box tree the
+    vertex test fits (the normal fan is then what exceeds that budget)."""
+    cert = _bench("sphere", 4, 30, 3)
+    monkeypatch.setattr(kernels, "MAX_EVAL_WORK", 1_000_000)
+    monkeypatch.setattr(kernels, "_LEAF_VERTICES", 10**9)
+    before = check(copy.deepcopy(cert))
+    assert before.verdict == "unchecked" and before.unchecked[0].startswith("vertices: each")
+    monkeypatch.setattr(kernels, "_LEAF_VERTICES", 4)
+    after = check(copy.deepcopy(cert))
+    assert after.verdict == "unchecked"
+    assert not any(u.startswith("vertices: each") for u in after.unchecked), after.unchecked
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_rank_mod_p_is_a_lower_bound(seed):
     """True only when the exact rank is >= d: rank-deficient integer rows with huge
