@@ -24,7 +24,13 @@ a JSON round trip; a few through ``rescon check`` / ``certificates/check.py``):
 * ``check_redundancy``: 240 random piecewise-quadratic families (d <= 3): every exact
   certificate valid. **SolverError instead of an answer** on ``x1``, ``norm2(0*x1, x1)``,
   ``x1^2`` (r = 1; its violation is exact from two point argmins), and on a family whose
-  verdict is found at scale 1 but not after the exact rescaling x -> 1024 x.
+  verdict is found at scale 1 but not after the exact rescaling x -> 1024 x. **A correct
+  certificate called invalid**: agent labels written by str() collide ((1, 2) and
+  "(1, 2)"), "agents has a repeated label".
+* Flat kernels of full-dimensional clouds: **"unchecked" at n = 200 in d = 2** (a
+  one-point kernel of a centrally symmetric cloud): rescon writes a "halfspaces" proof,
+  which for dim < d only (b)'s C(n, d) enumeration can check; a Tverberg proof (pairs
+  ±y) is valid at once. (Within FORMAT.md's stated limit of (b), but avoidable.)
 * ``rescon paper``'s five certificates (slow): valid.
 * The converse: bumping one number or one set member of a valid certificate (safe
   kernel, kernel point, robustness, not-(r, s)-robust, Sarymsakov, redundancy) never
@@ -395,6 +401,22 @@ def test_redundancy_ray_argmin_with_exact_violation():
     rep = rescon.check_redundancy(["x1", "norm2(0*x1, x1)", "x1^2"], 1, d=1)
     assert not rep.holds and rep.exact
     assert _verdicts(rep.certificate) == ("valid", "valid")
+
+
+@pytest.mark.xfail(strict=True, reason="V34: check_redundancy writes agent labels "
+                   "by str(): distinct labels (1, 2) and '(1, 2)' (or 2.5 and '2.5') become "
+                   "a repeated label, and the checker calls the certificate invalid")
+def test_redundancy_labels_that_print_alike():
+    costs = {(1, 2): "(x1 - 1)^2", "(1, 2)": "(x1 + 1)^2", "c": "2*abs(x1)"}
+    rep = rescon.check_redundancy(costs, 1)
+    assert rep.holds and rep.exact  # right: every pair's sum has argmin {0}
+    assert _verdicts(rep.certificate) == ("valid", "valid")  # ("invalid", "invalid")
+
+
+def test_redundancy_labels_of_mixed_types_valid():
+    costs = {1: "(x1 - 1)^2", "1": "(x1 + 1)^2", (2, 3): "2*abs(x1)", 10**30: "x1^2 + abs(x1)"}
+    for r in (1, 2):
+        assert _verdicts(rescon.check_redundancy(costs, r).certificate) == ("valid", "valid")
 
 
 def _scaled(s):
