@@ -280,6 +280,34 @@ def test_time_limit_honoured_serially_with_progress_bar(capsys):
     assert "robustness (n=50)" in capsys.readouterr().err
 
 
+def _sparse_400():
+    G = nx.gnp_random_graph(400, 0.04, seed=1)  # ρ ≥ 2 proven fast; s*(2) ∈ [1, 349]
+    rescon.robustness(nx.cycle_graph(5), time_limit=0.1)  # warm imports
+    return G
+
+
+@pytest.mark.xfail(strict=True, reason="V33: is_rs_robust ignores a 0.05 s time limit for "
+                   "~2.3 s on ER(400, 0.04): _s_star_fresh tries construction_proof for every "
+                   "s from the upper bound (349) down to 2, never checking the deadline "
+                   "(nor the cap)")
+def test_is_rs_robust_time_limit_on_a_sparse_400_node_graph():
+    G = _sparse_400()
+    t0 = time.perf_counter()
+    c = rescon.is_rs_robust(G, 2, 3, time_limit=0.05)
+    assert c.holds in (None, True)
+    assert time.perf_counter() - t0 < 1.0
+
+
+@pytest.mark.xfail(strict=True, reason="V33: max_s(G, 2, time_limit=0.05) takes ~2.5 s on "
+                   "ER(400, 0.04): the same deadline-blind construction loop in _s_star_fresh")
+def test_max_s_time_limit_on_a_sparse_400_node_graph():
+    G = _sparse_400()
+    t0 = time.perf_counter()
+    with pytest.raises(rescon.TimeLimitReached):
+        rescon.max_s(G, 2, time_limit=0.05)
+    assert time.perf_counter() - t0 < 1.0
+
+
 # --------------------------------------------------------------------------- #
 # the bitmask boundary (held)
 # --------------------------------------------------------------------------- #
@@ -425,6 +453,56 @@ def test_tampered_certificates_are_invalid():
     c = copy.deepcopy(no.certificate)
     c["r"] -= 1
     assert rescon.check_certificate(c).verdict == "invalid"
+
+
+def _k_in(n, k, seed):
+    """Each node gets k distinct random in-neighbours."""
+    rng = np.random.default_rng(seed)
+    G = nx.DiGraph()
+    G.add_nodes_from(range(n))
+    for v in range(n):
+        others = [u for u in range(n) if u != v]
+        for u in rng.choice(others, size=k, replace=False):
+            G.add_edge(int(u), v)
+    return G
+
+
+def _trusted_milp_case():
+    """A 3-in digraph (n = 22) whose ρ the MILP proves with a trusted proof that is
+    not replaced by a tree, where a fresh forced search gives a replayable tree."""
+    for seed in range(20):
+        G = _k_in(22, 3, seed)
+        clear_cache()
+        rho = rescon.robustness(G, method="search").r_max
+        clear_cache()
+        if rho >= 1 and rescon.is_r_robust(G, rho, method="milp").proof_method == "milp":
+            return G, rho
+    pytest.skip("no graph whose MILP proof stays trusted")
+
+
+def test_fresh_forced_search_gives_a_valid_certificate():
+    G, rho = _trusted_milp_case()
+    clear_cache()
+    c = rescon.is_r_robust(G, rho, method="search")
+    assert c.holds and c.proof_method in ("search", "cost_search")
+    assert rescon.check_certificate(c.certificate).verdict == "valid"
+
+
+@pytest.mark.xfail(strict=True, reason="V33: a cached trusted MILP proof (facts cache) is "
+                   "returned to a later method='search' call: certificate 'unchecked', "
+                   "method 'bounds', though README says force 'search' for a checkable tree")
+def test_forced_search_after_a_milp_call_still_gives_a_checkable_tree():
+    G, rho = _trusted_milp_case()
+    clear_cache()
+    first = rescon.is_r_robust(G, rho, method="milp")
+    assert first.holds and first.proof_method == "milp"
+    again = rescon.is_r_robust(G, rho, method="search")
+    assert again.holds
+    assert again.proof_method != "milp" and again.method != "bounds"
+    assert rescon.check_certificate(again.certificate).verdict == "valid"
+    rep = rescon.robustness(G, method="search")
+    assert rep.r_max == rho and rep.lower_proof != "milp"
+    assert rescon.check_certificate(rep.certificate).verdict == "valid"
 
 
 # --------------------------------------------------------------------------- #
