@@ -502,7 +502,7 @@ class _Check:
 
     def _head(self, kind: str) -> dict[str, Any]:
         return {"rescon_certificate": 1, "kind": kind, "d": self.d, "r": self.r,
-                "agents": [_label(x) for x in self.labels]}
+                "agents": _labels(self.labels)}
 
     def _costs_json(self) -> list[dict[str, Any] | None]:
         """Every agent's exact cost data; None for costs that are not piecewise
@@ -604,8 +604,21 @@ def _pt(p: np.ndarray | None) -> list[float] | None:
     return None if p is None else [float(v) for v in p]
 
 
-def _label(x: Hashable) -> Any:
-    return x if isinstance(x, (int, str)) and not isinstance(x, bool) else str(x)
+def _labels(labels: list[Hashable]) -> list[int | str]:
+    """The certificate's agent labels, distinct (FORMAT.md; agents are named by
+    position): integers and strings as they are, other labels as str(x), suffixed
+    " #i" (i its position, repeated while taken) when that text is another label's."""
+    plain = [isinstance(x, (int, str)) and not isinstance(x, bool) for x in labels]
+    out: list[Any] = [x if p else None for x, p in zip(labels, plain, strict=True)]
+    taken = {repr(x) for x in out if x is not None}
+    for i, x in enumerate(labels):
+        if out[i] is None:
+            t = str(x)
+            while repr(t) in taken:
+                t = f"{t} #{i}"
+            taken.add(repr(t))
+            out[i] = t
+    return out
 
 
 def _opt_json(opt: _pq.Optimal) -> dict[str, Any]:
