@@ -238,8 +238,8 @@ def test_kernel_points_valid_on_edge_clouds():
             assert _verdicts(cert) == ("valid", "valid"), (kind, d, n, F, m)
 
 
-@pytest.mark.xfail(strict=True, reason="V34: kernel_point(method='chebyshev') raises "
-                   "SolverError on a nonempty, full-dimensional kernel (a thin triangle)")
+# Fixed (was a bug: kernel_point(method='chebyshev') raises SolverError on a nonempty, full-
+# dimensional kernel (a thin triangle))
 def test_chebyshev_thin_triangle_gets_a_point():
     # t·u rounded: three points 1e-16 off a line, Ψ(X, 0) = their (thin) triangle
     X = [[-0.33716824900290865, -0.911031414953656],
@@ -251,8 +251,8 @@ def test_chebyshev_thin_triangle_gets_a_point():
     assert _verdicts(cert) == ("valid", "valid")
 
 
-@pytest.mark.xfail(strict=True, reason="V34: kernel_point(method='chebyshev') raises "
-                   "SolverError on a triangle with columns at 1e-200 and 1e200")
+# Fixed (was a bug: kernel_point(method='chebyshev') raises SolverError on a triangle with columns
+# at 1e-200 and 1e200)
 def test_chebyshev_anisotropic_triangle_gets_a_point():
     X = [[0.0, 0.0], [1e-200, 0.0], [0.0, 1e200]]
     for m in ("project", "vertex-mean"):  # the kernel and its other points are fine

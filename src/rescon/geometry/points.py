@@ -7,7 +7,8 @@
   x ∈ Ψ exactly (KKT). If the guess fails, active sets are enumerated exactly.
   The answer is therefore the same for every backend.
 * ``"chebyshev"``: the centre of the largest ball in Ψ within aff Ψ (LP, floats: Clarabel
-  for "auto", HiGHS where it fails), moved exactly onto aff Ψ and certified inside.
+  for "auto", HiGHS where it fails; a full-dimensional Ψ too thin for its unit frame in
+  its principal frame), moved exactly onto aff Ψ and certified inside.
 * ``"vertex-mean"``: the exact mean of Ψ's vertices.
 """
 
@@ -361,6 +362,12 @@ CHEBYSHEV_AUTO = ("clarabel", "highs")
 
 
 def _chebyshev(K: SafeKernel, backend: str) -> Vec:
+    """The Chebyshev centre from a backend's LP in Ψ's unit frame (:func:`_frame`),
+    moved onto aff Ψ and certified inside (pulled towards the vertex mean if rounding
+    left it on the boundary).  With ``backend="auto"``, a full-dimensional Ψ the unit
+    frame cannot resolve — thinner there than the solvers' tolerances, or narrower than
+    the float range allows beside its extent — is solved again in its principal frame
+    (:func:`_principal_chebyshev`)."""
     from ..models.kernel_models import chebyshev
 
     ex = K._exact
@@ -368,24 +375,85 @@ def _chebyshev(K: SafeKernel, backend: str) -> Vec:
         return ex.vertices[0]
     o, e = _frame(K)
     framed = _framed(K, o, e)[:4]
-    if backend == "auto":  # Clarabel, else HiGHS (its point is certified below either way)
-        try:
-            centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[0])
-        except SolverError:
-            centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[1])
-    else:
-        centre, _ = chebyshev(*framed, backend=backend)
-    centre = _from_frame(centre, o, e)
-    x = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre))
-    if ex.contains(x):
+    try:
+        if backend == "auto":  # Clarabel, else HiGHS (its point is certified below either way)
+            try:
+                centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[0])
+            except SolverError:
+                centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[1])
+        else:
+            centre, _ = chebyshev(*framed, backend=backend)
+        centre = _from_frame(centre, o, e)
+        x = _inside(K, _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre)))
+    except SolverError:
+        if backend != "auto" or K.dim < len(o):
+            raise
+        x = None
+    if x is None and backend == "auto" and K.dim == len(o):
+        x = _principal_chebyshev(K, o)
+    if x is None:
+        raise SolverError("the Chebyshev centre returned by the backend is not in the kernel")
+    return x
+
+
+def _inside(K: SafeKernel, x: Vec) -> Vec | None:
+    """x if it is in Ψ, else the first point of Ψ on the way from x to the vertex mean
+    (a centre on the boundary up to rounding), else None."""
+    if K._exact.contains(x):
         return x
-    # a centre on the boundary up to rounding: pull it towards the vertex mean
     vm = _vertex_mean(K)
     for t in (Fraction(1, 10**12), Fraction(1, 10**6), Fraction(1, 1000), Fraction(1, 2)):
         y = tuple((1 - t) * a + t * b for a, b in zip(x, vm, strict=True))
-        if ex.contains(y):
+        if K._exact.contains(y):
             return y
-    raise SolverError("the Chebyshev centre returned by the backend is not in the kernel")
+    return None
+
+
+def _principal_chebyshev(K: SafeKernel, o: np.ndarray) -> Vec | None:
+    """A Chebyshev centre of a full-dimensional Ψ from the margin LP (HiGHS) in its
+    principal frame x = o + Σ_j z_j s_j u_j: u_j the principal axes of Ψ's float vertices
+    (exact as floats, orthonormal up to rounding), s_j Ψ's exact extent max |u_j·(v − o)|
+    along u_j, so Ψ fills about [−1, 1]^d in z however thin or anisotropic it is in x.
+    A facet a·x ≤ β and a ball of radius r = s ρ (s = min s_j) in x read
+
+        Σ_j (s_j a·u_j) z_j + s‖a‖ ρ ≤ β − a·o,
+
+    each row computed exactly from the exact facet and divided by its largest entry
+    λ = max_j |s_j a·u_j| before rounding (s‖a‖/λ ≤ √d·(1 + rounding): some |a·u_j| ≥
+    ‖a‖/√d).  The point o + Σ z_j s_j u_j is formed exactly and certified as in
+    :func:`_chebyshev`; None if the LP has no optimum or no point is certified."""
+    from ._lp import max_margin
+
+    ex = K._exact
+    D, _, _ = _offsets(K, o)
+    axes = np.linalg.svd(D, full_matrices=False)[2]
+    of = [Fraction(float(v)) for v in o]
+    U = [[Fraction(float(t)) for t in u] for u in axes]
+    diffs = [[v - w for v, w in zip(x, of, strict=True)] for x in ex.vertices]
+    ext = [max(abs(_dot(u, df)) for df in diffs) for u in U]
+    if not all(ext):
+        return None
+    s = min(ext)
+    rows, rhs, w = [], [], []
+    for a, beta in ex.facets:
+        g = [sj * _dot(a, u) for sj, u in zip(ext, U, strict=True)]
+        lam = max(map(abs, g))
+        top = max(map(abs, a))
+        if not lam:
+            return None
+        rows.append([float(t / lam) for t in g])
+        rhs.append(_float((beta - _dot(a, of)) / lam))
+        w.append(float(s * top / lam) * math.hypot(*(float(t / top) for t in a)))
+    d = len(of)
+    with np.errstate(divide="ignore"):  # w = 0 (a ball negligible beside λ): slack / 0 = ±inf
+        found = max_margin(np.array(rows), np.array(rhs), np.array(w), np.full(d, -2.0),
+                           np.full(d, 2.0))
+    if found is None or not found.t > 0:
+        return None
+    z = [Fraction(float(t)) for t in found.x]
+    x = tuple(oi + sum(zj * sj * u[i] for zj, sj, u in zip(z, ext, U, strict=True))
+              for i, oi in enumerate(of))
+    return _inside(K, x)
 
 
 def _onto_hull(eqs, x: Vec) -> Vec:
