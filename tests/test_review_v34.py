@@ -403,9 +403,8 @@ def test_redundancy_ray_argmin_with_exact_violation():
     assert _verdicts(rep.certificate) == ("valid", "valid")
 
 
-@pytest.mark.xfail(strict=True, reason="V34: check_redundancy writes agent labels "
-                   "by str(): distinct labels (1, 2) and '(1, 2)' (or 2.5 and '2.5') become "
-                   "a repeated label, and the checker calls the certificate invalid")
+# Fixed (was a bug: check_redundancy writes agent labels by str(): distinct labels (1, 2) and '(1,
+# 2)' (or 2.5 and '2.5') become a repeated label, and the checker calls the certificate invalid)
 def test_redundancy_labels_that_print_alike():
     costs = {(1, 2): "(x1 - 1)^2", "(1, 2)": "(x1 + 1)^2", "c": "2*abs(x1)"}
     rep = rescon.check_redundancy(costs, 1)
