@@ -21,9 +21,17 @@ here (every pair of disjoint nonempty node sets, numpy over bitmasks, n ≤ 13):
 * the CLI: exactly one JSON object with the README's keys in each mode, exit 2 on bad
   arguments, no certificate file when the time limit leaves the answer open.
 
-Held almost everywhere (about 600 graphs, every method, in scratch fuzzing). Two bugs:
-a numpy complex time limit is accepted (its imaginary part silently dropped), and with
-``workers=N`` a time-limited call can return long after its limit (slow, timing-based).
+Every exact answer held (about 700 graphs, every method, in scratch fuzzing; the
+generators' ``G.graph["rho"]`` too, n ≤ 12). Bugs (strict xfails):
+
+* ``is_rs_robust`` / ``max_s`` overrun a 0.05 s time limit by seconds on ER(400, 0.04):
+  ``_s_star_fresh`` tries ``construction_proof`` for every s from the upper bound down
+  to 2 without looking at the deadline (or at ``cap``);
+* a trusted MILP proof cached by an earlier call is handed to a later
+  ``method="search"`` call (certificate not fully checkable, ``method`` "bounds"),
+  though a fresh forced search gives a replayable tree;
+* a numpy complex time limit is accepted (its imaginary part silently dropped);
+* with ``workers=N`` a time-limited call returns seconds after its limit (slow).
 """
 
 from __future__ import annotations
@@ -562,4 +570,4 @@ def test_workers_time_limit_is_honoured():
     rep = rescon.robustness(G, time_limit=4.0, workers=1)
     wall = time.perf_counter() - t0
     assert rep.r_max == 2 and not rep.exact
-    assert wall < 4.0 + 3.0
+    assert wall < 4.0 + 1.5
