@@ -50,7 +50,12 @@ all coincide): the same verdict wherever the costs sit and whatever the unit of 
 a power of two). The level sets' slack is relative to the sum's values: F_S is divided
 by V, the power of two nearest max_j |F_S(c ± s·e_j) − F_S(c)| (its variation over the
 frame; 1 when that is 0), before solving, so scaling the costs' values changes
-nothing. CVXPY solves in the same frame as
+nothing; each cost enters as f_i/κ_i with weight κ_i/V (κ_i the power of two nearest
+its largest |value| at y = 0, ±e_j; the division done on its data where f_i is
+positively homogeneous in them), so that after a power-of-two change of units
+(f ↦ t·f(x/t), or values times t) Clarabel solves the very same numbers and the
+verdict, gap and tolerance scale exactly. Clarabel is retried with other settings
+(``RETRIES``) when it stalls. CVXPY solves in the same frame as
 Clarabel (x = c + s·y, the atoms' data transformed exactly; Huber rows and log-sum-exp
 pieces count as kinks for c and s), so costs far from the origin are solved at unit
 scale. The ``gap`` is then the largest of them — a lower bound on the
@@ -83,6 +88,9 @@ LEVEL_TOL = 1e-10  # numerical supports: on {F/V ≤ F*/V + LEVEL_TOL (1 + |F*/V
 # quadratic bottom then widens each set by ~1e-5·s, well inside REL_TOL·s
 MAX_PAIRS = 5_000  # pairs of certified subsets tried for an exact witness
 ZOOMS = 3  # re-solves centred at an uncertified solution, each 2^20 times finer
+RETRIES = ({}, {"equilibrate_enable": False}, {"static_regularization_enable": False})
+# Clarabel's settings on the numerical path, tried in turn while it fails (thin level
+# sets and unbounded supports can stall its default settings: InsufficientProgress)
 
 
 @dataclass(frozen=True)
@@ -102,8 +110,9 @@ class RedundancyReport:
         ones, the support values in the direction where they differ most. None if holds.
     gap : the largest distance found between a subset's argmin and the whole set's
         (inf when exactly one of them is empty, or past the float range): the ε of
-        (r, ε)-redundancy. Exact witness values past the float range are ±inf (the
-        certificate holds them exactly)
+        (r, ε)-redundancy; nan for an exact violation whose numerical gap Clarabel
+        could not compute (the verdict does not depend on it). Exact witness values
+        past the float range are ±inf (the certificate holds them exactly)
     unbounded : the (N − r)-subsets whose sum has no minimiser (tuples of labels)
     unbounded_agents : the agents whose cost alone has no minimiser
     tolerance : of a numerical verdict (None when exact)
@@ -329,14 +338,19 @@ class _Check:
         unbounded = tuple(tuple(self.labels[i] for i in s.members) for s in subs
                           if s.status == "unbounded")
         nonempty = [s for s in subs if s.status != "unbounded"]
-        gaps = [0.0 if s.status == "unbounded" and ref.status == "unbounded"
-                else math.inf if "unbounded" in (s.status, ref.status)
-                else self.gap(s, ref) for s in subs]
-        gap = max(gaps, default=0.0) if nonempty else 0.0
         odd = [s for s in subs if not self.equal(s, subs[0])]
+        wit = self.exact_witness(odd, subs, ref) if odd else None
+        try:
+            gaps = [0.0 if s.status == "unbounded" and ref.status == "unbounded"
+                    else math.inf if "unbounded" in (s.status, ref.status)
+                    else self.gap(s, ref) for s in subs]
+        except SolverError:
+            if wit is None:
+                raise
+            gaps = [math.nan]  # a proven violation does not wait for the numerical gap
+        gap = max(gaps, default=0.0) if nonempty else 0.0
         if not odd:  # every subset certified and equal to the first: the definition
             return self.report(True, True, None, gap, unbounded, alone, subs=subs)
-        wit = self.exact_witness(odd, subs, ref)
         if wit is not None:
             return self.report(False, True, wit, gap, unbounded, alone)
         tol = self.tolerance(subs + [ref])
@@ -847,7 +861,13 @@ class _Cvx:
         self.c = np.array([float(v) for v in self.cq])
         self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)  # y
         self.w = cp.Parameter(len(oracles), nonneg=True)
-        self.terms = [_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s)) for o in oracles]
+        raw = [_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s)) for o in oracles]
+        self.grid = self._grid(raw)  # each cost at y = 0, ±e_j (_variation)
+        with np.errstate(all="ignore"):
+            top = np.abs(self.grid).max(axis=0, initial=0.0)
+        self.unit = [_pow2(v) if 0 < v < math.inf else Fraction(1) for v in top]
+        self.terms = [_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s), k)
+                      for o, k in zip(oracles, self.unit, strict=True)]
         F = sum(self.w[i] * t for i, t in enumerate(self.terms))
         self.u, self.level = cp.Parameter(d), cp.Parameter()
         self.p = cp.Parameter(d)
@@ -857,42 +877,53 @@ class _Cvx:
         self.fstar: dict[tuple[int, ...], float] = {}
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
         self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
-        self.grid: np.ndarray | None = None  # each cost at y = 0, ±e_j (_variation)
         self.posed: tuple[int, ...] | None = None  # whose weights and level are set
 
     def _solve(self, problem: Any) -> None:
-        """problem.solve by Clarabel; its status is read by the caller ("inaccurate"
-        warnings are dropped: the verdict is numerical anyway), CVXPY's own SolverError
-        becomes rescon's."""
+        """problem.solve by Clarabel with the settings of RETRIES in turn until it ends
+        optimal or unbounded (its status is then read by the caller; "inaccurate"
+        warnings are dropped: the verdict is numerical anyway); SolverError when no
+        setting gets there."""
+        why = ""
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
-            try:
-                problem.solve(solver="CLARABEL")
-            except self.cp.error.SolverError as e:
-                raise SolverError(f"Clarabel failed on the numerical path: {e}") from None
+            for opts in RETRIES:
+                try:
+                    problem.solve(solver="CLARABEL", **opts)
+                except self.cp.error.SolverError as e:
+                    why = str(e)
+                    continue
+                if problem.status in _DECIDED:
+                    return
+                why = f"status {problem.status}"
+        raise SolverError(f"Clarabel failed on the numerical path: {why}")
 
     def _weights(self, members: tuple[int, ...]) -> None:
-        """Weights 1/V on ``members`` (0 elsewhere), V the power of two nearest the sum's
-        variation over the frame, max_j |F(±e_j) − F(0)| in y (1 when 0 or not finite):
-        the solved sum has values of order 1 whatever the costs' unit, so Clarabel's
-        tolerances and the level sets' slack are relative to the costs' values."""
+        """Weights κ_i/V on ``members`` (0 elsewhere; each term is f_i/κ_i, κ_i its
+        ``unit``), V the power of two nearest the sum's variation over the frame,
+        max_j |F(±e_j) − F(0)| in y (1 when 0 or not finite): the solved sum is F/V,
+        of order 1 whatever the costs' unit, so Clarabel's tolerances and the level
+        sets' slack are relative to the costs' values."""
         if members not in self.scales:
             self.scales[members] = self._variation(members)
         w = np.zeros(self.w.size)
-        w[list(members)] = 1.0 / self.scales[members]
+        w[list(members)] = [float(self.unit[i] / Fraction(self.scales[members]))
+                            for i in members]
         self.w.value = w
         self.posed = None  # the level is not set for these weights
 
+    def _grid(self, terms: list[Any]) -> np.ndarray:
+        """Each term's value at y = 0, ±e_j (rows)."""
+        d = self.x.shape[0]
+        rows = []
+        for y in [np.zeros(d), *np.eye(d), *-np.eye(d)]:
+            self.x.value = y
+            rows.append([_value(t) for t in terms])
+        self.x.value = None
+        return np.array(rows, dtype=float).reshape(2 * d + 1, len(terms))
+
     def _variation(self, members: tuple[int, ...]) -> float:
-        """V of :meth:`_weights` from each cost's values at y = 0, ±e_j (computed once)."""
-        if self.grid is None:
-            d = self.x.shape[0]
-            rows = []
-            for y in [np.zeros(d), *np.eye(d), *-np.eye(d)]:
-                self.x.value = y
-                rows.append([_value(t) for t in self.terms])
-            self.x.value = None
-            self.grid = np.array(rows, dtype=float)
+        """V of :meth:`_weights` from each cost's values at y = 0, ±e_j."""
         with np.errstate(all="ignore"):
             F = self.grid[:, list(members)].sum(axis=1)
             v = float(np.abs(F[1:] - F[0]).max())
@@ -907,10 +938,7 @@ class _Cvx:
         self._solve(self.pmin)
         if self.pmin.status in ("unbounded", "unbounded_inaccurate"):
             return "unbounded", None
-        if self.pmin.status not in ("optimal", "optimal_inaccurate"):
-            raise SolverError(f"Clarabel could not minimise the sum of agents {members}: "
-                              f"{self.pmin.status}")
-        at = sum(_value(self.terms[i]) for i in members) / self.scales[members]
+        at = sum(self.w.value[i] * _value(self.terms[i]) for i in members)
         self.fstar[members] = max(float(self.pmin.value), at)  # F(x*) ≥ min F: a level
         self.offsets[members] = off = self._offset()
         return "optimal", self.c + off
@@ -938,9 +966,6 @@ class _Cvx:
         self._solve(self.psup)
         if self.psup.status in ("unbounded", "unbounded_inaccurate"):
             return math.inf, None, None
-        if self.psup.status not in ("optimal", "optimal_inaccurate"):
-            raise SolverError(f"Clarabel could not compute a support value of agents "
-                              f"{members}: {self.psup.status}")
         h = (_pq._dot([Fraction(float(v)) for v in u], self.cq)
              + Fraction(self.s) * Fraction(float(self.psup.value)))
         return _float(h), self.c + self._offset(), h
@@ -956,6 +981,9 @@ class _Cvx:
             raise SolverError(f"Clarabel could not compute a distance to the argmin of "
                               f"agents {members}: {self.pdist.status}")
         return self.s * float(self.pdist.value), self.c + self._offset()
+
+
+_DECIDED = ("optimal", "optimal_inaccurate", "unbounded", "unbounded_inaccurate")
 
 
 def _value(e: Any) -> float:
@@ -978,42 +1006,47 @@ def _grad_parts(o: Any) -> Iterator[Any]:
         yield from _grad_parts(o.term)
 
 
-def _to_cvxpy(cp: Any, o: Any, y: Any, c: list[Fraction], s: Fraction) -> Any:
-    """The CVXPY expression of an atom tree at x = c + s·y up to a constant (none is
-    kept: F* and the level sets do not depend on where the origin is), its data
-    transformed exactly before rounding (the rows' A ↦ sA, b ↦ b ∓ Ac; a quadratic
-    ½(x − m)ᵀQ(x − m) + qᵀx ↦ ½ s² yᵀQy + s(Q(c − m) + q)ᵀy; an affine aᵀx ↦ s aᵀy):
-    no cancellation of computing c + s·y in floats. A CVXPY
+def _to_cvxpy(cp: Any, o: Any, y: Any, c: list[Fraction], s: Fraction,
+              k: Fraction = Fraction(1)) -> Any:
+    """The CVXPY expression of an atom tree at x = c + s·y, divided by k (a power of two),
+    up to a constant (none is kept: F* and the level sets do not depend on where the
+    origin is), its data transformed exactly before rounding (the rows' A ↦ sA/k,
+    b ↦ (b ∓ Ac)/k for the positively homogeneous |·|, norms, hinge and max; a quadratic
+    ½(x − m)ᵀQ(x − m) + qᵀx ↦ (½ s² yᵀQy + s(Q(c − m) + q)ᵀy)/k; an affine aᵀx ↦
+    s aᵀy/k; Huber, log-sum-exp and ``.grad`` summands times 1/k): no cancellation of
+    computing c + s·y in floats, and data of order 1 when k is the term's size. A CVXPY
     summand evaluated by ``.grad`` is used as is when it is written in ``y`` (every CVXPY
     cost in one Variable of shape (d,), frame (0, 1)). InputError for other oracles."""
     from . import atoms
     from .cvxpy_adapter import CvxpyGradOracle
 
     if isinstance(o, CvxpyGradOracle) and o.x is y:
-        return o.expr
+        return float(1 / k) * o.expr
 
     def arr(v: Any) -> np.ndarray:
         return np.array(v, dtype=float)
 
     if isinstance(o, atoms.Sum):
-        return sum(_to_cvxpy(cp, t, y, c, s) for t in o.terms)
+        return sum(_to_cvxpy(cp, t, y, c, s, k) for t in o.terms)
     if isinstance(o, atoms.Scaled):
-        return o.coef * _to_cvxpy(cp, o.term, y, c, s)
+        return o.coef * _to_cvxpy(cp, o.term, y, c, s, k)
     if isinstance(o, atoms.MaxOf):
-        return cp.maximum(*[_to_cvxpy(cp, t, y, c, s) for t in o.terms])
+        return cp.maximum(*[_to_cvxpy(cp, t, y, c, s, k) for t in o.terms])
     ex = getattr(o, "exact", None)
     if isinstance(o, atoms.Quadratic):
-        Q = arr([[s * s * v for v in row] for row in ex["Q"]])
+        Q = arr([[s * s * v / k for v in row] for row in ex["Q"]])
         shift = [a - b for a, b in zip(c, ex["c"], strict=True)]
-        q = arr([s * (_pq._dot(row, shift) + qi) for row, qi in zip(ex["Q"], ex["q"],
-                                                                  strict=True)])
+        q = arr([s * (_pq._dot(row, shift) + qi) / k
+                 for row, qi in zip(ex["Q"], ex["q"], strict=True)])
         return (0.5 * cp.quad_form(y, cp.psd_wrap(Q)) if Q.any() else 0) + q @ y
     if isinstance(o, atoms.Affine):
-        return arr([s * v for v in ex["a"]]) @ y
+        return arr([s * v / k for v in ex["a"]]) @ y
     if isinstance(o, atoms._Rows):  # r = A x ∓ b = sA y + (Ac ∓ b)
-        A = arr([[s * v for v in row] for row in ex["A"]])
+        smooth = isinstance(o, (atoms.Huber, atoms.LogSumExp))  # not homogeneous in r
+        kr = Fraction(1) if smooth else k
+        A = arr([[s * v / kr for v in row] for row in ex["A"]])
         sign = 1 if o.pieces else -1
-        r = A @ y + arr([_pq._dot(row, c) + sign * bi
+        r = A @ y + arr([(_pq._dot(row, c) + sign * bi) / kr
                          for row, bi in zip(ex["A"], ex["b"], strict=True)])
         maps = {atoms.AbsAffine: lambda r: cp.abs(r[0]), atoms.Norm1: cp.norm1,
                 atoms.Norm2: lambda r: cp.norm(r, 2), atoms.NormInf: cp.norm_inf,
@@ -1021,7 +1054,7 @@ def _to_cvxpy(cp: Any, o: Any, y: Any, c: list[Fraction], s: Fraction) -> Any:
                 atoms.LogSumExp: cp.log_sum_exp,
                 atoms.Huber: lambda r: cp.sum(cp.huber(r, o.M))}
         if type(o) in maps:
-            return maps[type(o)](r)
+            return float(kr / k) * maps[type(o)](r)
     raise InputError(f"{o.name}: check_redundancy needs costs built of atoms (an expression "
                      f"string, atoms) or CVXPY expressions in one Variable of shape (d,); "
                      f"got a {o.kind} oracle")

@@ -1,0 +1,80 @@
+"""R9: check_redundancy after V34 — exact violations that do not wait for the numerical
+path, agent labels that print alike, and numerical verdicts that do not depend on the
+scale (powers of two)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+import rescon
+from rescon.errors import SolverError
+from rescon.optim import redundancy
+
+
+def _verdicts(cert):
+    return (rescon.check_certificate(cert).verdict,
+            rescon.check_certificate(json.loads(json.dumps(cert))).verdict)
+
+
+def test_ray_argmin_exact_violation():
+    # {x1, x1^2}: argmin {-1/2}, {norm2(0*x1, x1), x1^2}: argmin {0}, both certified;
+    # {x1, norm2(0*x1, x1)} = x1 + |x1|: argmin (-inf, 0] (Clarabel stalls on its
+    # support in −e1 instead of saying unbounded)
+    rep = rescon.check_redundancy(["x1", "norm2(0*x1, x1)", "x1^2"], 1, d=1)
+    assert not rep.holds and rep.exact
+    assert rep.gap > 1  # (-inf, 0] is at infinite distance from {0}: a lower bound
+    assert _verdicts(rep.certificate) == ("valid", "valid")
+
+
+def test_exact_violation_survives_a_failing_numerical_gap(monkeypatch):
+    def fail(*_a, **_k):
+        raise SolverError("Clarabel failed on the numerical path")
+
+    monkeypatch.setattr(redundancy._Cvx, "support", fail)
+    rep = rescon.check_redundancy(["x1", "norm2(0*x1, x1)", "x1^2"], 1, d=1)
+    assert not rep.holds and rep.exact and math.isnan(rep.gap)
+    assert _verdicts(rep.certificate) == ("valid", "valid")
+
+
+@pytest.mark.parametrize("pair", [((1, 2), "(1, 2)"), (2.5, "2.5"), (None, "None")])
+def test_labels_that_print_alike(pair):
+    a, b = pair
+    costs = {a: "(x1 - 1)^2", b: "(x1 + 1)^2", "c": "2*abs(x1)"}
+    for r, holds in ((1, True), (2, False)):
+        rep = rescon.check_redundancy(costs, r)
+        assert (rep.holds, rep.exact) == (holds, True)
+        assert _verdicts(rep.certificate) == ("valid", "valid")
+
+
+def test_labels_written_distinct():
+    # integers and strings as they are; others as str(x), " #i" (position) when taken
+    costs = {"(1, 2)": "x1^2", (1, 2): "x1^2", "(1, 2) #1": "x1^2", 2.5: "x1^2", 3: "x1^2"}
+    cert = rescon.check_redundancy(costs, 1).certificate
+    assert cert["agents"] == ["(1, 2)", "(1, 2) #1 #1", "(1, 2) #1", "2.5", 3]
+    assert _verdicts(cert) == ("valid", "valid")
+
+
+def _scaled(s):
+    return [f"abs((0)*x1 - ({-2 * s}))", f"norm2((1)*x1 - ({2 * s}), (-0.25)*x1 - ({2 * s}))",
+            f"norm2((1)*x1 - ({2 * s}), (-0.25)*x1 - ({2 * s}))", f"abs(x1 - ({s}))"]
+
+
+@pytest.mark.slow
+def test_numerical_verdict_scale_free():
+    base = rescon.check_redundancy(_scaled(1), 1, d=1)
+    assert (base.holds, base.exact) == (False, False)
+    assert rescon.check_certificate(base.certificate).verdict == "unchecked"
+    for e in range(-20, 21):
+        s = 2.0**e
+        rep = rescon.check_redundancy(_scaled(s), 1, d=1)
+        assert (rep.holds, rep.exact) == (base.holds, base.exact), e
+        assert rep.gap == base.gap * s and rep.tolerance == base.tolerance * s, e
+
+
+def test_numerical_verdict_scale_free_at_1024():
+    base, big = (rescon.check_redundancy(_scaled(s), 1, d=1) for s in (1, 1024))
+    assert (big.holds, big.exact) == (base.holds, base.exact) == (False, False)
+    assert big.gap == base.gap * 1024
