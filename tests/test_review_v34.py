@@ -392,9 +392,8 @@ def test_redundancy_exact_certificates_valid():
         assert _verdicts(rep.certificate) == ("valid", "valid"), costs
 
 
-@pytest.mark.xfail(strict=True, reason="V34: check_redundancy raises SolverError (an "
-                   "unbounded support on the numerical path) although two exact point "
-                   "argmins already refute 1-redundancy")
+# Fixed (was a bug: check_redundancy raises SolverError (an unbounded support on the numerical path)
+# although two exact point argmins already refute 1-redundancy)
 def test_redundancy_ray_argmin_with_exact_violation():
     # {x1, x1^2}: argmin {-1/2}; {norm2(0*x1, x1), x1^2}: argmin {0} — both certified;
     # {x1, norm2(0*x1, x1)} = x1 + |x1|: argmin (-inf, 0], on the numerical path
@@ -423,8 +422,8 @@ def _scaled(s):
             f"norm2((1)*x1 - ({2 * s}), (-0.25)*x1 - ({2 * s}))", f"abs(x1 - ({s}))"]
 
 
-@pytest.mark.xfail(strict=True, reason="V34: check_redundancy's numerical verdict "
-                   "depends on the scale: f(x / 1024)·1024 ends in SolverError")
+# Fixed (was a bug: check_redundancy's numerical verdict depends on the scale: f(x / 1024)·1024 ends
+# in SolverError)
 def test_redundancy_verdict_scale_free():
     base = rescon.check_redundancy(_scaled(1), 1, d=1)
     assert (base.holds, base.exact) == (False, False)
