@@ -43,6 +43,7 @@ __all__ = [
     "degree_r",
     "is_complete",
     "construction_proof",
+    "best_construction",
     "greedy_cliques",
     "greedy_order",
     "s_candidates",
@@ -284,9 +285,12 @@ def tabu_pairs(ig: IndexedGraph, r: int, *, floor: int = 0, below: int | None = 
     walks (one of the two must be given; seeded, so reproducible when only ``draws``
     is), on reaching cost ``floor`` (a proven lower bound, or 0: a pair of cost 0
     refutes r-robustness) or after ``TABU_PATIENCE`` walks in a row without a cheaper
-    pair. Every returned pair's cost bounds s*(r) from above."""
+    pair. Every returned pair's cost bounds s*(r) from above. Past ``deadline`` from the
+    start: none, and nothing compiled (a cold compile takes ~1 s)."""
     if deadline is None and draws is None:
         raise ValueError("tabu_pairs needs a deadline or a number of draws")
+    if deadline is not None and time.perf_counter() >= deadline:
+        return []
     pair_walk = compiled_walk()
     rng = random.Random(seed)
     out = _out_lists(ig)
@@ -445,12 +449,16 @@ def greedy_cliques(ig: IndexedGraph, *, limit: int = 32) -> list[list[int]]:
     return cliques
 
 
-def closure_order(ig: IndexedGraph, seed: list[int], threshold: int) -> list[int] | None:
+def closure_order(ig: IndexedGraph, seed: list[int], threshold: int, *,
+                  out: list[list[int]] | None = None) -> list[int] | None:
     """Order extending ``seed`` in which every later node has ≥ threshold in-neighbours
     among the earlier ones, or None if some node can never be added. The closure is
-    unique (adding nodes only raises counts), so greedy is exact. O(|E|)."""
+    unique (adding nodes only raises counts), so greedy is exact; an order for
+    ``threshold`` is one for every lower threshold. O(|E|) (``out``: the out-neighbour
+    lists, when the caller has them)."""
     n = ig.n
-    out = _out_lists(ig)
+    if out is None:
+        out = _out_lists(ig)
     placed = [False] * n
     count = [0] * n
     order = list(seed)
@@ -483,10 +491,44 @@ def construction_proof(
     """
     if seeds is None:
         seeds = greedy_cliques(ig)
+    return _construction(ig, r, s, seeds, _out_lists(ig))
+
+
+def best_construction(
+    ig: IndexedGraph, r: int, high: int, *, seeds: list[list[int]],
+    deadline: float | None = None,
+) -> tuple[int, Proof] | None:
+    """(s, :func:`construction_proof` of (r, s)-robustness) for the largest s ≤ ``high``
+    (s ≥ 2) it proves, or None.
+
+    Bisection over s: a seed's closure under r + s − 1 is complete for s only if it is
+    for every smaller s (closure_order), so "some seed closes" is monotone in s, and
+    the answer and its proof (the first seed that closes at that s) are those of trying
+    every s from ``high`` down; O(log(high) · |seeds| · |E|). When ``deadline`` passes
+    between two probes, the best s proven so far (a true lower bound, not always the
+    largest)."""
+    out = _out_lists(ig)
+    best: tuple[int, Proof] | None = None
+    lo, hi = 2, high  # the largest s lies in [lo − 1, hi] (lo − 1: none, or best's)
+    while lo <= hi:
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        mid = (lo + hi) // 2
+        proof = _construction(ig, r, mid, seeds, out)
+        if proof is None:
+            hi = mid - 1
+        else:
+            best, lo = (mid, proof), mid + 1
+    return best
+
+
+def _construction(ig: IndexedGraph, r: int, s: int, seeds: list[list[int]],
+                  out: list[list[int]]) -> Proof | None:
+    """:func:`construction_proof` with the seeds and out-neighbour lists given."""
     for clique in seeds:
         if len(clique) < 2 * r - 1:
             break
-        order = closure_order(ig, clique, r + s - 1)
+        order = closure_order(ig, clique, r + s - 1, out=out)
         if order is not None:
             return {
                 "method": "construction",

@@ -20,6 +20,11 @@ r = r' − 1 (``(r', s') ⇒ (r' − 1, s' + 1)``). Hence s*(r) ≥ s*(r') + r' 
 Refutation: a pair violating (r, s) violates every (r'', s'') with r'' ≥ r, s'' ≥ s
 (reach_r'' ⊆ reach_r, so the sets stay not fully reachable and the count only drops).
 
+A cached proof answers a call that forces an exact method (``method`` other than
+"auto") only when the checker can verify it, or when the parts it would take on trust
+(:func:`trusted_methods`) are that method's own: a forced "search" gets a replayable
+tree, not an earlier call's MILP proof.
+
 Facts are stored per :class:`IndexedGraph` (its node labels, their types and its
 in-neighbour sets: an exact fingerprint; any edit of the graph gives another key),
 in a least-recently-used cache of ``CACHE_SIZE`` graphs.
@@ -33,10 +38,13 @@ from collections.abc import Hashable
 from dataclasses import dataclass, field
 from typing import Any
 
+from rescon_certificates.check import MAX_ENUM_N
+
 from . import bounds as bd
 from .indexed import IndexedGraph
 
-__all__ = ["Facts", "facts_for", "implied_s", "implied_proof", "clear_cache", "CACHE_SIZE"]
+__all__ = ["Facts", "facts_for", "implied_s", "implied_proof", "trusted_methods",
+           "clear_cache", "CACHE_SIZE"]
 
 CACHE_SIZE = 32
 MAX_PAIRS = 64
@@ -61,6 +69,35 @@ def implied_proof(r: int, s: int, r2: int, s2: int, proof: Proof) -> Proof:
     return {"method": "implied", "r": r2, "s": s2, "proof": proof}
 
 
+# the proof methods each forced ``method`` produces (robustness.METHODS)
+_OWN_METHODS = {"search": {"search", "cost_search"}, "milp": {"milp"}, "dp": {"dp"}}
+
+
+def trusted_methods(proof: Proof, n: int) -> set[str]:
+    """The methods of the parts of ``proof`` (on an n-node graph) that the checker
+    takes on trust (certificates/check.py): ``milp``, ``dp``, and ``search`` or
+    ``cost_search`` without a recorded tree, on more than ``MAX_ENUM_N`` nodes (up to
+    that, the checker re-verifies them by enumeration), nested in ``implied`` proofs and
+    ``construction`` seeds (on ``seed_size`` nodes) included. Not seen here: a recorded
+    tree beyond the checker's replay limits."""
+    method = proof.get("method")
+    if method == "implied":
+        return trusted_methods(proof["proof"], n)
+    if method == "construction":
+        return trusted_methods(proof["seed_proof"], proof["seed_size"])
+    untreed = method in ("search", "cost_search") and proof.get("tree") is None \
+        and proof.get("charged_tree") is None
+    if n > MAX_ENUM_N and (method in ("milp", "dp") or untreed):
+        return {method}
+    return set()
+
+
+def _usable(proof: Proof, n: int, method: str) -> bool:
+    """May a cached ``proof`` answer a call with ``method``? Always under "auto"; under a
+    forced method, when every part taken on trust is that method's own."""
+    return method == "auto" or trusted_methods(proof, n) <= _OWN_METHODS.get(method, set())
+
+
 @dataclass
 class Facts:
     """What is proven about one graph: for each r the largest s proven with its proof,
@@ -72,8 +109,13 @@ class Facts:
     s_exact: dict[int, int] = field(default_factory=dict)
 
     def add_proof(self, r: int, s: int, proof: Proof) -> None:
-        """Record that ``proof`` proves (r, s)-robustness."""
-        if r >= 1 and s > self.proofs.get(r, (0, None))[0]:
+        """Record that ``proof`` proves (r, s)-robustness (kept when no proof of a larger s
+        is known, or one of the same s that the checker cannot fully verify)."""
+        if r < 1:
+            return
+        old = self.proofs.get(r)
+        if old is None or s > old[0] or (s == old[0] and trusted_methods(old[1], self.ig.n)
+                                         and not trusted_methods(proof, self.ig.n)):
             self.proofs[r] = (s, proof)
 
     def add_pair(self, pair: bd.Pair | None) -> None:
@@ -82,12 +124,13 @@ class Facts:
         if pair is not None and pair not in self.pairs and len(self.pairs) < MAX_PAIRS:
             self.pairs.append(pair)
 
-    def lower(self, r: int) -> tuple[int, Proof] | None:
-        """(s, proof of (r, s)-robustness) with the largest s implied by the facts."""
+    def lower(self, r: int, method: str = "auto") -> tuple[int, Proof] | None:
+        """(s, proof of (r, s)-robustness) with the largest s implied by the facts whose
+        proofs may answer a call with ``method`` (module docstring)."""
         best: tuple[int, Proof] | None = None
         for r2, (s2, proof) in self.proofs.items():
             s = implied_s(self.ig.n, r, r2, s2)
-            if s >= 1 and (best is None or s > best[0]):
+            if s >= 1 and (best is None or s > best[0]) and _usable(proof, self.ig.n, method):
                 best = (s, implied_proof(r, s, r2, s2, proof))
         return best
 

@@ -37,7 +37,7 @@ import numpy as np
 from rescon_certificates.check import MAX_ENUM_N
 
 from .._progress import progress_bar
-from .._validate import integer
+from .._validate import integer, positive
 from ..errors import InputError, RESCONError, SolverError, TimeLimitReached
 from . import bounds as bd
 from .charged import charged_order, charged_tree, uniform_excluded, uniform_tree
@@ -144,11 +144,7 @@ def _check_options(method: str, time_limit: float | None) -> float | None:
         raise InputError(f"method must be one of {METHODS}; got {method!r}")
     if time_limit is None:
         return None
-    if isinstance(time_limit, bool) or not isinstance(time_limit, (int, float, np.number)) or not (
-        time_limit > 0 and np.isfinite(time_limit)
-    ):
-        raise InputError(f"time_limit must be a positive number of seconds; got {time_limit!r}")
-    return time.perf_counter() + float(time_limit)
+    return time.perf_counter() + positive("time_limit", time_limit, what="number of seconds")
 
 
 def _remaining(deadline: float | None) -> float | None:
@@ -240,7 +236,7 @@ def _decide_r(
     if r > (ig.n + 1) // 2:
         return _Decision(False, pair=_half_pair(ig))
     facts = facts_for(ig)
-    known = facts.lower(r)
+    known = facts.lower(r, method)
     if known is not None:
         return _Decision(True, proof=implied_proof(r, 1, r, known[0], known[1]))
     refuted = facts.upper(r)
@@ -378,7 +374,10 @@ def _walked_witness(ig: IndexedGraph, r: int, deadline: float | None) -> bd.Pair
     by the tabu walks (bounds.tabu_pairs) within ``WITNESS_SECONDS``, or None. Dense
     graphs are where the exact decision finds its witness slowly: ER(50, 0.8), seed
     50000, r = 21: the walks find one in 0.1 s, the MILP took 41 s, the decision
-    search more than 60 s. The budget starts once the walk is compiled."""
+    search more than 60 s. The budget starts once the walk is compiled; past the
+    ``deadline`` nothing is compiled or walked (a cold compile takes ~1 s)."""
+    if deadline is not None and time.perf_counter() >= deadline:
+        return None
     bd.compiled_walk()
     stop = time.perf_counter() + WITNESS_SECONDS
     found = bd.tabu_pairs(ig, r, floor=0, deadline=stop if deadline is None else
@@ -592,7 +591,7 @@ def _s_star(
     and pair are added to the cached facts."""
     facts = facts_for(ig)
     ss = _s_star_fresh(ig, r, method, deadline, seeds, r_proof, candidates + facts.pairs,
-                       facts.lower(r), cap, on_progress)
+                       facts.lower(r, method), cap, on_progress)
     if ss.value is not None and ss.proof is not None:
         ss = replace(ss, proof=_replayed(ig, r, ss.lower, ss.proof, deadline))
     if ss.proof is not None:
@@ -627,11 +626,9 @@ def _s_star_fresh(
     # lower: the r-robustness proof itself (s = 1), a construction with r + s − 1,
     # or what the facts imply
     lower, proof = 1, r_proof
-    for s in range(upper, 1, -1):
-        con = bd.construction_proof(ig, r, s, seeds=seeds)
-        if con is not None:
-            lower, proof = s, con
-            break
+    con = bd.best_construction(ig, r, upper, seeds=seeds, deadline=deadline)
+    if con is not None:
+        lower, proof = con
     if known is not None and known[0] > lower:
         lower, proof = min(known[0], upper), implied_proof(r, min(known[0], upper), r, *known)
     if lower < upper and (cap is None or cap > lower):
@@ -899,7 +896,7 @@ def _robustness(G: Any, method: str, time_limit: float | None, undirected: bool 
     # lower bound: the best cheap or cached proof at or below r_upper
     r_lower, lower = 0, {"method": "trivial"}
     for r in range(r_upper, 0, -1):
-        known = facts.lower(r)
+        known = facts.lower(r, method)
         proof = _cheap_proof(ig, r, 1, seeds)
         if proof is None and known is not None:
             proof = implied_proof(r, 1, r, *known)
@@ -1021,7 +1018,7 @@ def _decide_rs(ig: IndexedGraph, r: int, s: int, method: str, deadline: float | 
     within ``IMPLIED_SEARCH_SECONDS``; not with the DP, which settles min(s*(r), s)
     in one uninterruptible pass anyway), then the exact min(s*(r), s)."""
     facts = facts_for(ig)
-    known = facts.lower(r)
+    known = facts.lower(r, method)
     if known is not None and known[0] >= s:
         return _Decision(True, proof=implied_proof(r, s, r, *known))
     refuted = facts.upper(r)
