@@ -451,7 +451,10 @@ def test_ctrl_c_during_a_threaded_kernel():
     within seconds, no range thread left, and the next kernel is right."""
     import signal
 
-    code = ("import numpy as np, rescon, threading\n"
+    # Python's handler explicitly: a child inherits an ignored SIGINT (a test run started
+    # in the background by a non-interactive shell), and Python then installs none
+    code = ("import numpy as np, rescon, signal, threading\n"
+            "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
             "rescon.safe_kernel(np.random.default_rng(0).normal(size=(20, 5)), 2)\n"
             "print('ready', flush=True)\n"
             "try:\n"

@@ -537,9 +537,8 @@ def test_non_robust_graph_warns_and_stays_valid():
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, reason="V36: the vertex mean of 2d identical kernel points "
-                   "(_scaled_mean: rounded sum / 2d) is not the point: converged states "
-                   "drift off their one-point benign hull")
+# Fixed (was a bug: the vertex mean of 2d identical kernel points (_scaled_mean: rounded sum / 2d)
+# is not the point: converged states drift off their one-point benign hull)
 def test_alg1_converged_states_stay_put_d4():
     p = [-0.7466528839828983, 0.6787395958595579, -0.46990009907954344, -0.8696871441704723]
     n = 8
@@ -549,8 +548,8 @@ def test_alg1_converged_states_stay_put_d4():
     assert tr.max_validity == 0.0
 
 
-@pytest.mark.xfail(strict=True, reason="V36: W-MSR averages identical values with "
-                   "_scaled_mean, whose rounded sum / n is not the value")
+# Fixed (was a bug: W-MSR averages identical values with _scaled_mean, whose rounded sum / n is not
+# the value)
 def test_wmsr_identical_states_stay_put_d1():
     p = 0.9053558666731177
     n = 7
@@ -560,8 +559,8 @@ def test_wmsr_identical_states_stay_put_d1():
     assert tr.max_validity == 0.0
 
 
-@pytest.mark.xfail(strict=True, reason="V36: the mean baseline averages identical values "
-                   "with _scaled_mean, whose rounded sum / n is not the value")
+# Fixed (was a bug: the mean baseline averages identical values with _scaled_mean, whose rounded sum
+# / n is not the value)
 def test_mean_identical_states_stay_put_d2():
     p = [0.5889689337804737, -0.8407215900583078]
     n = 8
@@ -571,8 +570,8 @@ def test_mean_identical_states_stay_put_d2():
     assert tr.max_validity == 0.0
 
 
-@pytest.mark.xfail(strict=True, reason="V36: an adversary callable returning a string "
-                   "raises numpy's bare ValueError, not a one-line InputError naming it")
+# Fixed (was a bug: an adversary callable returning a string raises numpy's bare ValueError, not a
+# one-line InputError naming it)
 def test_adversary_callable_returning_string_is_input_error():
     n, d = 7, 2
     G = nx.complete_graph(n).to_directed()

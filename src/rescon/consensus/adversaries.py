@@ -170,7 +170,10 @@ def _vector(name: str, value: Any, *, finite: bool = True) -> tuple[float, ...]:
 
 
 def _row(name: str, value: Any, d: int) -> np.ndarray:
-    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    try:
+        arr = np.atleast_1d(np.asarray(value, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must return a vector of {d} numbers; got {value!r}") from None
     if arr.shape != (d,):
         raise InputError(f"{name} must return a vector of shape ({d},); got shape {arr.shape}")
     return arr

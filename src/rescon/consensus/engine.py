@@ -324,10 +324,14 @@ def _receive(sc, links, x, adv_idx, benign_mask, k, t, rng, last, has_last, metr
 def _scaled_mean(a: np.ndarray, axis: int = 0) -> np.ndarray:
     """Mean of a finite array along ``axis`` without overflow: each slice is divided by
     its own power of two 2^e ≥ max |entry| (exact), averaged (|mean| ≤ 1), and scaled
-    back — ``a.mean(axis)`` overflows to inf once the sum passes 1.8e308."""
+    back — ``a.mean(axis)`` overflows to inf once the sum passes 1.8e308 — then held
+    between the slice's smallest and largest entries: the rounded sum can pass them by
+    an ulp (8 copies of one value averaged to its neighbour float, so converged states
+    drifted out of their one-point hull), and the mean of equal entries is that entry."""
     top = np.abs(a).max(axis=axis, keepdims=True)
     e = np.frexp(np.where(top > 0.0, top, 1.0))[1]
-    return np.ldexp(np.ldexp(a, -e).mean(axis=axis), np.squeeze(e, axis=axis))
+    mean = np.ldexp(np.ldexp(a, -e).mean(axis=axis), np.squeeze(e, axis=axis))
+    return np.clip(mean, a.min(axis=axis), a.max(axis=axis))
 
 
 def _auxiliary(sc, links, x, values, usable, benign, d, cache):
