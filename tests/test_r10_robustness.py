@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 
 import networkx as nx
@@ -181,3 +182,61 @@ def test_forced_search_after_a_trusted_milp_proof_gives_a_tree():
     assert rep.r_max == 2 and rep.exact
     assert rescon.check_certificate(rep.certificate).verdict == "valid"
     assert rescon.is_rs_robust(G, 2, rep.s_max, method="search").holds is True
+
+
+# --------------------------------------------------------------------------- #
+# item 4: workers=N within the time limit, nothing left behind (slow)
+# --------------------------------------------------------------------------- #
+
+
+def _running() -> set[tuple[str, int]]:
+    """This process's threads and child processes (multiprocessing's resource tracker,
+    started once per process, excepted)."""
+    import psutil
+
+    procs = {("process", p.pid) for p in psutil.Process().children(recursive=True)
+             if "resource_tracker" not in " ".join(p.cmdline())}
+    return {(t.name, t.ident or 0) for t in threading.enumerate()} | procs
+
+
+def _left(before: set[tuple[str, int]], seconds: float = 15.0) -> set[tuple[str, int]]:
+    """What runs now and did not before, once it has had ``seconds`` to end (distributed's
+    process-wide offload thread, started once, excepted)."""
+    stop = time.perf_counter() + seconds
+    while True:
+        new = {x for x in _running() - before if not x[0].startswith("Dask-Offload")}
+        if not new or time.perf_counter() > stop:
+            return new
+        time.sleep(0.2)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("limit", [1.6, 4.0])
+def test_workers_time_limit_is_honoured_and_nothing_is_left(limit):
+    """1.6 s: the cluster start is still under way at the limit (it is left to its
+    thread, which closes what it made); 4 s: the s* search's parts are running on it."""
+    pytest.importorskip("distributed")
+    G = gen.circulant(63, 3, directed=True)
+    rescon.robustness(nx.cycle_graph(5), time_limit=0.1)  # warm imports
+    clear_cache()
+    before = _running()
+    t0 = time.perf_counter()
+    rep = rescon.robustness(G, time_limit=limit, workers=1)
+    wall = time.perf_counter() - t0
+    assert rep.r_max == 2 and not rep.exact and 1 <= rep.s_lower <= rep.s_upper <= 4
+    assert wall < limit + 1.0
+    assert _left(before) == set()
+
+
+@pytest.mark.slow
+def test_an_embedded_cluster_closes_fast_with_a_task_running():
+    pytest.importorskip("distributed")
+    from rescon import _dask
+
+    before = _running()
+    with _dask.client(None, 1) as client:
+        client.submit(time.sleep, 30, pure=False)
+        time.sleep(1.0)
+        t0 = time.perf_counter()
+    assert time.perf_counter() - t0 < 2.0  # distributed's own close: 4 s
+    assert _left(before) == set()

@@ -10,6 +10,7 @@ use, never with rescon.
 
 from __future__ import annotations
 
+import logging
 import os
 import threading
 import time
@@ -176,8 +177,16 @@ class Workers:
             return set()
 
 
+#: seconds a worker of an embedded LocalCluster is given to stop (80 %) before it is killed
+STOP_SECONDS = 0.25
+
+
 class _Owned:
-    """A client with the LocalCluster it owns: both closed on exit."""
+    """A client with the LocalCluster it owns: both closed on exit, the worker
+    processes first, each given ``STOP_SECONDS`` to stop, then killed: a task still
+    running (a search part, cancelled) holds its worker's thread, and the cluster's own
+    close would wait 4 s for it (distributed's Nanny.close default) — after the caller's
+    time limit. The workers hold nothing but their tasks' inputs."""
 
     def __init__(self, owned_client: Any, cluster: Any) -> None:
         self.client, self.cluster = owned_client, cluster
@@ -186,5 +195,28 @@ class _Owned:
         return self.client
 
     def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the client, stop the workers (killed after ``STOP_SECONDS``), close
+        the cluster."""
+        import asyncio
+
         self.client.close()
-        self.cluster.close()
+        nannies = list(self.cluster.workers.values())
+
+        async def stop() -> None:
+            await asyncio.gather(*(w.close(timeout=STOP_SECONDS) for w in nannies))
+
+        log = logging.getLogger("distributed.nanny")
+        log.addFilter(_kill_notice)
+        try:
+            self.cluster.sync(stop)
+        finally:
+            log.removeFilter(_kill_notice)
+            self.cluster.close()
+
+
+def _kill_notice(record: logging.LogRecord) -> bool:
+    """Drops the nanny's warning that a worker it stops is killed (expected here)."""
+    return "still alive after" not in record.getMessage()

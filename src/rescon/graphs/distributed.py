@@ -97,6 +97,7 @@ outlasts ``LOCAL_NODES`` states in this process, inside :func:`searches_on`.
 from __future__ import annotations
 
 import itertools
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -140,23 +141,66 @@ MIN_GRANT = 1 << 16
 
 class _Cluster:
     """A Dask client for the searches of one :func:`searches_on` block, opened on first
-    use (a search that ends locally never starts a cluster) and closed with the block."""
+    use (a search that ends locally never starts a cluster) and closed with the block.
+
+    The client is made in a daemon thread (an embedded LocalCluster takes 1–2 s to
+    start on 2 cores), so a search with a deadline stops waiting for it at the deadline
+    (:meth:`ready`); a block that ends while the start is still under way leaves it to
+    that thread, which closes what it made as soon as it has it."""
 
     def __init__(self, scheduler: str | None, workers: int | None) -> None:
         self.scheduler, self.workers = scheduler, workers
-        self._context: Any = None
+        self._lock = threading.Lock()
+        self._thread: threading.Thread | None = None
+        self._made: dict[str, Any] = {}  # "context", or "error"; or "abandoned"
         self._client: Any = None
 
+    def ready(self, deadline: float | None = None) -> bool:
+        """Is the client made? Waits for it until ``deadline`` (perf_counter; none is
+        started past it); the error that stopped it from being made is raised here."""
+        if self._client is not None:
+            return True
+        if self._thread is None:
+            if deadline is not None and time.perf_counter() >= deadline:
+                return False
+            self._thread = threading.Thread(target=self._make, name="rescon-cluster",
+                                            daemon=True)
+            self._thread.start()
+        self._thread.join(None if deadline is None else max(deadline - time.perf_counter(), 0))
+        with self._lock:
+            if "error" in self._made:
+                raise self._made["error"]
+            context = self._made.get("context")
+        if context is None:
+            return False
+        self._client = context.__enter__()  # in the caller's context (contextvars)
+        return True
+
     def client(self) -> Any:
-        if self._client is None:
-            self._context = _dask.client(self.scheduler, self.workers)
-            self._client = self._context.__enter__()
+        """The client (made now if need be)."""
+        self.ready()
         return self._client
 
+    def _make(self) -> None:
+        try:
+            made = {"context": _dask.client(self.scheduler, self.workers)}
+        except BaseException as exc:  # noqa: BLE001 (raised in the caller's thread)
+            made = {"error": exc}
+        with self._lock:
+            if "abandoned" not in self._made:
+                self._made = made
+                return
+        if "context" in made:
+            made["context"].close()
+
     def close(self) -> None:
-        if self._context is not None:
-            self._context.__exit__(None, None, None)
-            self._context = self._client = None
+        with self._lock:
+            made, self._made = self._made, {"abandoned": True}
+        context, entered, self._client = made.get("context"), self._client is not None, None
+        if context is not None and entered:
+            context.__exit__(None, None, None)
+        elif context is not None:
+            context.close()
 
 
 _ACTIVE: ContextVar[_Cluster | None] = ContextVar("rescon_search_cluster", default=None)
@@ -313,12 +357,14 @@ def finish_on_cluster(
     cluster; the outcome is the serial search's, tree included (module docstring);
     after "not_robust" the witness is the first one a task found."""
 
-    client = cluster.client()
-    workers = _Workers(client)
     K = run.K
-    masks = (run.inmask, run.outmask, run.order)
     order = tuple(run.order.tolist())
     r = run.r
+    if deadline is not None and not cluster.ready(deadline):
+        return SearchOutcome("stopped", r, order, None, None, run.nodes, float(run.progress[0]))
+    client = cluster.client()
+    workers = _Workers(client)
+    masks = (run.inmask, run.outmask, run.order)
     tree = _Tree(run.record)
     nodes, progress = run.nodes, float(run.progress[0])
     running: dict[Any, int] = {}
@@ -473,11 +519,13 @@ def finish_cost_on_cluster(
     ``lower``. Its ``best`` is the serial search's; the sized engine's tree, assembled
     from its parts, proves it."""
 
-    client = cluster.client()
-    workers = _Workers(client)
     first = runs[0]
     lower = first.lower
     order = tuple(first.order.tolist())
+    if deadline is not None and not cluster.ready(deadline):
+        return CostOutcome("stopped", best, pair, sum(run.nodes for run in runs), order)
+    client = cluster.client()
+    workers = _Workers(client)
     slots = max(sum(client.nthreads().values()), 1)
     engines = [_Engine(run) for run in runs]
     running: dict[Any, tuple[_Engine, int]] = {}
