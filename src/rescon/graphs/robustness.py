@@ -23,7 +23,9 @@ per type of charges: the uniform one; _replayed).
 Before any search, every fact already proven about the same graph in this process
 (facts.py: a bounded cache keyed by node labels and edges) is used through the
 implication (r', s')-robust ⇒ (r, s)-robust for r ≤ r', s ≤ s' + r' − r (so
-s*(r) ≥ s*(ρ) + ρ − r), and every known violating pair refutes (r'', s'') above it.
+s*(r) ≥ s*(ρ) + ρ − r), and every known violating pair refutes (r'', s'') above it;
+under a forced method, only the proofs the checker verifies or that method's own
+(facts.trusted_methods).
 """
 
 from __future__ import annotations
