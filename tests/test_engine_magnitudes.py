@@ -7,6 +7,7 @@ import math
 import warnings
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -64,3 +65,28 @@ def test_no_adversary_magnitude_moves_a_benign_agent_outside_the_benign_hull(see
     assert np.isfinite(fast.states[:, 1:]).all()
     assert fast.max_validity == 0.0 and exact.max_validity == 0.0
     assert np.abs(fast.states[:, 1:] - exact.states[:, 1:]).max() <= 1e-9
+
+
+def test_batch_point_allowance_follows_the_size_of_the_kernel():
+    """engine._allowance: at 1e15 + a spread of 1 a batch point may be off by ~2 ulps
+    (it was ACCEPT_REL of the magnitude, ~900: states left their benign hull, V36); near
+    the origin and for converged sets ACCEPT_REL of the magnitude as before; a set whose
+    trimmed box overflows falls back to the magnitude's."""
+    from rescon.consensus import engine
+    from rescon.geometry._small2d import ACCEPT_REL
+
+    rng = np.random.default_rng(0)
+    Y = rng.normal(size=(1, 9, 3))
+    pts = Y[:, 0]
+    size = np.abs(pts).max()
+    far = engine._allowance(Y + 1e15, 1, pts + 1e15)[0]
+    assert 2 * np.spacing(1e15) <= far < 1.0  # 4 ulps of 1e15 = 0.5; before: ~900
+    near = engine._allowance(Y, 1, pts)[0]
+    assert near == pytest.approx(ACCEPT_REL * size + engine.ROUNDING_SLACK * size)
+    converged = 1.0 + 1e-9 * Y
+    got = engine._allowance(converged, 1, converged[:, 0])[0]
+    assert got == pytest.approx(ACCEPT_REL * np.abs(converged[:, 0]).max(), rel=1e-3)
+    wide = Y.copy()
+    wide[0, :4, 0], wide[0, 4:, 0] = -1.7e308, 1.7e308
+    assert engine._allowance(wide, 1, pts)[0] == pytest.approx(
+        ACCEPT_REL * size + engine.ROUNDING_SLACK * size)

@@ -580,9 +580,9 @@ def test_adversary_callable_returning_string_is_input_error():
         sim(G, x0, 1, steps=2, adversaries={0: FunctionOfTime(lambda t: "abc")})
 
 
-@pytest.mark.xfail(strict=True, reason="V36: d = 3 batch kernel points (_small3d._project) "
-                   "at offset 1e15 are accepted up to 2^-40 of the magnitude (~900), here "
-                   "6 ulps off and outside Ψ: states leave the benign hull (project-exact: 0)")
+# Fixed (was a bug: d = 3 batch kernel points (_small3d._project) at offset 1e15 are accepted up to
+# 2^-40 of the magnitude (~900), here 6 ulps off and outside Ψ: states leave the benign hull
+# (project-exact: 0))
 def test_offset_1e15_d3_batch_kernel_points_stay_in_hull():
     n, d = 9, 3
     G = nx.complete_graph(n).to_directed()

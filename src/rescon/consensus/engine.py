@@ -431,8 +431,9 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
     (:mod:`rescon.geometry._small2d`: exact decisions, float geometry, certified error
     bound), in space through :mod:`rescon.geometry._small3d` (exact halfspaces, a float
     QP, a KKT certificate with rigorous rounding bounds); a batch point is used only if
-    its certified error bound is at most ACCEPT_REL of its own magnitude, so no far
-    value in the set can loosen it. The sets they decline and every other case are
+    its certified error bound is within :func:`_allowance` (ACCEPT_REL of its own
+    magnitude and of the size of the box Ψ lies in), so neither a far value in the set
+    nor a far origin can loosen it. The sets they decline and every other case are
     computed exactly, once per distinct set in a run (``cache``: held values and
     converged states repeat the same sets). "project-exact" computes everything
     exactly."""
@@ -457,7 +458,8 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
                 project_small_2d(Ys, F, pts, err, status)
                 found = (status == OK) & (err <= ACCEPT_REL * np.abs(pts).max(axis=1))
             else:
-                pts, _, found = project_small_3d(Ys, F)
+                pts, err, found = project_small_3d(Ys, F)
+            found &= err <= _allowance(Ys, F, pts)
             out[idx[found]] = pts[found]
             done[idx[found]] = True
     exact = "project" if method == "project-exact" else method
@@ -468,6 +470,33 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
             cache[key] = safe_kernel(X, F).point(exact)[0]
         out[k] = cache[key]
     return out
+
+
+#: a batch point may be off by at most this share of the widest side of the box Ψ
+#: lies in (besides ACCEPT_REL of its magnitude) ...
+WIDTH_REL = 2.0**-20
+#: ... plus this share of its magnitude (two units in the last place: the exact point
+#: rounded is off by up to half of one)
+ROUNDING_SLACK = 2.0**-51
+
+
+def _allowance(Ys: np.ndarray, F: int, pts: np.ndarray) -> np.ndarray:
+    """Per set, the largest certified error a batch kernel point may have: ACCEPT_REL of
+    its magnitude or WIDTH_REL of the widest side of the box Ψ lies in, whichever is
+    smaller, plus ROUNDING_SLACK of the magnitude. Ψ(Y, F) lies between the (F+1)-th
+    smallest and the (F+1)-th largest value of every coordinate (a point beyond has a
+    closed halfspace {y_j ≤ x_j} or {y_j ≥ x_j} with ≤ F points), so the allowance
+    also follows the size of Ψ, not only its distance from the origin: 1e15 + a spread
+    of 1 was allowed ~900 by its magnitude alone, and states left their benign hull
+    (V36); converged states (Ψ 1e-6 of its magnitude wide) keep ACCEPT_REL."""
+    from ..geometry._small2d import ACCEPT_REL
+
+    Z = np.sort(Ys, axis=1)
+    m = Ys.shape[1]
+    with np.errstate(over="ignore", invalid="ignore"):  # ±inf widths: the magnitude's
+        width = (Z[:, m - 1 - F] - Z[:, F]).max(axis=1)
+    size = np.abs(pts).max(axis=1)
+    return np.fmin(ACCEPT_REL * size, WIDTH_REL * width) + ROUNDING_SLACK * size
 
 
 def _same_shape(problems: list[np.ndarray] | np.ndarray) -> dict[tuple[int, ...], np.ndarray]:
