@@ -17,7 +17,15 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["check_F", "check_points", "integer", "nonnegative", "positive", "real"]
+__all__ = ["check_F", "check_points", "flag", "integer", "nonnegative", "positive", "real"]
+
+
+def flag(name: str, value: Any) -> bool:
+    """``value`` as a bool: True or False (numpy's too); "no", 0, None … are refused rather
+    than read by their truth value."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{name} must be True or False; got {value!r}")
+    return bool(value)
 
 
 def integer(name: str, value: Any, *, low: int | None = None, high: int | None = None) -> int:

@@ -27,6 +27,7 @@ from xml.etree.ElementTree import ParseError
 import networkx as nx
 import numpy as np
 
+from ._validate import flag
 from .errors import GraphFormatError, InputError
 
 __all__ = ["output_path", "read_graph", "read_points", "to_jsonable", "write_json"]
@@ -111,6 +112,7 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
     >>> sorted(G.edges()), sorted(G.nodes())
     ([(1, 2), (2, 3)], [1, 2, 3, 4])
     """
+    undirected = flag("undirected", undirected)
     p = _existing_file(path, "graph file")
     reader = _GRAPH_READERS.get(p.suffix.lower(), _read_edge_list)
     G = reader(p)

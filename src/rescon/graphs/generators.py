@@ -23,7 +23,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from .._validate import integer
+from .._validate import flag, integer
 from ..errors import InputError
 
 __all__ = ["ba_robust", "circulant", "directed_growth", "two_cliques"]
@@ -164,6 +164,7 @@ def circulant(n: int, k: int, *, directed: bool = False) -> nx.Graph:
     """
     n = integer("n", n, low=2)
     k = integer("k", k, low=1)
+    directed = flag("directed", directed)
     if k > n - 1:
         raise InputError(f"k must be an integer with 1 <= k <= n - 1 = {n - 1}; got k={k}")
     complete = k >= n // 2 if not directed else k == n - 1

@@ -153,8 +153,7 @@ class CallableOracle(Oracle):
         if not callable(f) or not callable(subgrad):
             raise InputError(f"{name}: a pair of callables (f, subgrad) is needed; got "
                              f"({type(f).__name__}, {type(subgrad).__name__})")
-        if not isinstance(vectorised, bool):
-            raise InputError(f"vectorised must be a boolean; got {vectorised!r}")
+        vectorised = _validate.flag("vectorised", vectorised)
         super().__init__(None if d is None else _validate.integer("d", d, low=1), name)
         self.f, self.g, self.vectorised = f, subgrad, vectorised
 

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import flag
 from . import figure_path, in_units, new_figure, unit_exponent, unit_label
 
 __all__ = ["log_floor", "plot_log_clipped", "plot_trajectory"]
@@ -54,6 +55,7 @@ def plot_trajectory(traj: Any, *, path: Any = None, log_diameter: bool = True) -
     paper's Fig. 7). One legend for the figure. Saves to ``path`` if given
     (:func:`rescon.plot.figure_path`; a figure of its own, outside pyplot); returns the
     matplotlib Figure."""
+    log_diameter = flag("log_diameter", log_diameter)
     path = None if path is None else figure_path(path)
     d = traj.states.shape[2]
     k_t, ks = _units(traj)
