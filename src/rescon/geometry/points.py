@@ -361,13 +361,20 @@ def _kkt(eqs, facets, S, m: Vec) -> Vec | None:
 CHEBYSHEV_AUTO = ("clarabel", "highs")
 
 
+#: a unit-frame ball this small (the frame's unit is about Ψ's extent) is near the
+#: solvers' tolerances: "auto" then also asks the principal frame
+THIN = 2.0**-20
+
+
 def _chebyshev(K: SafeKernel, backend: str) -> Vec:
     """The Chebyshev centre from a backend's LP in Ψ's unit frame (:func:`_frame`),
     moved onto aff Ψ and certified inside (pulled towards the vertex mean if rounding
     left it on the boundary).  With ``backend="auto"``, a full-dimensional Ψ the unit
-    frame cannot resolve — thinner there than the solvers' tolerances, or narrower than
-    the float range allows beside its extent — is solved again in its principal frame
-    (:func:`_principal_chebyshev`)."""
+    frame may not resolve — its LP failed, its centre needed the pull, or its ball is
+    under THIN of the frame (thinner there than the solvers' tolerances, or narrower
+    than the float range allows beside its extent) — is solved again in its principal
+    frame (:func:`_principal_chebyshev`), and the point with the larger inscribed ball
+    (:func:`_inscribed`) is kept."""
     from ..models.kernel_models import chebyshev
 
     ex = K._exact
@@ -375,25 +382,39 @@ def _chebyshev(K: SafeKernel, backend: str) -> Vec:
         return ex.vertices[0]
     o, e = _frame(K)
     framed = _framed(K, o, e)[:4]
+    x, unsure = None, True
     try:
         if backend == "auto":  # Clarabel, else HiGHS (its point is certified below either way)
             try:
-                centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[0])
+                centre, radius = chebyshev(*framed, backend=CHEBYSHEV_AUTO[0])
             except SolverError:
-                centre, _ = chebyshev(*framed, backend=CHEBYSHEV_AUTO[1])
+                centre, radius = chebyshev(*framed, backend=CHEBYSHEV_AUTO[1])
         else:
-            centre, _ = chebyshev(*framed, backend=backend)
-        centre = _from_frame(centre, o, e)
-        x = _inside(K, _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in centre)))
+            centre, radius = chebyshev(*framed, backend=backend)
+        c0 = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in _from_frame(centre, o, e)))
+        x = _inside(K, c0)
+        unsure = x is not c0 or not radius >= THIN
     except SolverError:
         if backend != "auto" or K.dim < len(o):
             raise
-        x = None
-    if x is None and backend == "auto" and K.dim == len(o):
-        x = _principal_chebyshev(K, o)
+    if unsure and backend == "auto" and K.dim == len(o):
+        y = _principal_chebyshev(K, o)
+        if y is not None and (x is None or _inscribed(K, y) > _inscribed(K, x)):
+            x = y
     if x is None:
         raise SolverError("the Chebyshev centre returned by the backend is not in the kernel")
     return x
+
+
+def _inscribed(K: SafeKernel, x: Vec) -> float:
+    """The radius of the largest ball around x in a full-dimensional Ψ: the smallest
+    (β − a·x)/‖a‖ over its facets (exact slacks, rounded; the norms in floats)."""
+    out = math.inf
+    for a, beta in K._exact.facets:
+        top = max(map(abs, a))
+        slack = _float((beta - _dot(a, x)) / top)
+        out = min(out, slack / math.hypot(*(float(t / top) for t in a)))
+    return out
 
 
 def _inside(K: SafeKernel, x: Vec) -> Vec | None:
