@@ -240,9 +240,9 @@ def _incircle(P, unit) -> float:
     return float(area2 / Fraction(per))
 
 
-@pytest.mark.xfail(strict=True, reason="V35: a thin triangle whose unit-frame LP returns an "
-                   "inaccurate centre (on the boundary, pulled 1e-12 inside) keeps it: radius "
-                   "2e-13 / 0.77 of the incircle; the principal frame runs only on failure")
+# Fixed (was a bug: a thin triangle whose unit-frame LP returns an inaccurate centre (on the
+# boundary, pulled 1e-12 inside) keeps it: radius 2e-13 / 0.77 of the incircle; the principal
+# frame runs only on failure)
 @pytest.mark.parametrize("P", [
     [[3.735664949173389e+46, -5.194052821535125e+35],
      [2.0595805639972844e+47, 3.2433721819581687e+36],
