@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
+from decimal import Decimal
 
 import pytest
 
@@ -78,3 +80,23 @@ def test_numerical_verdict_scale_free_at_1024():
     base, big = (rescon.check_redundancy(_scaled(s), 1, d=1) for s in (1, 1024))
     assert (big.holds, big.exact) == (base.holds, base.exact) == (False, False)
     assert big.gap == base.gap * 1024
+
+
+def _scaled_exact(s):
+    """_scaled(s) written with the floats' exact decimal values."""
+    return [c.replace(f"({v})", f"({Decimal(v)})") for c, v in
+            zip(_scaled(s), (-2 * s, 2 * s, 2 * s, s), strict=True)]
+
+
+@pytest.mark.parametrize("e", [510, 700, 1010, -540, -800, -1000])
+def test_numerical_verdict_scale_free_past_the_norm_squares(e):
+    # V35: a Norm2 cost evaluated in numpy as sqrt(r·r) overflowed (underflowed) past
+    # ~2^511 (below ~2^-537), so its unit κ fell back to 1 and Clarabel failed; κ now
+    # comes from the data divided by their size first
+    base = rescon.check_redundancy(_scaled(1), 1, d=1)
+    s = 2.0**e
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no numpy RuntimeWarning either
+        rep = rescon.check_redundancy(_scaled_exact(s), 1, d=1)
+    assert (rep.holds, rep.exact) == (base.holds, base.exact) == (False, False)
+    assert rep.gap == base.gap * s and rep.tolerance == base.tolerance * s

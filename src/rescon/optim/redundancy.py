@@ -793,7 +793,14 @@ def _moved(c: list[Fraction], s: float, y: np.ndarray) -> list[Fraction]:
 
 def _pow2(v: float) -> Fraction:
     """The power of two nearest v > 0 (exact)."""
-    return Fraction(2) ** max(-1000, min(1000, round(math.log2(v))))
+    return Fraction(2) ** max(-1074, min(1023, round(math.log2(v))))
+
+
+def _log2(v: Fraction) -> int:
+    """An exponent e with 2^e within a factor 2 of the Fraction v > 0, in [−1022, 1022]
+    (2^±e normal floats; 0 when v = 0)."""
+    e = v.numerator.bit_length() - v.denominator.bit_length() if v else 0
+    return max(-1022, min(1022, e))
 
 
 def _pow2_exact(v: Fraction) -> Fraction:
@@ -845,7 +852,11 @@ class _Cvx:
     :func:`_centred` (the costs' data transformed exactly, :func:`_to_cvxpy`): costs far
     from the origin or at any scale are solved at unit scale, and the results mapped
     back (points c + s·y, supports uᵀc + s·h_y, distances s·dist). CVXPY costs that
-    CVXPY evaluates itself (``.grad``) are used as written: then the frame is (0, 1)."""
+    CVXPY evaluates itself (``.grad``) are used as written: then the frame is (0, 1).
+    Each cost enters as f_i/κ_i, κ_i the power of two nearest its largest |f_i| on
+    y = 0, ±e_j, evaluated on data divided by 2^e_i ≈ their largest |datum|
+    (:func:`_size`) so that no norm's square over- or underflows: κ_i = 2^e_i ·
+    (power of two nearest max |f_i/2^e_i|), exactly the same at every magnitude."""
 
     def __init__(self, oracles: list[Any], d: int, frame: tuple[list[Fraction], float]
                  ) -> None:
@@ -861,11 +872,14 @@ class _Cvx:
         self.c = np.array([float(v) for v in self.cq])
         self.x = user if user is not None and user.shape == (d,) else cp.Variable(d)  # y
         self.w = cp.Parameter(len(oracles), nonneg=True)
-        raw = [_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s)) for o in oracles]
-        self.grid = self._grid(raw)  # each cost at y = 0, ±e_j (_variation)
+        e0 = [_log2(_size(o, self.cq, Fraction(self.s))) for o in oracles]
+        pre = self._grid([_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s), Fraction(2) ** e)
+                          for o, e in zip(oracles, e0, strict=True)])  # f_i / 2^e0_i
         with np.errstate(all="ignore"):
-            top = np.abs(self.grid).max(axis=0, initial=0.0)
-        self.unit = [_pow2(v) if 0 < v < math.inf else Fraction(1) for v in top]
+            self.grid = np.ldexp(pre, e0)  # each cost at y = 0, ±e_j (_variation)
+            top = np.abs(pre).max(axis=0, initial=0.0)
+        self.unit = [Fraction(2) ** e * (_pow2(v) if 0 < v < math.inf else 1)
+                     for e, v in zip(e0, top, strict=True)]
         self.terms = [_to_cvxpy(cp, o, self.x, self.cq, Fraction(self.s), k)
                       for o, k in zip(oracles, self.unit, strict=True)]
         F = sum(self.w[i] * t for i, t in enumerate(self.terms))
@@ -883,14 +897,14 @@ class _Cvx:
         """problem.solve by Clarabel with the settings of RETRIES in turn until it ends
         optimal or unbounded (its status is then read by the caller; "inaccurate"
         warnings are dropped: the verdict is numerical anyway); SolverError when no
-        setting gets there."""
+        setting gets there (also when CVXPY finds data that overflowed to inf)."""
         why = ""
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
             for opts in RETRIES:
                 try:
                     problem.solve(solver="CLARABEL", **opts)
-                except self.cp.error.SolverError as e:
+                except (self.cp.error.SolverError, ValueError) as e:  # ValueError: inf data
                     why = str(e)
                     continue
                 if problem.status in _DECIDED:
@@ -1032,22 +1046,18 @@ def _to_cvxpy(cp: Any, o: Any, y: Any, c: list[Fraction], s: Fraction,
         return o.coef * _to_cvxpy(cp, o.term, y, c, s, k)
     if isinstance(o, atoms.MaxOf):
         return cp.maximum(*[_to_cvxpy(cp, t, y, c, s, k) for t in o.terms])
-    ex = getattr(o, "exact", None)
     if isinstance(o, atoms.Quadratic):
-        Q = arr([[s * s * v / k for v in row] for row in ex["Q"]])
-        shift = [a - b for a, b in zip(c, ex["c"], strict=True)]
-        q = arr([s * (_pq._dot(row, shift) + qi) / k
-                 for row, qi in zip(ex["Q"], ex["q"], strict=True)])
-        return (0.5 * cp.quad_form(y, cp.psd_wrap(Q)) if Q.any() else 0) + q @ y
+        M, v = _leaf_data(o, c, s)
+        Q = arr([[m / k for m in row] for row in M])
+        return (0.5 * cp.quad_form(y, cp.psd_wrap(Q)) if Q.any() else 0) + arr(
+            [vi / k for vi in v]) @ y
     if isinstance(o, atoms.Affine):
-        return arr([s * v / k for v in ex["a"]]) @ y
+        return arr([vi / k for vi in _leaf_data(o, c, s)[1]]) @ y
     if isinstance(o, atoms._Rows):  # r = A x ∓ b = sA y + (Ac ∓ b)
         smooth = isinstance(o, (atoms.Huber, atoms.LogSumExp))  # not homogeneous in r
         kr = Fraction(1) if smooth else k
-        A = arr([[s * v / kr for v in row] for row in ex["A"]])
-        sign = 1 if o.pieces else -1
-        r = A @ y + arr([(_pq._dot(row, c) + sign * bi) / kr
-                         for row, bi in zip(ex["A"], ex["b"], strict=True)])
+        M, v = _leaf_data(o, c, s)
+        r = arr([[m / kr for m in row] for row in M]) @ y + arr([vi / kr for vi in v])
         maps = {atoms.AbsAffine: lambda r: cp.abs(r[0]), atoms.Norm1: cp.norm1,
                 atoms.Norm2: lambda r: cp.norm(r, 2), atoms.NormInf: cp.norm_inf,
                 atoms.Hinge: lambda r: cp.pos(r[0]), atoms.MaxAffine: cp.max,
@@ -1058,6 +1068,44 @@ def _to_cvxpy(cp: Any, o: Any, y: Any, c: list[Fraction], s: Fraction,
     raise InputError(f"{o.name}: check_redundancy needs costs built of atoms (an expression "
                      f"string, atoms) or CVXPY expressions in one Variable of shape (d,); "
                      f"got a {o.kind} oracle")
+
+
+def _leaf_data(o: Any, c: list[Fraction], s: Fraction
+               ) -> tuple[list[list[Fraction]], list[Fraction]]:
+    """(M, v), the exact data of a quadratic, affine or rows atom at x = c + s·y:
+    ½(x − m)ᵀQ(x − m) + qᵀx = ½ yᵀ(s²Q)y + (s(Q(c − m) + q))ᵀy + const, aᵀx = (s·a)ᵀy +
+    const ([], s·a), rows r = Ax ∓ b = (sA)y + (Ac ∓ b)."""
+    from . import atoms
+
+    ex = o.exact
+    if isinstance(o, atoms.Quadratic):
+        shift = [a - b for a, b in zip(c, ex["c"], strict=True)]
+        return ([[s * s * v for v in row] for row in ex["Q"]],
+                [s * (_pq._dot(row, shift) + qi) for row, qi in zip(ex["Q"], ex["q"],
+                                                                     strict=True)])
+    if isinstance(o, atoms.Affine):
+        return [], [s * v for v in ex["a"]]
+    sign = 1 if o.pieces else -1
+    return ([[s * v for v in row] for row in ex["A"]],
+            [_pq._dot(row, c) + sign * bi for row, bi in zip(ex["A"], ex["b"], strict=True)])
+
+
+def _size(o: Any, c: list[Fraction], s: Fraction) -> Fraction:
+    """max |datum| of an atom tree at x = c + s·y (:func:`_leaf_data`; coef times its
+    term's under Scaled, the max over Sum and MaxOf terms; 0 for CVXPY summands), exact:
+    the scale :func:`_to_cvxpy` divides the data by before :class:`_Cvx` evaluates them
+    in floats, so that no square of a norm over- or underflows."""
+    from . import atoms
+
+    if isinstance(o, (atoms.Sum, atoms.MaxOf)):
+        return max((_size(t, c, s) for t in o.terms), default=Fraction(0))
+    if isinstance(o, atoms.Scaled):
+        return o.exact["coef"] * _size(o.term, c, s)
+    if isinstance(o, (atoms.Quadratic, atoms.Affine, atoms._Rows)):
+        M, v = _leaf_data(o, c, s)
+        return max((abs(x) for x in [*itertools.chain.from_iterable(M), *v]),
+                   default=Fraction(0))
+    return Fraction(0)
 
 
 def _shape(o: Any) -> Any:
