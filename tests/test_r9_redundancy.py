@@ -100,3 +100,13 @@ def test_numerical_verdict_scale_free_past_the_norm_squares(e):
         rep = rescon.check_redundancy(_scaled_exact(s), 1, d=1)
     assert (rep.holds, rep.exact) == (base.holds, base.exact) == (False, False)
     assert rep.gap == base.gap * s and rep.tolerance == base.tolerance * s
+
+
+@pytest.mark.parametrize("e", [-1012, -1030, -1070])
+def test_numerical_verdict_refused_below_the_normal_floats(e):
+    """Costs whose kinks lie within ~1e-304 of each other (V35's family at 2^-1012 and
+    below): the numerical tolerance would be subnormal (0 at 2^-1070) and the frame has
+    lost precision — a one-line InputError, not a verdict (R11 saw holds=True there where
+    scale 1 says False)."""
+    with pytest.raises(rescon.InputError, match="below what the numerical path resolves"):
+        rescon.check_redundancy(_scaled_exact(2.0**e), 1, d=1)

@@ -343,10 +343,9 @@ def test_redundancy_power_of_two_scaling_exact_far_out(base_report, e):
     assert rep.gap == base_report.gap * s and rep.tolerance == base_report.tolerance * s
 
 
-@pytest.mark.xfail(strict=True, reason="V35: a Norm2 cost whose values pass ~1e154 (or are "
-                   "below ~1e-162) overflows (underflows) in numpy when _Cvx._grid evaluates "
-                   "it, its unit kappa falls back to 1 and Clarabel fails: SolverError where "
-                   "the same costs at scale 1 have a verdict")
+# Fixed (was a bug: a Norm2 cost whose values pass ~1e154 (or are below ~1e-162) overflows
+# (underflows) in numpy when _Cvx._grid evaluates it, its unit kappa falls back to 1 and Clarabel
+# fails: SolverError where the same costs at scale 1 have a verdict)
 @pytest.mark.parametrize("e", [510, -540])
 def test_redundancy_power_of_two_scaling_past_the_norm_squares(base_report, e):
     s = 2.0**e

@@ -67,6 +67,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import sys
 import warnings
 from collections.abc import Hashable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -413,7 +414,9 @@ class _Check:
         centres around c; 1 when they all coincide): the verdict does not depend on
         where the costs sit, and scaling x by t scales the tolerance by t. InputError
         when a minimiser or a bounded support passes the float range (an exact verdict
-        was not reached, and a numerical one has no scale there)."""
+        was not reached, and a numerical one has no scale there), or when the tolerance
+        is below the normal floats (the costs' kinks within ~1e-304 of each other: the
+        frame and the supports have lost precision there)."""
         cq, scale = self.centre
         vals = [abs(_float(hq - _pq._dot([Fraction(float(v)) for v in self.dirs[k]], cq)))
                 for s in sets for k, (_, p, _, hq) in s.supports.items() if p is not None]
@@ -423,6 +426,10 @@ class _Check:
             raise InputError("check_redundancy: an argmin reaches beyond the float range "
                              "(|x| > 1.8e308) and no exact verdict was found; rescale the "
                              "costs")
+        if tol < sys.float_info.min:
+            raise InputError(f"check_redundancy: the costs' kinks and argmins lie within "
+                             f"{scale:.3g} of each other, below what the numerical path "
+                             f"resolves in floats, and no exact verdict was found; rescale x")
         return tol
 
     def _offset(self, s: _Set) -> np.ndarray:
