@@ -23,6 +23,7 @@ from rescon.graphs import bounds as bd
 from rescon.graphs import generators as gen
 from rescon.graphs.facts import Facts, clear_cache, trusted_methods
 from rescon.graphs.indexed import index_graph
+from tests.test_review_v33 import _k_in
 
 # --------------------------------------------------------------------------- #
 # item 1: s*'s construction bound by bisection, deadlines
@@ -154,18 +155,6 @@ def test_facts_offer_a_trusted_proof_only_to_auto_and_its_own_method():
     assert facts.lower(3, "search") == (2, tree) and facts.lower(3) == (2, tree)
     facts.add_proof(3, 2, milp)  # ... and is not replaced by it again
     assert facts.lower(3, "milp") == (2, tree)
-
-
-def _k_in(n, k, seed):
-    """Each node gets k distinct random in-neighbours (as in test_review_v33)."""
-    rng = np.random.default_rng(seed)
-    G = nx.DiGraph()
-    G.add_nodes_from(range(n))
-    for v in range(n):
-        others = [u for u in range(n) if u != v]
-        for u in rng.choice(others, size=k, replace=False):
-            G.add_edge(int(u), v)
-    return G
 
 
 def test_forced_search_after_a_trusted_milp_proof_gives_a_tree():
