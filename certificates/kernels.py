@@ -1616,10 +1616,10 @@ def _left_by_filters(rows: list[tuple[list[float], float, float]] | None,
     while stack:
         ids, cand = stack.pop()
         if len(ids) <= _LEAF_VERTICES:
+            sub = [rows[j] for j in cand]
             for i in ids:
                 if meter is not None:
                     _charge(meter, len(cand) * d, 1)
-                sub = [rows[j] for j in cand]
                 left[i] = [j for j, ok in zip(cand, _surely_inside(sub, *fvs[i])) if not ok]
             continue
         if meter is not None:
