@@ -899,18 +899,29 @@ class _Cvx:
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
         self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
         self.posed: tuple[int, ...] | None = None  # whose weights and level are set
+        self.compiled: tuple[dict, Any, Any] | None = None  # psup's data for ``posed``
+        self.cmap: Any = None  # the linear map u ↦ psup's objective vector (_compiled)
 
-    def _solve(self, problem: Any) -> None:
+    def _solve(self, problem: Any, compiled: tuple[dict, Any, Any] | None = None) -> None:
         """problem.solve by Clarabel with the settings of RETRIES in turn until it ends
         optimal or unbounded (its status is then read by the caller; "inaccurate"
         warnings are dropped: the verdict is numerical anyway); SolverError when no
-        setting gets there (also when CVXPY finds data that overflowed to inf)."""
+        setting gets there (also when CVXPY finds data that overflowed to inf).
+        ``compiled``: (data, chain, inverse data) of problem.get_problem_data, solved
+        and unpacked as problem.solve does (the same warm-started Clarabel), without
+        compiling the problem again."""
         why = ""
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
             for opts in RETRIES:
                 try:
-                    problem.solve(solver="CLARABEL", **opts)
+                    if compiled is None:
+                        problem.solve(solver="CLARABEL", **opts)
+                    else:
+                        data, chain, inverse = compiled
+                        problem.unpack_results(chain.solve_via_data(problem, data, True,
+                                                                    False, opts),
+                                               chain, inverse)
                 except (self.cp.error.SolverError, ValueError) as e:  # ValueError: inf data
                     why = str(e)
                     continue
@@ -931,7 +942,7 @@ class _Cvx:
         w[list(members)] = [float(self.unit[i] / Fraction(self.scales[members]))
                             for i in members]
         self.w.value = w
-        self.posed = None  # the level is not set for these weights
+        self.posed, self.compiled = None, None  # the level is not set for these weights
 
     def _grid(self, terms: list[Any]) -> np.ndarray:
         """Each term's value at y = 0, ±e_j (rows)."""
@@ -984,12 +995,36 @@ class _Cvx:
         unbounded, h = inf)."""
         self._level(members)
         self.u.value = u
-        self._solve(self.psup)
+        self._solve(self.psup, self._compiled(u))
         if self.psup.status in ("unbounded", "unbounded_inaccurate"):
             return math.inf, None, None
         h = (_pq._dot([Fraction(float(v)) for v in u], self.cq)
              + Fraction(self.s) * Fraction(float(self.psup.value)))
         return _float(h), self.c + self._offset(), h
+
+    def _compiled(self, u: np.ndarray) -> tuple[dict, Any, Any]:
+        """The support problem's Clarabel data (data, chain, inverse data) for the posed
+        sum and the direction u, as CVXPY's solve compiles them: the constraints' data
+        (they depend on the weights and the level only) compiled once per sum, then only
+        the objective vector c replaced by C·u, C the sparse map of CVXPY's compilation
+        from u to c (its columns compiled once, at u = e_j; u enters c linearly, each
+        entry ±u_j, so C·u is the very vector CVXPY computes). One compilation per sum
+        instead of one per direction: the data Clarabel solves are unchanged."""
+        import scipy.sparse as sp
+
+        if self.cmap is None:
+            self.cmap = sp.hstack([sp.csc_array(self._compile(e)[0]["c"].reshape(-1, 1))
+                                   for e in np.eye(len(u))], format="csr")
+        if self.compiled is None:
+            self.compiled = self._compile(u)
+        data, chain, inverse = self.compiled
+        return {**data, "c": self.cmap @ u}, chain, inverse
+
+    def _compile(self, u: np.ndarray) -> tuple[dict, Any, Any]:
+        """psup.get_problem_data for Clarabel at the direction u (the weights and level
+        as posed)."""
+        self.u.value = u
+        return self.psup.get_problem_data("CLARABEL", solver_opts={})
 
     def distance(self, members: tuple[int, ...], p: np.ndarray) -> tuple[float, np.ndarray]:
         """The distance from p to {F ≤ level} for the sum over ``members`` and the
