@@ -899,7 +899,7 @@ class _Cvx:
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
         self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
         self.posed: tuple[int, ...] | None = None  # whose weights and level are set
-        self.compiled: tuple[dict, Any, Any] | None = None  # psup's data for ``posed``
+        self.compiled: dict[tuple[int, ...], tuple[dict, Any, Any]] = {}  # psup, per sum
         self.cmap: Any = None  # the linear map u ↦ psup's objective vector (_compiled)
 
     def _solve(self, problem: Any, compiled: tuple[dict, Any, Any] | None = None) -> None:
@@ -942,7 +942,7 @@ class _Cvx:
         w[list(members)] = [float(self.unit[i] / Fraction(self.scales[members]))
                             for i in members]
         self.w.value = w
-        self.posed, self.compiled = None, None  # the level is not set for these weights
+        self.posed = None  # the level is not set for these weights
 
     def _grid(self, terms: list[Any]) -> np.ndarray:
         """Each term's value at y = 0, ±e_j (rows)."""
@@ -972,6 +972,7 @@ class _Cvx:
             return "unbounded", None
         at = sum(self.w.value[i] * _value(self.terms[i]) for i in members)
         self.fstar[members] = max(float(self.pmin.value), at)  # F(x*) ≥ min F: a level
+        self.compiled.pop(members, None)  # compiled at the previous level
         self.offsets[members] = off = self._offset()
         return "optimal", self.c + off
 
@@ -993,31 +994,34 @@ class _Cvx:
                 ) -> tuple[float, np.ndarray | None, Fraction | None]:
         """h(u), a point attaining it and h(u) = uᵀc + s·h_y exactly as computed (None:
         unbounded, h = inf)."""
-        self._level(members)
+        compiled = self._compiled(members, u)
         self.u.value = u
-        self._solve(self.psup, self._compiled(u))
+        self._solve(self.psup, compiled)
         if self.psup.status in ("unbounded", "unbounded_inaccurate"):
             return math.inf, None, None
         h = (_pq._dot([Fraction(float(v)) for v in u], self.cq)
              + Fraction(self.s) * Fraction(float(self.psup.value)))
         return _float(h), self.c + self._offset(), h
 
-    def _compiled(self, u: np.ndarray) -> tuple[dict, Any, Any]:
-        """The support problem's Clarabel data (data, chain, inverse data) for the posed
-        sum and the direction u, as CVXPY's solve compiles them: the constraints' data
-        (they depend on the weights and the level only) compiled once per sum, then only
-        the objective vector c replaced by C·u, C the sparse map of CVXPY's compilation
-        from u to c (its columns compiled once, at u = e_j; u enters c linearly, each
-        entry ±u_j, so C·u is the very vector CVXPY computes). One compilation per sum
-        instead of one per direction: the data Clarabel solves are unchanged."""
+    def _compiled(self, members: tuple[int, ...], u: np.ndarray
+                  ) -> tuple[dict, Any, Any]:
+        """The support problem's Clarabel data (data, chain, inverse data) for the sum
+        over ``members`` and the direction u, as CVXPY's solve compiles them: the
+        constraints' data (they depend on the weights and the level only, :meth:`_level`)
+        compiled once per sum, then only the objective vector c replaced by C·u, C the
+        sparse map of CVXPY's compilation from u to c (its columns compiled once, at
+        u = e_j; u enters c linearly, each entry ±u_j, so C·u is the very vector CVXPY
+        computes). One compilation per sum instead of one per direction: the data
+        Clarabel solves are unchanged."""
         import scipy.sparse as sp
 
-        if self.cmap is None:
-            self.cmap = sp.hstack([sp.csc_array(self._compile(e)[0]["c"].reshape(-1, 1))
-                                   for e in np.eye(len(u))], format="csr")
-        if self.compiled is None:
-            self.compiled = self._compile(u)
-        data, chain, inverse = self.compiled
+        if members not in self.compiled:
+            self._level(members)
+            if self.cmap is None:
+                self.cmap = sp.hstack([sp.csc_array(self._compile(e)[0]["c"].reshape(-1, 1))
+                                       for e in np.eye(len(u))], format="csr")
+            self.compiled[members] = self._compile(u)
+        data, chain, inverse = self.compiled[members]
         return {**data, "c": self.cmap @ u}, chain, inverse
 
     def _compile(self, u: np.ndarray) -> tuple[dict, Any, Any]:
