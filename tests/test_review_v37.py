@@ -504,3 +504,17 @@ def test_cost_with_a_huge_exponent_is_refused_quickly():
             print("refused")
     """, timeout=10)
     assert proc.stdout == "refused\n"
+
+
+@pytest.mark.xfail(strict=True, reason="V37: robustness(D, undirected='no') reads 'no' by its "
+                   "truth value: a directed 3-cycle (rho 1) is answered as undirected (rho 2); "
+                   "README says 'no' or 0 is refused (indexed.py index_graph: undirected or ...)")
+@pytest.mark.parametrize("value", ["no", 0, 1])
+def test_undirected_takes_true_or_false_only(value):
+    D = nx.DiGraph([(0, 1), (1, 2), (2, 0)])
+    assert rescon.robustness(D).r_max == 1 and rescon.robustness(D, undirected=True).r_max == 2
+    for call in (lambda: rescon.robustness(D, undirected=value),
+                 lambda: rescon.is_r_robust(D, 2, undirected=value),
+                 lambda: rescon.max_s(D, 1, undirected=value)):
+        with pytest.raises(rescon.InputError, match="undirected"):
+            call()
