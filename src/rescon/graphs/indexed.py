@@ -7,11 +7,14 @@ parallel edges of a multigraph count once.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Hashable
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import networkx as nx
+import numpy as np
 
 from ..errors import InputError
 
@@ -37,9 +40,18 @@ class IndexedGraph:
     def n(self) -> int:
         return len(self.nodes)
 
-    @property
+    @cached_property
     def in_degrees(self) -> tuple[int, ...]:
+        """In-degrees, computed once (the bounds read them per node and per r)."""
         return tuple(len(s) for s in self.in_nbrs)
+
+    def edge_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The edges u → v as two int64 arrays (U, V), grouped by v."""
+        count = sum(self.in_degrees)
+        U = np.fromiter(itertools.chain.from_iterable(self.in_nbrs), dtype=np.int64,
+                        count=count)
+        V = np.repeat(np.arange(self.n, dtype=np.int64), self.in_degrees)
+        return U, V
 
     def in_masks(self) -> list[int]:
         """In-neighbour sets as Python-int bitmasks (bit j set iff j → i)."""
@@ -47,7 +59,9 @@ class IndexedGraph:
 
     def edges(self) -> list[list[int]]:
         """Edges ``[u, v]`` (u → v) in index form, sorted."""
-        return sorted([u, v] for v, s in enumerate(self.in_nbrs) for u in s)
+        U, V = self.edge_arrays()
+        order = np.lexsort((V, U))
+        return np.column_stack((U[order], V[order])).tolist()
 
     def labels(self, indices: Any) -> list[Hashable]:
         """Map node indices back to the user's labels (sorted by index)."""

@@ -222,6 +222,9 @@ def milp_min_cost(
     time_limit: float | None = None,
     on_progress: Callable[[float, int], None] | None = None,
 ) -> MilpOutcome:
-    """Solve :class:`RobustnessMilp` and wait for the answer."""
+    """Solve :class:`RobustnessMilp` and wait for the answer (none, and no model built,
+    when ``time_limit`` is 0: a model of a dense n = 800 graph takes ~1 s to build)."""
+    if time_limit is not None and time_limit <= 0:
+        return MilpOutcome("time_limit", None, None, 0.0)
     return RobustnessMilp(ig, r, upper=upper, lower=lower, decision_only=decision_only,
                           time_limit=time_limit, on_progress=on_progress).outcome()
