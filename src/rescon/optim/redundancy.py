@@ -37,7 +37,8 @@ sums are piecewise quadratic (:mod:`rescon.optim._pq`: quadratics, affine functi
 Everything else is numerical (``exact=False``): support functions h_A(u) = max_{x∈A} uᵀx
 in the fixed directions ±e_i and ±u_j (j < d, u_j seeded Gaussian unit vectors, seed 0),
 from Clarabel via CVXPY (min F_S, then max uᵀx on {F_S ≤ F_S* + 1e-10(V + |F_S*|)},
-F_S* the value at the minimiser found, V below) or,
+F_S* the value at the minimiser found, V below; the support problem compiled once per
+sum, only its objective changing with u) or,
 for certified polyhedral argmins, from HiGHS on their canonical faces (centred and
 scaled), each support point then made exact on the faces it makes tight; when one of
 the two sets is not certified, also the distance from each set's minimiser to the other
@@ -855,7 +856,8 @@ def _poly_support(opt: _pq.Optimal, u: np.ndarray) -> _Support:
 
 class _Cvx:
     """The numerical path: Σ w_i f_i in CVXPY (w a nonnegative Parameter, so each
-    subset re-solves a compiled problem) with Clarabel, in the frame x = c + s·y of
+    subset re-solves a compiled problem; a sum's 4d support problems share one
+    compilation, :meth:`_compiled`) with Clarabel, in the frame x = c + s·y of
     :func:`_centred` (the costs' data transformed exactly, :func:`_to_cvxpy`): costs far
     from the origin or at any scale are solved at unit scale, and the results mapped
     back (points c + s·y, supports uᵀc + s·h_y, distances s·dist). CVXPY costs that
