@@ -12,6 +12,8 @@ compilations are per sum, and compare the answers with an independent CVXPY solv
 from __future__ import annotations
 
 import itertools
+import math
+from fractions import Fraction
 
 import cvxpy as cp
 import numpy as np
@@ -19,7 +21,7 @@ import pytest
 
 import rescon
 from benchmarks.redundancy_bench import family
-from rescon.optim import redundancy
+from rescon.optim import _pq, redundancy
 
 
 def shifted(N: int, t: int = 1, z: int = 0, v: float = 1.0) -> list[str]:
@@ -48,11 +50,22 @@ def _answer(rep: rescon.RedundancyReport) -> str:
                  rep.unbounded_agents, rep.certificate))
 
 
+def _old_support(self, members, u):
+    """_Cvx.support before R12: every direction solved by Problem.solve."""
+    self._level(members)
+    self.u.value = u
+    self._solve(self.psup)
+    if self.psup.status in ("unbounded", "unbounded_inaccurate"):
+        return math.inf, None, None
+    h = (_pq._dot([Fraction(float(v)) for v in u], self.cq)
+         + Fraction(self.s) * Fraction(float(self.psup.value)))
+    return redundancy._float(h), self.c + self._offset(), h
+
+
 def _old_answer(monkeypatch: pytest.MonkeyPatch, costs: list[str], r: int, d: int) -> str:
     """check_redundancy with every support solved by Problem.solve (the old path)."""
     with monkeypatch.context() as m:
-        m.setattr(redundancy._Cvx, "_compiled",
-                  lambda self, members, u: self._level(members))  # and None
+        m.setattr(redundancy._Cvx, "support", _old_support)
         return _answer(rescon.check_redundancy(costs, r, d=d))
 
 

@@ -901,35 +901,38 @@ class _Cvx:
         self.offsets: dict[tuple[int, ...], np.ndarray] = {}  # minimiser − c, unrounded
         self.scales: dict[tuple[int, ...], float] = {}  # V of each sum (_weights)
         self.posed: tuple[int, ...] | None = None  # whose weights and level are set
-        self.compiled: dict[tuple[int, ...], tuple[dict, Any, Any]] = {}  # psup, per sum
+        self.compiled: dict[tuple[int, ...], tuple[dict, Any]] = {}  # psup, per sum
         self.cmap: Any = None  # the linear map u ↦ psup's objective vector (_compiled)
+        self.cols: np.ndarray | None = None  # y's entries in psup's compiled variables
 
-    def _solve(self, problem: Any, compiled: tuple[dict, Any, Any] | None = None) -> None:
+    def _solve(self, problem: Any, compiled: tuple[dict, Any] | None = None
+               ) -> tuple[str, Any]:
         """problem.solve by Clarabel with the settings of RETRIES in turn until it ends
-        optimal or unbounded (its status is then read by the caller; "inaccurate"
-        warnings are dropped: the verdict is numerical anyway); SolverError when no
-        setting gets there (also when CVXPY finds data that overflowed to inf).
-        ``compiled``: (data, chain, inverse data) of problem.get_problem_data, solved
-        and unpacked as problem.solve does (the same warm-started Clarabel), without
-        compiling the problem again."""
-        why = ""
+        optimal or unbounded ("inaccurate" warnings are dropped: the verdict is numerical
+        anyway); SolverError when no setting gets there (also when CVXPY finds data that
+        overflowed to inf). Returns the status and, for ``compiled`` = (data, chain) of
+        problem.get_problem_data, Clarabel's own solution: solved by the same
+        warm-started Clarabel as problem.solve, without compiling again or unpacking
+        into the problem (the status mapped as CVXPY maps it); None otherwise (the
+        problem's variables then hold the solution)."""
+        why, raw = "", None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
             for opts in RETRIES:
                 try:
                     if compiled is None:
                         problem.solve(solver="CLARABEL", **opts)
+                        status = problem.status
                     else:
-                        data, chain, inverse = compiled
-                        problem.unpack_results(chain.solve_via_data(problem, data, True,
-                                                                    False, opts),
-                                               chain, inverse)
+                        data, chain = compiled
+                        raw = chain.solve_via_data(problem, data, True, False, opts)
+                        status = chain.solver.STATUS_MAP.get(str(raw.status), "solver_error")
                 except (self.cp.error.SolverError, ValueError) as e:  # ValueError: inf data
                     why = str(e)
                     continue
-                if problem.status in _DECIDED:
-                    return
-                why = f"status {problem.status}"
+                if status in _DECIDED:
+                    return status, raw
+                why = f"status {status}"
         raise SolverError(f"Clarabel failed on the numerical path: {why}")
 
     def _weights(self, members: tuple[int, ...]) -> None:
@@ -996,35 +999,40 @@ class _Cvx:
                 ) -> tuple[float, np.ndarray | None, Fraction | None]:
         """h(u), a point attaining it and h(u) = uᵀc + s·h_y exactly as computed (None:
         unbounded, h = inf)."""
-        compiled = self._compiled(members, u)
-        self.u.value = u
-        self._solve(self.psup, compiled)
-        if self.psup.status in ("unbounded", "unbounded_inaccurate"):
+        status, raw = self._solve(self.psup, self._compiled(members, u))
+        if status in ("unbounded", "unbounded_inaccurate"):
             return math.inf, None, None
+        y = np.asarray(raw.x, dtype=float)[self.cols]  # the maximiser, and h_y = uᵀy
         h = (_pq._dot([Fraction(float(v)) for v in u], self.cq)
-             + Fraction(self.s) * Fraction(float(self.psup.value)))
-        return _float(h), self.c + self._offset(), h
+             + Fraction(self.s) * Fraction(float(u @ y)))
+        return _float(h), self.c + self.s * y, h
 
-    def _compiled(self, members: tuple[int, ...], u: np.ndarray
-                  ) -> tuple[dict, Any, Any]:
-        """The support problem's Clarabel data (data, chain, inverse data) for the sum
-        over ``members`` and the direction u, as CVXPY's solve compiles them: the
+    def _compiled(self, members: tuple[int, ...], u: np.ndarray) -> tuple[dict, Any]:
+        """The support problem's Clarabel data and CVXPY's solving chain for the sum over
+        ``members`` and the direction u, as CVXPY's solve compiles them: the
         constraints' data (they depend on the weights and the level only, :meth:`_level`)
         compiled once per sum, then only the objective vector c replaced by C·u, C the
         sparse map of CVXPY's compilation from u to c (its columns compiled once, at
-        u = e_j; u enters c linearly, each entry ±u_j, so C·u is the very vector CVXPY
-        computes). One compilation per sum instead of one per direction: the data
-        Clarabel solves are unchanged."""
+        u = e_j). C must be −1 at y_j's column j and 0 elsewhere (max uᵀy compiled as
+        min −uᵀz, z_cols = y), else SolverError: then C·u is the very vector CVXPY
+        computes and y = z_cols. One compilation per sum instead of one per direction:
+        the data Clarabel solves are unchanged."""
         import scipy.sparse as sp
 
         if members not in self.compiled:
             self._level(members)
             if self.cmap is None:
-                self.cmap = sp.hstack([sp.csc_array(self._compile(e)[0]["c"].reshape(-1, 1))
-                                       for e in np.eye(len(u))], format="csr")
-            self.compiled[members] = self._compile(u)
-        data, chain, inverse = self.compiled[members]
-        return {**data, "c": self.cmap @ u}, chain, inverse
+                C = sp.hstack([sp.csc_array(self._compile(e)[0]["c"].reshape(-1, 1))
+                               for e in np.eye(len(u))], format="csc")
+                if not ((np.diff(C.indptr) == 1).all() and (C.data == -1).all()
+                        and len(set(C.indices)) == len(u)):
+                    raise SolverError("CVXPY compiled the support problem's objective uᵀy "
+                                      "other than as −uᵀ(y's columns)")
+                self.cmap, self.cols = C, C.indices
+            data, chain, _ = self._compile(u)
+            self.compiled[members] = data, chain
+        data, chain = self.compiled[members]
+        return {**data, "c": self.cmap @ u}, chain
 
     def _compile(self, u: np.ndarray) -> tuple[dict, Any, Any]:
         """psup.get_problem_data for Clarabel at the direction u (the weights and level
