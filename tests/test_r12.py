@@ -21,6 +21,7 @@ import pytest
 
 import rescon
 from benchmarks.redundancy_bench import family
+from rescon.errors import SolverError
 from rescon.optim import _pq, redundancy
 
 
@@ -42,6 +43,9 @@ CASES = {
     "logsumexp": (["logsumexp(x1, -x1) + sqrt(x2^2 + 1)",
                    "logsumexp(x1 - 1, -x1 + 1) + sqrt(x2^2 + 1)",
                    "huber(x1, 1) + huber(x2 - 1, 1)"], 1, 2),
+    "ray": (["x1", "norm2(0*x1, x1)", "x1^2"], 1, 1),  # exact verdict, numerical gap
+    "v34": (["abs((0)*x1 - (-2048))", "norm2((1)*x1 - (2048), (-0.25)*x1 - (2048))",
+             "norm2((1)*x1 - (2048), (-0.25)*x1 - (2048))", "abs(x1 - (1024))"], 1, 1),
 }
 
 
@@ -73,8 +77,30 @@ def _old_answer(monkeypatch: pytest.MonkeyPatch, costs: list[str], r: int, d: in
 def test_same_answer_as_one_solve_per_direction(monkeypatch, name):
     costs, r, d = CASES[name]
     rep = rescon.check_redundancy(costs, r, d=d)
-    assert not rep.exact
     assert _answer(rep) == _old_answer(monkeypatch, costs, r, d)
+
+
+def _outcome(costs: list[str], r: int, d: int) -> str:
+    try:
+        return _answer(rescon.check_redundancy(costs, r, d=d))
+    except SolverError as e:
+        return f"SolverError: {e}"
+
+
+@pytest.mark.parametrize("retries", [({"max_iter": 2}, {"max_iter": 200}),
+                                     ({"max_iter": 2},)])
+def test_retries_take_the_same_course(monkeypatch, retries):
+    """Clarabel stopped early (MaxIterations) is retried with the next settings, on the
+    same warm-started solver, as before; when every setting fails, the same
+    SolverError."""
+    costs, r, d = CASES["bench5"]
+    monkeypatch.setattr(redundancy, "RETRIES", retries)
+    new = _outcome(costs, r, d)
+    with monkeypatch.context() as m:
+        m.setattr(redundancy._Cvx, "support", _old_support)
+        old = _outcome(costs, r, d)
+    assert new == old
+    assert new.startswith("SolverError") == (len(retries) == 1)
 
 
 @pytest.mark.slow
