@@ -16,13 +16,15 @@ Families (integer data, seed 0; c a common centre):
 
 Each verdict is checked before it is timed: exact ones by the standalone checker
 (``valid``), numerical ones must say ``unchecked``. The time is the median of
-``--repeat`` runs after one warm-up. Writes ``redundancy.csv`` and ``redundancy.md``.
+``--repeat`` runs after one warm-up, the machine's load average noted (times grow with
+it). Writes ``redundancy.csv`` and ``redundancy.md``.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import os
 import platform
 import statistics
 import time
@@ -87,6 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results"))
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
+    load0 = os.getloadavg()[0]
     rows = [run(name, N, args.repeat) for N in (12, 20)
             for name in ("quadratic-common", "quadratic-shifted", "mixed-common",
                          "mixed-shifted", "numerical")]
@@ -96,8 +99,10 @@ def main(argv: list[str] | None = None) -> int:
         w.writeheader()
         w.writerows(rows)
     machine = f"{platform.processor() or platform.machine()}, Python {platform.python_version()}"
+    load = f"{load0:.1f}–{os.getloadavg()[0]:.1f}"  # the 2 cores are shared: times scale
     lines = ["# r-redundancy verification (rescon.check_redundancy, d = 3, r = 2)", "",
-             (f"{machine}; median of {args.repeat} warm runs; C(N, 2) subsets + the whole set "
+             (f"{machine}; load {load} (1-min average, start–end); median of {args.repeat} "
+              "warm runs; C(N, 2) subsets + the whole set "
               "+ each agent alone. exact: certificate verified valid by certificates/check.py; "
               "numerical: unchecked."), "",
              "| family | N | holds | exact | gap | seconds | target |",
