@@ -441,7 +441,9 @@ def test_adversary_raising_after_a_nested_kernel_propagates_and_restores_state()
     assert _state() == before
 
 
+@pytest.mark.slow
 def test_cost_oracle_calling_rescon_in_rmdo():
+    """(~35 s: the oracle is called for every agent at every step.)"""
     sc = replace(rescon.Scenario.paper_example(), steps=4)
 
     def pair(i):
