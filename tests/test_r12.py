@@ -113,12 +113,15 @@ def test_same_answer_on_the_bench_family_n12(monkeypatch):
 
 def test_compiled_data_is_cvxpys_own():
     """The data solved per direction (cached constraints, c = C·u) equal CVXPY's own
-    compilation at that direction, entry for entry."""
+    compilation at that direction, entry for entry, also when a sum's cached data are
+    used again after other sums were compiled."""
     chk = redundancy._Check(*redundancy._costs(family("numerical", 5), 3), 2)
     cvx = chk.cvx
     rng = np.random.default_rng(1)
-    for members in [(0, 1, 2), (1, 3, 4), (0, 1, 2, 3, 4)]:
+    sums = [(0, 1, 2), (1, 3, 4), (0, 1, 2, 3, 4)]
+    for members in sums:
         assert cvx.minimise(members)[0] == "optimal"
+    for members in sums + sums:  # the second time from the cache, after other sums'
         for u in [*chk.dirs, *rng.standard_normal((3, 3))]:
             data = cvx._compiled(members, u)[0]
             cvx._level(members)
