@@ -9,15 +9,17 @@ validation; output paths checked for writability before any work.
 
 from __future__ import annotations
 
+import inspect
+import shutil
 import time
 from fractions import Fraction
+from pathlib import Path
 
 import networkx as nx
 import pytest
 
 import rescon
 from rescon.optim import expr
-
 
 # --------------------------------------------------------------------------- undirected
 
@@ -94,3 +96,69 @@ def test_digit_bound_is_exact():
     assert expr.MAX_DIGITS == 4300
     assert expr._fits(Fraction(10**4300 - 1, 10**4300 - 3))
     assert not expr._fits(Fraction(10**4300, 3)) and not expr._fits(Fraction(1, 10**4300))
+
+
+# --------------------------------------------------------------------------- input files
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _readers():
+    from rescon.optim import read_costs, read_rmdo
+    from rescon.sweep.grid import read_grid
+
+    return {"from_toml": rescon.Scenario.from_toml, "read_rmdo": read_rmdo,
+            "read_costs": read_costs, "read_grid": read_grid, "sweep": rescon.sweep}
+
+
+@pytest.mark.parametrize("reader", ["from_toml", "read_rmdo", "read_costs", "read_grid",
+                                    "sweep"])
+def test_toml_readers_refuse_a_directory_in_one_line(tmp_path, reader):
+    with pytest.raises(rescon.InputError, match="is a directory") as exc:
+        _readers()[reader](tmp_path)
+    assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("path, reader", [
+    ("scenarios/ring_attack.toml", "from_toml"),
+    ("scenarios/rmdo_quadratic.toml", "read_rmdo"),
+    ("scenarios/rmdo_quadratic.toml", "read_costs"),
+    ("sweeps/small.toml", "read_grid"),
+])
+def test_toml_readers_read_a_file_with_a_bom_like_without(tmp_path, path, reader):
+    shutil.copytree(EXAMPLES, tmp_path / "ex")  # with the files the examples name
+    src = tmp_path / "ex" / path
+    bom = src.with_name("bom.toml")
+    bom.write_bytes(b"\xef\xbb\xbf" + src.read_bytes())
+    read = _readers()[reader]
+    a, b = read(src), read(bom)
+    if reader == "from_toml":
+        assert a.to_dict() == b.to_dict()
+    elif reader == "read_rmdo":
+        assert a.scenario.to_dict() == b.scenario.to_dict() and a.costs.keys() == b.costs.keys()
+    elif reader == "read_costs":
+        assert a[1] == b[1] and [o.source for o in a[0].values()] == [
+            o.source for o in b[0].values()]
+    else:
+        assert a.axes == b.axes and a.kind == b.kind
+
+
+def test_input_file_names_what_it_wanted(tmp_path):
+    from rescon.io import input_file
+
+    with pytest.raises(rescon.InputError, match="^graph file: path must be a str or "
+                                                "os.PathLike; got NoneType$"):
+        input_file(None, "graph file")
+    with pytest.raises(rescon.InputError, match="^points file is a directory: "):
+        input_file(tmp_path, "points file")
+    with pytest.raises(rescon.InputError, match="^points file not found: "):
+        input_file(tmp_path / "x", "points file")
+    (tmp_path / "x").write_text("")
+    assert input_file(tmp_path / "x", "points file") == tmp_path / "x"
+
+
+def test_sweep_shows_its_real_signature():
+    from rescon.sweep.run import sweep
+
+    assert inspect.signature(rescon.sweep) == inspect.signature(sweep)
+    assert "scheduler" in inspect.signature(rescon.sweep).parameters

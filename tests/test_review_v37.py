@@ -434,24 +434,21 @@ def test_scenario_files_naming_a_directory_are_input_errors(tmp_path):
 # --------------------------------------------------------------------------- API: bugs
 
 
-@pytest.mark.xfail(strict=True, reason="V37: Scenario.from_toml(a directory) raises "
-                   "IsADirectoryError (scenario.py read_toml catches FileNotFoundError only)")
 def test_from_toml_of_a_directory_is_an_input_error(tmp_path):
+    """Fixed (was a bug: IsADirectoryError, read_toml caught FileNotFoundError only)."""
     with pytest.raises(rescon.InputError):
         rescon.Scenario.from_toml(tmp_path)
 
 
-@pytest.mark.xfail(strict=True, reason="V37: Scenario.from_toml(None) raises a builtins "
-                   "TypeError (read_graph says 'path must be a str or os.PathLike')")
 def test_from_toml_of_a_non_path_is_an_input_error():
+    """Fixed (was a bug: a builtins TypeError from Path(None))."""
     with pytest.raises(rescon.InputError):
         rescon.Scenario.from_toml(None)
 
 
-@pytest.mark.xfail(strict=True, reason="V37: a BOM-prefixed scenario file is 'malformed TOML "
-                   "(Invalid statement (at line 1, column 1))' while graph and point files "
-                   "with a BOM are read (scenario.py reads utf-8, io.py utf-8-sig)")
 def test_scenario_file_with_a_bom_reads_like_without(tmp_path):
+    """Fixed (was a bug: a BOM-prefixed scenario file was 'malformed TOML'; read_toml now
+    reads utf-8-sig like rescon.io)."""
     text = '[scenario]\nF = 0\nsteps = 2\n[graph]\nedges = [[0, 1], [1, 0]]\n' \
            '[initial]\n0 = [0.0]\n1 = [1.0]\n'
     plain, bom = tmp_path / "plain.toml", tmp_path / "bom.toml"

@@ -30,7 +30,8 @@ import numpy as np
 from ._validate import flag
 from .errors import GraphFormatError, InputError
 
-__all__ = ["output_path", "read_graph", "read_points", "to_jsonable", "write_json"]
+__all__ = ["input_file", "output_path", "read_graph", "read_points", "to_jsonable",
+           "write_json"]
 
 #: an integer label as Python writes it (ASCII digits, no "+", no leading zeros, not
 #: "-0"): only these become ints, so two spellings of one number ("1", "01") stay two nodes
@@ -113,7 +114,7 @@ def read_graph(path: str | os.PathLike[str], *, undirected: bool = False) -> nx.
     ([(1, 2), (2, 3)], [1, 2, 3, 4])
     """
     undirected = flag("undirected", undirected)
-    p = _existing_file(path, "graph file")
+    p = input_file(path, "graph file")
     reader = _GRAPH_READERS.get(p.suffix.lower(), _read_edge_list)
     G = reader(p)
     if G.number_of_nodes() == 0:
@@ -326,7 +327,7 @@ def read_points(path: str | os.PathLike[str]) -> np.ndarray:
         no points, or an ``.npy`` array that is not 2-D. CSV messages name the
         file and line.
     """
-    p = _existing_file(path, "points file")
+    p = input_file(path, "points file")
     if p.suffix.lower() == ".npy":
         return _read_npy_points(p)
     rows = _point_rows(p)
@@ -370,13 +371,28 @@ def _read_npy_points(p: Path) -> np.ndarray:
 # --------------------------------------------------------------------------- text helpers
 
 
-def _existing_file(path: Any, what: str) -> Path:
+def input_file(path: Any, what: str, *, missing: str = "{what} not found: {path}") -> Path:
+    """``path`` as a Path naming an existing file, by one rule for every input (graph,
+    points, scenario, costs, RMDO and sweep files).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    what : what the file is, for the message (e.g. ``"graph file"``).
+    missing : the message when nothing is at ``path`` (``{what}``, ``{path}`` filled in).
+
+    Raises
+    ------
+    InputError
+        ``path`` is not a str or os.PathLike, is a directory, or names nothing (one line).
+    """
     if not isinstance(path, (str, os.PathLike)):
-        raise InputError(f"path must be a str or os.PathLike; got {type(path).__name__}")
+        raise InputError(f"{what}: path must be a str or os.PathLike; got {type(path).__name__}")
     p = Path(path)
     if not p.is_file():
-        reason = "is a directory" if p.is_dir() else "not found"
-        raise InputError(f"{what} {reason}: {p}")
+        if p.is_dir():
+            raise InputError(f"{what} is a directory: {p}")
+        raise InputError(missing.format(what=what, path=p))
     return p
 
 

@@ -459,8 +459,9 @@ class Scenario:
         """Read a scenario file (format: README, "Scenario files"). A file with
         [costs] or [step_size] describes an RMDO run and is refused here: read it with
         :func:`rescon.optim.read_rmdo` (``rescon rmdo``)."""
+        data = read_toml(path)
         p = Path(path)
-        return cls.from_dict(read_toml(p), base=p.parent, where=str(p))
+        return cls.from_dict(data, base=p.parent, where=str(p))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], *, base: str | Path = ".",
@@ -499,15 +500,21 @@ class Scenario:
                          "schedule": a.schedule.to_dict()} for a in self.dos]}
 
 
-def read_toml(path: Path) -> dict:
-    """The parsed TOML of a scenario (or costs) file; missing, undecodable or
-    malformed files are an InputError naming the file."""
+def read_toml(path: Any) -> dict:
+    """The parsed TOML of a scenario (or costs, RMDO, sweep) file, read as UTF-8 with an
+    optional byte-order mark (as :mod:`rescon.io` reads graph and point files); a path
+    that is not a str / os.PathLike, a directory, a missing, undecodable or malformed
+    file is an InputError naming it (:func:`rescon.io.input_file`)."""
+    from ..io import input_file
+
+    path = input_file(path, "scenario file", missing="{path}: no such scenario file")
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such scenario file") from None
+        return tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: malformed TOML ({exc})") from None
+    except OSError as exc:  # unreadable (permissions), or gone since input_file looked
+        raise InputError(f"{path}: cannot read the scenario file "
+                         f"({exc.strerror or exc})") from None
 
 
 _TOP = {"scenario", "graph", "initial", "adversaries", "dos"}

@@ -24,5 +24,12 @@ class _CallableModule(types.ModuleType):
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         return sweep(*args, **kwargs)
 
+    @property
+    def __signature__(self) -> Any:
+        """:func:`sweep`'s, for ``inspect.signature(rescon.sweep)`` and ``help``."""
+        import inspect
+
+        return inspect.signature(sweep)
+
 
 sys.modules[__name__].__class__ = _CallableModule
