@@ -12,7 +12,7 @@ compared bit for bit with the serial answer; forked / spawned worker pools after
 parent ran the kernels, numba and the robustness MILP; reentrancy (an adversary or a cost
 oracle that itself calls rescon).
 
-Found (xfail strict):
+Found (were xfail strict; fixed, the tests say "Fixed (was a bug: …)"):
 * ``simulate`` / ``rmdo`` fail with ``FloatingPointError: underflow`` under the caller's
   ``np.seterr(all="raise")`` (or ``under="raise"``): the validity monitor's error bound
   (consensus/_facet_filter.py ``_slack_bound``) multiplies the smallest subnormal and
@@ -78,10 +78,9 @@ def _quiet_simulate(sc, **kw):
 # --------------------------------------------------------------------------- #
 
 
-@pytest.mark.xfail(strict=True, raises=FloatingPointError,
-                   reason="V38: simulate raises FloatingPointError (underflow "
-                   "in consensus/_facet_filter.py _slack_bound) under np.seterr(under='raise')")
 def test_simulate_under_the_callers_seterr_all_raise():
+    """Fixed (was a bug: FloatingPointError from the validity monitor's error bound,
+    whose products round to subnormals, under the caller's np.seterr(all="raise"))."""
     sc = _ring_scenario(steps=2)
     ref = _quiet_simulate(sc)
     with np.errstate(all="raise"):
@@ -89,10 +88,8 @@ def test_simulate_under_the_callers_seterr_all_raise():
     assert np.array_equal(got.states, ref.states)
 
 
-@pytest.mark.xfail(strict=True, raises=FloatingPointError,
-                   reason="V38: the validity monitor's error bound underflows: "
-                   "FloatingPointError under np.seterr(under='raise') (the paper's example)")
 def test_paper_example_validity_monitor_under_seterr_under_raise():
+    """Fixed (was a bug: the same underflow under np.seterr(under="raise"))."""
     sc = replace(rescon.Scenario.paper_example(), steps=3)
     with np.errstate(under="raise"):
         out = _quiet_simulate(sc, metrics=["validity"])
@@ -227,10 +224,10 @@ def test_two_concurrent_fast_path_kernels_leave_gc_enabled():
         assert gc.isenabled()
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="V38: gc.disable() by another thread during a "
-                   "fast-path kernel is undone on return (fastpath._collection_deferred)")
 def test_callers_gc_disable_during_a_kernel_in_another_thread_is_kept():
+    """Fixed (was a bug: the fast path switched the cyclic collector off and on
+    process-wide, undoing a gc.disable() made meanwhile by another thread; it no longer
+    touches the collector)."""
     X = _cloud(14, 5, 0)
     rescon.safe_kernel(X, 1)  # warm (numba)
     worker = threading.Thread(target=rescon.safe_kernel, args=(X, 1))

@@ -25,7 +25,7 @@ from .._rounding import MIN_SUBNORMAL, UNIT_ROUNDOFF
 def _slacks(A: np.ndarray, b: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """fl(Â x − b̂) per row of ``states`` and facet (Â, b̂), and its error bound
     (:meth:`ValidityMonitor.surely_inside`)."""
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
         S = states @ A.T - b
         bound = _slack_bound(states.shape[1], np.abs(states) @ np.abs(A).T, np.abs(b),
                              np.abs(states).max(axis=1)[:, None])
@@ -36,9 +36,12 @@ def _slack_bound(d: int, abs_dot: np.ndarray, abs_b: np.ndarray,
                  top: np.ndarray) -> np.ndarray:
     """Error bound of fl(â·x − b̂) in R^d from |â|·|x| (``abs_dot``), |b̂| and
     max |x_p| (``top``): 2(d+2)u(|â|·|x| + |b̂|) + (d+2)·2^-1074·(max |x_p| + 1), the
-    last term for gradual underflow (one rule for :func:`_slacks` and the fan test)."""
-    return (2 * (d + 2) * UNIT_ROUNDOFF * (abs_dot + abs_b)
-            + (d + 2) * MIN_SUBNORMAL * (top + 1))
+    last term for gradual underflow (one rule for :func:`_slacks` and the fan test).
+    Its products round to subnormals by design: numpy's underflow flag is ignored here,
+    whatever the caller's ``np.seterr`` (V38: ``all="raise"`` stopped every run)."""
+    with np.errstate(under="ignore"):
+        return (2 * (d + 2) * UNIT_ROUNDOFF * (abs_dot + abs_b)
+                + (d + 2) * MIN_SUBNORMAL * (top + 1))
 
 
 def _filter_rows(facets) -> tuple[np.ndarray, np.ndarray]:

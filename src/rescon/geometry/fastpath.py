@@ -53,8 +53,6 @@ whose floats are not proven, or the first read of the exact vertices
 
 from __future__ import annotations
 
-import contextlib
-import gc
 import itertools
 import operator
 from math import gcd
@@ -329,12 +327,11 @@ def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope 
         return None
     sel = np.asarray(first if len(first) >= k + 1 else np.arange(len(H)), dtype=np.int64)
     split = _Split()
-    with _collection_deferred():
-        for options in QHULL_OPTIONS:
-            for opts in _chain(options, k):
-                P = _attempt(H, k, scale, sel, opts, split)
-                if P is not None:
-                    return P
+    for options in QHULL_OPTIONS:
+        for opts in _chain(options, k):
+            P = _attempt(H, k, scale, sel, opts, split)
+            if P is not None:
+                return P
     return None
 
 
@@ -347,21 +344,6 @@ def _chain(options: str | None, k: int) -> tuple[str | None, ...]:
     if options is None and k >= 5:
         return MERGED_OPTIONS_5D
     return MERGED_OPTIONS_4D if options is None and k == 4 else (options,)
-
-
-@contextlib.contextmanager
-def _collection_deferred():
-    """Python's cyclic garbage collector off (if it was on) while the fast path runs: it
-    allocates ~10⁵ containers (vertex tuples, lists of rows), none of them in a cycle,
-    which set off collections of the whole heap — a third of the fast path's time in
-    d = 4, n = 50 (0.11 of 0.35 CPU-s). Reference counting still frees everything."""
-    on = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if on:
-            gc.enable()
 
 
 def _attempt(H, k: int, scale: int, sel: np.ndarray, options: str | None,
