@@ -250,3 +250,28 @@ def test_pickle_before_and_after_reading_and_threads():
     for t in threads:
         t.join()
     assert len(got) == 4 and all(g == V for g in got)
+
+
+def test_a_deferred_value_is_built_once_by_concurrent_readers():
+    """Fixed (was a bug, V38: threads reading one kernel's deferred value at the same
+    time each built it — 8 threads sharing a d = 5 kernel solved its vertices 8 times)."""
+    import threading
+    import time
+
+    from rescon.geometry.kernel import _Deferred
+
+    built = []
+
+    def make():
+        built.append(1)
+        time.sleep(0.05)  # long enough for every reader to arrive meanwhile
+        return ("value",)
+
+    deferred = _Deferred(make)
+    seen = []
+    threads = [threading.Thread(target=lambda: seen.append(deferred.get())) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    assert len(built) == 1 and len(seen) == 8 and all(v is seen[0] for v in seen)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 import math
 import operator
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -52,15 +53,20 @@ FAST_PATH_MIN_HALFSPACES = 60
 class _Deferred:
     """A value built on its first use, then kept: a kernel's exact vertices (a reduced
     Fraction — a gcd of 500-1300-bit integers in d = 4-5 — per coordinate, which most
-    callers never read; the floats, the order and the facets come without them)."""
+    callers never read; the floats, the order and the facets come without them).
+    Built once also when threads read it at the same time: the others wait for the
+    first (V38: 8 threads sharing one kernel each solved its vertices)."""
 
     def __init__(self, make: Callable[[], Any]) -> None:
         self._make: Callable[[], Any] | None = make
         self._value: Any = None
+        self._lock = threading.Lock()
 
     def get(self) -> Any:
         if self._make is not None:
-            self._value, self._make = self._make(), None
+            with self._lock:
+                if self._make is not None:  # not built while this thread waited
+                    self._value, self._make = self._make(), None
         return self._value
 
 
