@@ -10,6 +10,7 @@ validation; output paths checked for writability before any work.
 from __future__ import annotations
 
 import inspect
+import os
 import shutil
 import time
 from fractions import Fraction
@@ -162,3 +163,106 @@ def test_sweep_shows_its_real_signature():
 
     assert inspect.signature(rescon.sweep) == inspect.signature(sweep)
     assert "scheduler" in inspect.signature(rescon.sweep).parameters
+
+
+# --------------------------------------------------------------------------- API arguments
+
+
+def test_simulate_refuses_a_non_scenario_like_rmdo():
+    for bad in (None, {"scenario": {}}, "paper.toml"):
+        with pytest.raises(rescon.InputError, match="scenario must be a rescon.Scenario"):
+            rescon.simulate(bad)
+
+
+@pytest.mark.parametrize("value", ["no", 0, 1, "False"])
+def test_progress_refuses_non_bools_everywhere(value):
+    from rescon._progress import progress_bar, wanted
+
+    with pytest.raises(rescon.InputError, match="progress must be True or False"):
+        wanted(value)
+    with pytest.raises(rescon.InputError, match="progress"):
+        progress_bar(value, 10, "x")
+    with pytest.raises(rescon.InputError, match="progress"):
+        rescon.robustness(nx.complete_graph(4), progress=value)
+    assert wanted(False) is False and progress_bar(False, 10, "x") is None
+
+
+def test_check_subgradient_seed_zero_is_fine_and_negative_refused():
+    f = rescon.cost("abs(x1)")
+    assert rescon.check_subgradient(f, [[1.0]], seed=0) <= 1e-12
+    with pytest.raises(rescon.InputError, match="seed must be a nonnegative integer"):
+        rescon.check_subgradient(f, [[1.0]], seed=-5)
+
+
+# --------------------------------------------------------------------------- output paths
+
+
+def _unwritable_dir() -> Path | None:
+    """A directory this process cannot create files in, even as root (/proc refuses)."""
+    for d in (Path("/proc"), Path("/sys")):
+        probe = d / "rescon_r13_probe"
+        try:
+            probe.write_text("")
+        except OSError:
+            return d
+        probe.unlink()
+    return None
+
+
+def test_output_path_tries_writing_and_leaves_nothing_behind(tmp_path):
+    from rescon.io import output_path
+
+    existing = tmp_path / "keep.json"
+    existing.write_text("old")
+    before = existing.stat().st_mtime_ns
+    assert output_path(existing, "--certificate") == existing
+    assert existing.read_text() == "old" and existing.stat().st_mtime_ns == before
+    new = tmp_path / "sub" / "new.json"
+    assert output_path(new, "--certificate") == new and not new.exists()
+    out = output_path(tmp_path / "dir", "--out", directory=True)
+    assert out.is_dir() and list(out.iterdir()) == []
+    assert output_path(os.devnull, "--certificate") == Path(os.devnull)
+
+
+def test_output_path_refuses_an_unwritable_place_naming_the_option():
+    from rescon.io import output_path
+
+    d = _unwritable_dir()
+    if d is None:
+        pytest.skip("needs a directory that refuses new files (/proc or /sys)")
+    with pytest.raises(rescon.InputError, match=r"^--certificate: cannot write .*rescon_r13"):
+        output_path(d / "rescon_r13.json", "--certificate")
+    with pytest.raises(rescon.InputError, match=r"^out: cannot write "):
+        output_path(d, "out", directory=True)
+
+
+def test_cli_refuses_unwritable_outputs_before_reading_input(tmp_path, capfd):
+    from rescon.cli import main
+
+    d = _unwritable_dir()
+    if d is None:
+        pytest.skip("needs a directory that refuses new files (/proc or /sys)")
+    missing = tmp_path / "no_such_input"  # read after the outputs are checked
+    for argv, option in (
+            (["kernel", missing, "--F", "1", "--certificate", d / "k.json"], "--certificate"),
+            (["simulate", missing, "--out", d], "--out"),
+            (["robustness", missing, "--certificate", d / "r.json"], "--certificate")):
+        code = main([str(a) for a in argv])
+        out, err = capfd.readouterr()
+        assert code == 2 and out == "" and err.startswith(f"rescon: error: {option}: "), err
+        assert len(err.splitlines()) == 1
+
+
+def test_a_write_that_fails_after_the_check_names_the_option(tmp_path, capfd, monkeypatch):
+    from rescon import cli
+
+    g = tmp_path / "g.txt"
+    g.write_text("0 1\n1 0\n")
+
+    def refuse(self, *args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(Path, "write_text", refuse)
+    code = cli.main(["robustness", str(g), "--certificate", str(tmp_path / "c.json")])
+    err = capfd.readouterr().err
+    assert code == 2 and err.startswith("rescon: error: --certificate: cannot write "), err

@@ -261,9 +261,9 @@ def test_simulate_out_that_is_a_file_is_refused_before_running(tmp_path, capfd):
     assert "--out" in err and f.read_text() == "x"
 
 
-@pytest.mark.xfail(strict=True, reason="V37: an unwritable --certificate is found only after "
-                   "the computation, as a bare '[Errno 13] ...' not naming the option")
 def test_unwritable_certificate_is_refused_before_any_work(tmp_path, capfd, monkeypatch):
+    """Fixed (was a bug: an unwritable --certificate was found only after the computation,
+    as a bare '[Errno 13] ...' not naming the option)."""
     target = Path("/sys/rescon_v37_certificate.json")
     if not Path("/sys").is_dir() or os.access("/sys", os.W_OK) and _writable(target):
         pytest.skip("needs an unwritable location (/sys on Linux)")
@@ -457,23 +457,20 @@ def test_scenario_file_with_a_bom_reads_like_without(tmp_path):
     assert rescon.Scenario.from_toml(bom).to_dict() == rescon.Scenario.from_toml(plain).to_dict()
 
 
-@pytest.mark.xfail(strict=True, reason="V37: simulate(a non-Scenario) raises AttributeError from "
-                   "ConsensusMonitor (rmdo checks its scenario, simulate does not)")
 def test_simulate_of_a_non_scenario_is_an_input_error():
+    """Fixed (was a bug: AttributeError from ConsensusMonitor; rmdo checked, simulate not)."""
     with pytest.raises(rescon.InputError):
         rescon.simulate({"scenario": {"paper_example": True}})
 
 
-@pytest.mark.xfail(strict=True, reason="V37: progress='no' is read by its truth value (a bar "
-                   "is forced); _progress.wanted does bool(enabled)")
 def test_progress_takes_true_false_or_none_only():
+    """Fixed (was a bug: progress='no' was read by its truth value, a bar forced)."""
     with pytest.raises(rescon.InputError):
         rescon.simulate(rescon.Scenario.paper_example(steps=1), progress="no")
 
 
-@pytest.mark.xfail(strict=True, reason="V37: check_subgradient(seed=-1) raises numpy's "
-                   "'expected non-negative integer' ValueError (oracle.py: integer() with no low)")
 def test_check_subgradient_negative_seed_is_an_input_error():
+    """Fixed (was a bug: numpy's 'expected non-negative integer' ValueError)."""
     with pytest.raises(rescon.InputError):
         rescon.check_subgradient(rescon.cost("x1^2"), [[1.0]], seed=-1)
 

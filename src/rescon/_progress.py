@@ -10,14 +10,18 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from ._validate import flag
+
 __all__ = ["progress_bar", "wanted"]
 
 
 def wanted(enabled: bool | None) -> bool:
-    """Whether a bar should be shown: ``enabled``, or stderr is a terminal when None."""
+    """Whether a bar should be shown: ``enabled``, or stderr is a terminal when None.
+    Anything but True, False or None ("no", 0 …) is an InputError naming ``progress``,
+    not read by its truth value."""
     if enabled is None:
         return sys.stderr.isatty()
-    return bool(enabled)
+    return flag("progress", enabled)
 
 
 def progress_bar(enabled: bool | None, total: float | None, desc: str, *,

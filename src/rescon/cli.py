@@ -48,7 +48,12 @@ def _write_certificate(cert: dict[str, Any] | None, target: Path | None) -> None
               "search before an answer", file=sys.stderr)
         return
     # compact: a search-tree proof can hold millions of tokens
-    target.write_text(json.dumps(cert, separators=(",", ":")) + "\n", encoding="utf-8")
+    text = json.dumps(cert, separators=(",", ":")) + "\n"
+    try:  # checked writable before the work (_output); this catches what changed since
+        target.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise RESCONError(f"--certificate: cannot write {target} "
+                          f"({exc.strerror or exc})") from None
 
 
 def _progress(args: argparse.Namespace) -> bool | None:
@@ -185,6 +190,8 @@ def _draw(draw: Callable[[], Any], path: Path) -> None:
         raise
     except ValueError as exc:
         raise RESCONError(f"--plot: cannot draw {path}: {exc}") from exc
+    except OSError as exc:  # checked writable before the work; changed since
+        raise RESCONError(f"--plot: cannot write {path} ({exc.strerror or exc})") from None
 
 
 def _run_outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
@@ -228,9 +235,13 @@ def _run_summary(args: argparse.Namespace, sc: Any, traj: Any, out_dir: Path | N
            "assumptions_violated": traj.info["assumptions_violated"],
            "seconds": round(traj.seconds, 6)}
     if out_dir is not None:
-        (out_dir / "trajectory.json").write_text(json.dumps(traj.to_json()) + "\n",
-                                                 encoding="utf-8")
-        traj.to_csv(out_dir / "trajectory.csv")
+        try:  # checked writable before the run (_run_outputs)
+            (out_dir / "trajectory.json").write_text(json.dumps(traj.to_json()) + "\n",
+                                                     encoding="utf-8")
+            traj.to_csv(out_dir / "trajectory.csv")
+        except OSError as exc:
+            raise RESCONError(f"--out: cannot write into {out_dir} "
+                              f"({exc.strerror or exc})") from None
         if plot is not None:
             _draw(lambda: traj.plot(plot), plot)
         out["out"] = str(out_dir)

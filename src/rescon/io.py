@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import errno
 import json
 import math
 import os
 import re
 import sys
+import tempfile
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from fractions import Fraction
 from pathlib import Path
@@ -464,7 +466,12 @@ def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
     """Where an output goes, by one rule for every output (``--plot``,
     ``--certificate``, ``--out``, ``write_json``, figures): missing parent
     directories are created; a file path that is an existing directory, a directory
-    path that is an existing file, and a symbolic link to nothing are refused.
+    path that is an existing file, a symbolic link to nothing, and a place that
+    cannot be written now are refused — before any work is done. Writability is
+    tried, not guessed from permission bits (``os.access`` says yes to root on file
+    systems that refuse it, such as /sys): an existing file is opened for appending
+    (nothing written), a new one is created and removed, a directory gets a probe file
+    created and removed.
 
     Parameters
     ----------
@@ -475,8 +482,8 @@ def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
     Raises
     ------
     InputError
-        ``path`` is not a path, has the wrong kind, or a directory on it cannot be
-        created (one line naming ``what``).
+        ``path`` is not a path, has the wrong kind, a directory on it cannot be
+        created, or it cannot be written (one line naming ``what``).
     """
     if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
         raise InputError(f"{what} must be a non-empty path; got {path!r}")
@@ -492,7 +499,31 @@ def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
     except OSError as exc:
         raise InputError(f"{what}: cannot create the directory for {p} "
                          f"({exc.strerror or exc})") from None
+    try:
+        _try_writing(p, directory)
+    except OSError as exc:
+        raise InputError(f"{what}: cannot write {p} ({exc.strerror or exc})") from None
     return p
+
+
+def _try_writing(p: Path, directory: bool) -> None:
+    """OSError unless ``p`` (a directory: a file in it) can be written now; leaves
+    everything as it was. Special files (/dev/null, FIFOs) by their permission bits only:
+    opening a FIFO for writing would wait for a reader."""
+    if directory:
+        fd, probe = tempfile.mkstemp(prefix=".rescon-write-probe-", dir=p)
+        os.close(fd)
+        os.unlink(probe)
+    elif p.is_file():
+        with p.open("a"):
+            pass
+    elif p.exists():
+        if not os.access(p, os.W_OK):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+    else:
+        with p.open("x"):
+            pass
+        p.unlink()
 
 
 # --------------------------------------------------------------------------- JSON output

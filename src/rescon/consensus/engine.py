@@ -79,11 +79,14 @@ def simulate(scenario: Scenario, *, metrics: Sequence[str] | str | None = None,
     Raises
     ------
     InputError
-        A metric passing the float range (:meth:`ConsensusMonitor.record`: benign
+        ``scenario`` is not a :class:`Scenario`; ``progress`` is not True, False or
+        None; a metric passing the float range (:meth:`ConsensusMonitor.record`: benign
         states dragged apart to ±1e308 by adversaries, with F = 0 or the "mean"
         baseline). States themselves stay finite at every magnitude.
     """
     t0 = time.perf_counter()
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario must be a rescon.Scenario; got {type(scenario).__name__}")
     monitor = ConsensusMonitor(scenario, metrics)
     problems = scenario.warn()
     return run(scenario, ConvexStep(scenario.residual), monitors=[monitor],

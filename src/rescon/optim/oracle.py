@@ -206,7 +206,7 @@ def check_subgradient(oracle: Any, points: Any, *, samples: int = 64, seed: int 
     oracle : anything :func:`rescon.cost` accepts
     points : array (B, d)
     samples : int, number of y per point (≥ 1)
-    seed : int, for the sample directions (one ``numpy.random.Generator``)
+    seed : int ≥ 0, for the sample directions (one ``numpy.random.Generator``)
 
     Examples
     --------
@@ -219,7 +219,7 @@ def check_subgradient(oracle: Any, points: Any, *, samples: int = 64, seed: int 
 
     o = cost(oracle)
     n = _validate.integer("samples", samples, low=1)
-    rng = np.random.default_rng(_validate.integer("seed", seed))
+    rng = np.random.default_rng(_validate.integer("seed", seed, low=0))
     X = o._points(points)
     if not len(X):
         raise InputError("points must hold at least one point; got shape (0, d)")
