@@ -288,7 +288,7 @@ def test_plot_needs_out_and_bad_out(capsys, tmp_path):
     f.write_text("x")
     assert_error(["rmdo", EXAMPLES / "paper_rmdo.toml", "--out", f], capsys, "--out",
                  "not a directory")
-    assert_error(["rmdo", tmp_path / "missing.toml"], capsys, "no such scenario file")
+    assert_error(["rmdo", tmp_path / "missing.toml"], capsys, "no such RMDO file")
 
 
 def test_subprocess_bad_expression(tmp_path):

@@ -266,3 +266,21 @@ def test_a_write_that_fails_after_the_check_names_the_option(tmp_path, capfd, mo
     code = cli.main(["robustness", str(g), "--certificate", str(tmp_path / "c.json")])
     err = capfd.readouterr().err
     assert code == 2 and err.startswith("rescon: error: --certificate: cannot write "), err
+
+
+@pytest.mark.parametrize("reader, what", [("read_rmdo", "RMDO file"),
+                                          ("read_costs", "costs file")])
+def test_rmdo_and_costs_readers_refuse_a_non_path_naming_the_file_kind(reader, what):
+    """Fixed (was a bug, V37: read_rmdo(None) / read_costs(None) raised a builtins
+    TypeError from Path(None))."""
+    from rescon.optim import files
+
+    with pytest.raises(rescon.InputError, match=f"^{what}: path must be"):
+        getattr(files, reader)(None)
+
+
+def test_cost_vectorised_takes_true_or_false_only():
+    """Fixed (was a bug, V37: cost("x1^2", vectorised="no") was accepted and ignored)."""
+    with pytest.raises(rescon.InputError, match="vectorised must be True or False"):
+        rescon.cost("x1^2", vectorised="no")
+    assert rescon.cost("x1^2", vectorised=True).value([[2.0]]).tolist() == [4.0]

@@ -500,20 +500,20 @@ class Scenario:
                          "schedule": a.schedule.to_dict()} for a in self.dos]}
 
 
-def read_toml(path: Any) -> dict:
-    """The parsed TOML of a scenario (or costs, RMDO, sweep) file, read as UTF-8 with an
-    optional byte-order mark (as :mod:`rescon.io` reads graph and point files); a path
-    that is not a str / os.PathLike, a directory, a missing, undecodable or malformed
-    file is an InputError naming it (:func:`rescon.io.input_file`)."""
+def read_toml(path: Any, what: str = "scenario file") -> dict:
+    """The parsed TOML of a scenario (or costs, RMDO, sweep grid: ``what``) file, read as
+    UTF-8 with an optional byte-order mark (as :mod:`rescon.io` reads graph and point
+    files); a path that is not a str / os.PathLike, a directory, a missing, undecodable
+    or malformed file is an InputError naming it (:func:`rescon.io.input_file`)."""
     from ..io import input_file
 
-    path = input_file(path, "scenario file", missing="{path}: no such scenario file")
+    path = input_file(path, what, missing=f"{{path}}: no such {what}")
     try:
         return tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: malformed TOML ({exc})") from None
     except OSError as exc:  # unreadable (permissions), or gone since input_file looked
-        raise InputError(f"{path}: cannot read the scenario file "
+        raise InputError(f"{path}: cannot read the {what} "
                          f"({exc.strerror or exc})") from None
 
 

@@ -51,6 +51,7 @@ def cost(spec: Any, *, x: Any = None, d: int | None = None, vectorised: bool = F
     """
     if d is not None:
         d = _validate.integer("d", d, low=1)
+    vectorised = _validate.flag("vectorised", vectorised)  # checked for every spec
     if isinstance(spec, Oracle):
         return _dimension(spec, d, name)
     if isinstance(spec, str):

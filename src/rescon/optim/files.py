@@ -83,8 +83,8 @@ def read_rmdo(path: str | Path) -> RMDOFile:
         dimension, a module that cannot be imported or whose function fails, a bad
         [step_size], a benign agent without a cost.
     """
-    p = Path(path)
-    return rmdo_from_dict(read_toml(p), path=p)
+    data = read_toml(path, "RMDO file")  # refuses a non-path, a directory, an unreadable file
+    return rmdo_from_dict(data, path=Path(path))
 
 
 def rmdo_from_dict(data: Mapping[str, Any], *, path: str | Path = "rmdo") -> RMDOFile:
@@ -118,8 +118,8 @@ def read_costs(path: str | Path) -> tuple[dict[Hashable, Oracle], int]:
         RMDO file without a cost (as :func:`rescon.rmdo` refuses it), no [costs], a bad
         ``d``, a cost the expression parser or :func:`rescon.cost` refuses.
     """
+    data = read_toml(path, "costs file")  # refuses a non-path, a directory, an unreadable file
     p = Path(path)
-    data = read_toml(p)
     if set(data) & {"scenario", "graph", "initial"}:  # an RMDO file: its benign agents'
         f = read_rmdo(p)  # it refuses a benign agent without a cost
         keep = set(f.scenario.benign)

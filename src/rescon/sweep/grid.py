@@ -123,7 +123,7 @@ def read_grid(grid: str | Path | Mapping[str, Any]) -> Grid:
         data, path, where = grid, Path.cwd() / "grid", "grid"
     elif isinstance(grid, (str, Path)):
         path = Path(grid)
-        data, where = read_toml(path), str(path)
+        data, where = read_toml(path, "sweep grid"), str(path)
     else:
         raise InputError(f"grid must be a TOML file name or a dict; got {type(grid).__name__}")
     extra = sorted(set(data) - {"base", "axes", "run"})
