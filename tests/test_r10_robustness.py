@@ -81,16 +81,19 @@ def _sparse_400():
 
 
 def test_is_rs_robust_and_max_s_honour_a_short_time_limit_on_400_nodes():
+    """The work a 0.05-s limit allows, in CPU seconds of this process (wall time grows
+    with the machine's load: 1.55 s in a clean-clone CI run at load 4, 0.2-0.4 s
+    alone); the bug took 2.3-4 CPU-s."""
     G = _sparse_400()
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     c = rescon.is_rs_robust(G, 2, 3, time_limit=0.05)
     assert c.holds in (None, True)
-    assert time.perf_counter() - t0 < 1.0
+    assert time.process_time() - t0 < 1.0
     clear_cache()
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(rescon.TimeLimitReached, match=r"≤ s\*\(2\) ≤"):
         rescon.max_s(G, 2, time_limit=0.05)
-    assert time.perf_counter() - t0 < 1.0
+    assert time.process_time() - t0 < 1.0
 
 
 # --------------------------------------------------------------------------- #
