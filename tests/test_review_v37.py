@@ -180,10 +180,10 @@ def test_single_node_and_self_loop_only_graphs_are_one_line_errors(tmp_path, cap
         clean_error(*run(["robustness", g, "--json"], capfd))
 
 
-@pytest.mark.xfail(strict=True, reason="V37: README's block says 'proof: construction' and "
-                   "'method: bounds'; rescon prints 'proof: search' and 'method: search'")
 def test_readme_robustness_console_block_runs_as_shown():
-    """README "Command line": the first console block, run in a fresh process."""
+    """Fixed (was a bug: the README's block said 'proof: construction', 'method: bounds'
+    — from before seeds of all n nodes were left to the search itself). README "Command
+    line": the first console block, run in a fresh process."""
     text = (ROOT / "README.md").read_text()
     block = re.search(r"```console\n\$ rescon robustness examples/graphs/paper_example"
                       r"\.edgelist\n(.*?)```", text, re.S)
