@@ -226,8 +226,8 @@ def test_two_concurrent_fast_path_kernels_leave_gc_enabled():
 
 def test_callers_gc_disable_during_a_kernel_in_another_thread_is_kept():
     """Fixed (was a bug: the fast path switched the cyclic collector off and on
-    process-wide, undoing a gc.disable() made meanwhile by another thread; it no longer
-    touches the collector)."""
+    process-wide, undoing a gc.disable() made meanwhile by another thread; it now only
+    spaces the collector's runs by its threshold, tests/test_fastpath_gc.py)."""
     X = _cloud(14, 5, 0)
     rescon.safe_kernel(X, 1)  # warm (numba)
     worker = threading.Thread(target=rescon.safe_kernel, args=(X, 1))
