@@ -351,7 +351,7 @@ def _collections_spaced():
     threshold raised to SPACED_THRESHOLD (unless the caller's is 0 or higher), restored
     when the last fast path running in the process ends. The fast path allocates ~10⁵
     acyclic containers (vertex tuples, lists of rows), which set off collections of
-    the whole heap: 10–25 % of the wall time of a d = 5, n = 30 kernel. Reference
+    the whole heap: 5–25 % of the wall time of a d = 5, n = 30 kernel. Reference
     counting still frees everything. The collector's on/off switch is left alone (it
     was switched off: a ``gc.disable()`` another thread made meanwhile was undone,
     V38); a ``gc.set_threshold`` another thread makes during the call is overwritten
