@@ -77,7 +77,7 @@ def test_tiny_literals_are_still_read_exactly():
 ])
 def test_literals_needing_huge_integers_are_refused_quickly(text):
     t = time.perf_counter()
-    with pytest.raises(rescon.InputError, match="more than 4300 digits") as exc:
+    with pytest.raises(rescon.InputError, match="more than 4300 (significant )?digits") as exc:
         rescon.cost(f"{text}*x1")
     assert time.perf_counter() - t < 2
     assert "\n" not in str(exc.value)

