@@ -33,11 +33,27 @@ def _pair_json(pair: Any) -> dict[str, list[Any]] | None:
     return {"S1": sorted_labels(S1), "S2": sorted_labels(S2)}
 
 
-def _output(path: str | None, what: str, *, directory: bool = False) -> Path | None:
-    """An output path checked (and its directories created) before any work is done."""
+def _output(path: str | None, what: str, *, directory: bool = False,
+            input_file: str | None = None) -> Path | None:
+    """An output path checked (and its directories created) before any work is done;
+    never the command's ``input_file`` (``--certificate G.txt`` for the graph G.txt
+    would overwrite the graph)."""
     from .io import output_path
 
-    return None if path is None else output_path(path, what, directory=directory)
+    if path is None:
+        return None
+    out = output_path(path, what, directory=directory)
+    if input_file is not None and _same_file(out, input_file):
+        raise InputError(f"{what}: {out} is the input file; give the output another name")
+    return out
+
+
+def _same_file(a: Path, b: str) -> bool:
+    """Whether ``a`` and ``b`` name one existing file (links followed)."""
+    try:
+        return Path(a).samefile(b)
+    except (OSError, ValueError):  # either missing (the input's error comes later)
+        return False
 
 
 def _write_certificate(cert: dict[str, Any] | None, target: Path | None) -> None:
@@ -79,7 +95,7 @@ def _cmd_robustness(args: argparse.Namespace) -> int:
 
     if args.s is not None and args.r is None:
         raise RESCONError("--s needs --r")
-    cert_path = _output(args.certificate, "--certificate")
+    cert_path = _output(args.certificate, "--certificate", input_file=args.graph)
     G = read_graph(args.graph, undirected=args.undirected)
     kw = {"time_limit": args.time_limit, "method": args.method,
           "scheduler": args.scheduler, "workers": args.workers}
@@ -155,7 +171,7 @@ def _cmd_kernel(args: argparse.Namespace) -> int:
     from .plot import figure_path
 
     plot = None if args.plot is None else figure_path(args.plot, "--plot")
-    cert_path = _output(args.certificate, "--certificate")
+    cert_path = _output(args.certificate, "--certificate", input_file=args.points)
     X = read_points(args.points)
     if plot is not None and X.shape[1] not in (2, 3):
         raise RESCONError(f"--plot draws d = 2 or 3 only; the points have d = {X.shape[1]}")
@@ -339,7 +355,7 @@ def _cmd_redundancy(args: argparse.Namespace) -> int:
     from .optim.files import read_costs
     from .optim.redundancy import check_redundancy
 
-    cert_path = _output(args.certificate, "--certificate")
+    cert_path = _output(args.certificate, "--certificate", input_file=args.costs)
     t0 = time.perf_counter()
     costs, d = read_costs(args.costs)
     rep = check_redundancy(costs, args.r, d=d)
