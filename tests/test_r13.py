@@ -284,3 +284,17 @@ def test_cost_vectorised_takes_true_or_false_only():
     with pytest.raises(rescon.InputError, match="vectorised must be True or False"):
         rescon.cost("x1^2", vectorised="no")
     assert rescon.cost("x1^2", vectorised=True).value([[2.0]]).tolist() == [4.0]
+
+
+def test_errors_on_long_expressions_stay_short():
+    """Fixed (was a bug, V37/R13 noticed: the error repeated the whole expression — a
+    7 kB line for a 7 kB cost). Now a window around the error's position."""
+    middle = "x1^2 + " * 500 + "x1^3 + " + "x1^2 + " * 500 + "1"
+    with pytest.raises(rescon.InputError) as exc:
+        rescon.cost(middle)
+    msg = str(exc.value)
+    assert len(msg) < 400 and "\n" not in msg
+    assert "x1^3" in msg and f"({len(middle)} characters)" in msg
+    assert f"at position {middle.index('x1^3') + 3}" in msg  # the exponent
+    with pytest.raises(rescon.InputError, match=r"^cost: expression 'x1 \+ \(': "):
+        rescon.cost("x1 + (")  # short ones whole, as before

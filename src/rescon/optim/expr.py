@@ -338,6 +338,18 @@ def _magnitude(v: Fraction) -> str:
 _NUMBER = re.compile(r"(\d*)\.?(\d*)(?:[eE]([+-]?\d+))?")
 
 
+def _abridged(text: str, limit: int, at: int | None = None) -> str:
+    """``text`` itself up to ``limit`` characters; longer, a window of about ``limit``
+    characters around position ``at`` (else its start and end) with "…" where text is
+    left out and the full length — error messages stay one readable line."""
+    if len(text) <= limit:
+        return text
+    half = limit // 2 - 8
+    if at is None or at < half or at > len(text) - half:
+        return f"{text[:half]}…{text[-half:]} ({len(text)} characters)"
+    return f"…{text[at - half:at + half]}… ({len(text)} characters)"
+
+
 def _number(text: str, pos: int) -> Fraction:
     """The number token ``text`` exactly, or ExprError quoting it: beyond the float range
     (``float(text)`` is infinite: correctly rounded, as :func:`_float` decides for computed
@@ -346,7 +358,7 @@ def _number(text: str, pos: int) -> Fraction:
     :data:`MAX_DIGITS` digits. A
     number too large, or too small for its denominator, is refused from its digits and
     exponent, before 10^exponent is built (``1e1000000000``, ``1e-1000000000``)."""
-    shown = text if len(text) <= 40 else f"{text[:16]}…{text[-16:]} ({len(text)} characters)"
+    shown = _abridged(text, 40)
     whole, frac, exp = _NUMBER.fullmatch(text).groups()  # type: ignore[union-attr]
     digits = (whole + frac).lstrip("0")
     sig = digits.rstrip("0")
@@ -641,6 +653,7 @@ def expression_cost(src: Any, *, d: int | None = None, name: str = "cost") -> Or
         o = lower(e, d if d is not None else used)
     except ExprError as exc:
         at = "" if exc.pos is None else f" at position {exc.pos}"
-        raise InputError(f"{name}: expression {src!r}: {exc.msg}{at}") from None
+        raise InputError(f"{name}: expression {_abridged(src, 200, exc.pos)!r}: "
+                         f"{exc.msg}{at}") from None
     o.name, o.kind, o.source = name, "expression", src
     return o
