@@ -9,7 +9,9 @@ when a rounding-error bound proves the float answer right.
 
 from __future__ import annotations
 
+import functools
 import itertools
+from collections.abc import Iterable
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -23,6 +25,7 @@ __all__ = [
     "bareiss_rank",
     "cross_all",
     "exact_points",
+    "exact_sum",
     "float_view",
     "fraction_str",
     "halfspaces_json",
@@ -229,8 +232,28 @@ def _int_str(n: int) -> str:
     if n.bit_length() < _STR_BITS:
         return str(n)
     k = int(n.bit_length() * 0.30103) // 2  # about half the digits
-    high, low = divmod(n, 10**k)
+    high, low = divmod(n, _power_of_ten(k))
     return _int_str(high) + _int_str(low).zfill(k)
+
+
+@functools.lru_cache(maxsize=256)
+def _power_of_ten(k: int) -> int:
+    """10**k, kept: the halves of one number's digits ask for the same powers."""
+    return 10**k
+
+
+def exact_sum(values: Iterable[Fraction]) -> Fraction:
+    """Σ values exactly, added in a balanced tree: adding n fractions of unrelated
+    denominators one by one grows the running sum's denominator at every step (O(n²)
+    in its size); in pairs each level adds numbers of equal size (1 095 vertices of a
+    d = 5 kernel: 4.4 s one by one, 1.3 s in pairs)."""
+    level = [Fraction(v) for v in values]
+    if not level:
+        return Fraction(0)
+    while len(level) > 1:
+        level = [level[i] + level[i + 1] if i + 1 < len(level) else level[i]
+                 for i in range(0, len(level), 2)]
+    return level[0]
 
 
 def fraction_str(x: Fraction) -> str:

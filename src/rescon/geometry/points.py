@@ -25,7 +25,7 @@ import numpy as np
 from .._rounding import MAX_FINITE
 from .._validate import check_point
 from ..errors import EmptyKernel, InputError, SolverError
-from .exact import fraction_str, solve_exact
+from .exact import exact_sum, fraction_str, solve_exact
 
 if TYPE_CHECKING:
     from .kernel import SafeKernel
@@ -100,7 +100,7 @@ def kernel_point_of(K: SafeKernel, *, method: str, backend: str, target: Any
 
 def _vertex_mean(K: SafeKernel) -> Vec:
     V = K.exact_vertices
-    return tuple(sum(col, Fraction(0)) / len(V) for col in zip(*V, strict=True))
+    return tuple(exact_sum(col) / len(V) for col in zip(*V, strict=True))
 
 
 def _target(K: SafeKernel, target: Any) -> Vec:
