@@ -54,7 +54,9 @@ def client(scheduler: str | None, workers: int | None) -> Any:
     """A context manager giving a distributed.Client on ``scheduler`` (refused within
     CONNECT_SECONDS when unreachable, within WORKER_SECONDS when no worker joins it: its
     tasks would wait forever) or on an embedded LocalCluster of ``workers`` processes
-    (default: the CPU count), one thread each, closed with the client."""
+    (default: the CPU count), one thread each, closed with the client. The client is
+    not made the process's default (``set_as_default=False``): rescon submits to it
+    explicitly, and the caller's own ``dask.compute`` keeps going where it went (R5)."""
     require()
     from distributed import Client, LocalCluster
 
@@ -73,7 +75,7 @@ def client(scheduler: str | None, workers: int | None) -> Any:
     n = workers if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                            dashboard_address=None)
-    return _Owned(Client(cluster), cluster)
+    return _Owned(Client(cluster, set_as_default=False), cluster)
 
 
 def _connect(Client: Any, scheduler: str) -> Any:
@@ -88,7 +90,7 @@ def _connect(Client: Any, scheduler: str) -> Any:
 
     def attempt() -> None:
         try:
-            made = Client(scheduler, timeout=CONNECT_SECONDS)
+            made = Client(scheduler, timeout=CONNECT_SECONDS, set_as_default=False)
         except Exception as exc:  # noqa: BLE001 (whatever answers there may be no Dask
             # scheduler: an HTTP reply read as a frame length is a MemoryError)
             made, box["error"] = None, exc
@@ -152,7 +154,9 @@ class Workers:
         POLL_SECONDS / 10)."""
         from distributed import as_completed
 
-        ready, idle = as_completed(futures), time.perf_counter()
+        # the client's own loop: rescon's client is not the default one as_completed
+        # would look up
+        ready, idle = as_completed(futures, loop=self.client.loop), time.perf_counter()
         while not ready.is_empty():
             batch = ready.next_batch(block=False)
             if batch:
@@ -170,8 +174,10 @@ class Workers:
         (:meth:`check`) — the caller then checks its deadline."""
         from distributed import wait
 
-        try:
-            return wait(list(running), timeout=POLL_SECONDS, return_when="FIRST_COMPLETED").done
+        try:  # wait() asks for the current client; rescon's is not the default
+            with self.client.as_current():
+                return wait(list(running), timeout=POLL_SECONDS,
+                            return_when="FIRST_COMPLETED").done
         except TimeoutError:
             self.check()
             return set()
