@@ -889,8 +889,7 @@ def near_pairs(A, b, A_abs, b_abs, V, coarse, c_err: float, c: float, floor: flo
     offsets = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     out_r = np.repeat(np.arange(len(b), dtype=np.int64), counts)
     out_v = np.empty_like(out_r)
-    kept = np.arange(NEAR_KEPT)[None, :] < np.where(counts <= NEAR_KEPT, counts, 0)[:, None]
-    out_v[(offsets[:, None] + np.arange(NEAR_KEPT)[None, :])[kept]] = first[kept]
+    _kept_pairs(counts, offsets, first, out_v)
     if (counts > NEAR_KEPT).any():  # only those rows again, writing every pair
         _near_run(common, parallel, True, np.where(counts > NEAR_KEPT, offsets, -1), out_r,
                   out_v, first)
@@ -898,8 +897,20 @@ def near_pairs(A, b, A_abs, b_abs, V, coarse, c_err: float, c: float, floor: flo
 
 
 #: near_pairs keeps this many pairs per row from its counting pass; rows with more are
-#: scanned again (d = 4, n = 50: at most ~90; d = 5: up to ~500)
-NEAR_KEPT = 96
+#: scanned again (d = 4, n = 50: at most ~90; d = 5: up to ~580 — of sphere(5, 30, 3)'s
+#: 857 defining rows 35 are scanned twice, 328 when 96 were kept)
+NEAR_KEPT = 256
+
+
+@njit(cache=True, nogil=True)
+def _kept_pairs(counts, offsets, first, out_v):
+    """The points of the rows whose near pairs the counting pass kept whole (counts[h]
+    ≤ NEAR_KEPT; first[h, :counts[h]]) into out_v from offsets[h] on."""
+    keep = first.shape[1]
+    for h in range(len(counts)):
+        if 0 < counts[h] <= keep:
+            for i in range(counts[h]):
+                out_v[offsets[h] + i] = first[h, i]
 
 
 def _near_run(common: tuple, parallel: bool, fill: bool, offsets, out_r, out_v, first

@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["KEY_PRIME", "nonsingular", "paired_rows", "point_keys", "tight_through"]
+__all__ = ["KEY_PRIME", "nonsingular", "packed_pairs", "paired_rows", "point_keys",
+           "tight_through"]
 
 #: the largest prime below 2^31 − 1 (a compile-time constant: the reductions modulo it
 #: compile to multiplications); residues < 2^31, so a product of two fits an int64
@@ -225,3 +226,29 @@ def _first_pair(rows, k):
                 return g
             g += 1
     return -1
+
+
+@njit(cache=True, nogil=True)
+def packed_pairs(vs, hs, n, nbytes):
+    """The bitsets of the pairs (vs[i], hs[i]) (vertex < n, position < 8 · nbytes),
+    little-endian, nbytes per vertex side by side (uint8, n · nbytes), and the distinct
+    pairs ordered by vertex then position: what ``np.packbits`` of the boolean table
+    and its set bits read back give, without the table."""
+    packed = np.zeros(n * nbytes, dtype=np.uint8)
+    for i in range(len(vs)):
+        packed[vs[i] * nbytes + (hs[i] >> 3)] |= np.uint8(1 << (hs[i] & 7))
+    total = 0
+    for i in range(len(packed)):
+        total += _popcount(np.int64(packed[i]))
+    pv = np.empty(total, dtype=np.int64)
+    ph = np.empty(total, dtype=np.int64)
+    e = 0
+    for i in range(len(packed)):
+        byte = packed[i]
+        if byte:
+            for bit in range(8):
+                if byte >> bit & 1:
+                    pv[e] = i // nbytes
+                    ph[e] = i % nbytes * 8 + bit
+                    e += 1
+    return packed, pv, ph

@@ -43,11 +43,19 @@ that fall below the normal range are exact), so the relative bounds above hold;
 also needs its rows' lo parts 0 or normal with an exact or normal remainder, and
 2^σ T, 2^σ Q (:func:`_residual`) 0 or in [2^-400, 2^400]. Anything non-finite fails
 every comparison (NaN) or the range checks (inf): not certified.
+
+The proofs run compiled, a proposal at a time (:func:`_rounded_nb`, the float
+operations of each step in the order of the numpy reference :func:`_rounded`, without
+fastmath: no fused multiply-adds, no reassociation); the approximate inverse R, which
+the proof does not trust, is its own Gauss–Jordan elimination.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from .._rounding import UNIT_ROUNDOFF as _U
 
@@ -58,7 +66,7 @@ LIMIT = 400
 #: the floor of the bound terms (β_i, E_s)
 FLOOR = 2.0**-300
 #: from this many proposals on, ranges of them (THREAD_CHUNKS) are proven on threads
-#: (:func:`._candidates.on_threads`; numpy's array operations run without the GIL)
+#: (:func:`._candidates.on_threads`; :func:`_rounded_nb` runs without the GIL)
 THREADS_MIN = 2000
 THREAD_CHUNKS = 4
 
@@ -81,7 +89,9 @@ def rounded_points(E: np.ndarray, at: np.ndarray, scale: int, k: int,
     homogeneous integer rows (−b_h, a_h)), the floats fl(z) of the point z = x / scale
     where its rows meet, and whether they are proven correctly rounded (module
     docstring); entries not proven are NaN. ``slack`` multiplies the bound E (1: the
-    proven bound; tests pass < 1 to show a weakened bound is caught)."""
+    proven bound; tests pass < 1 to show a weakened bound is caught). The proofs run
+    compiled (:func:`_rounded_nb`), from THREADS_MIN proposals on in THREAD_CHUNKS
+    ranges on threads."""
     from ._candidates import on_threads  # looked up per call: tests replace it
 
     P = len(at)
@@ -90,15 +100,16 @@ def rounded_points(E: np.ndarray, at: np.ndarray, scale: int, k: int,
     if not P or scale <= 0 or scale & (scale - 1):
         return out, ok
     with np.errstate(all="ignore"):
-        rows = _row_floats(E, scale, k)
-        ah, al = _split(rows[0].T)  # columns first: (k, P, k) gathers, each contiguous
+        Ahi, Alo, bhi, blo, _, split = map(np.ascontiguousarray, _row_floats(E, scale, k))
+        ah, al = _split(Ahi)
+        split = split & _in_range(Ahi, True) & _in_range(Alo, True)
+    at = np.ascontiguousarray(at, dtype=np.int64)
 
-        def scan(lo: int, hi: int) -> None:
-            if lo < hi:
-                with np.errstate(all="ignore"):  # numpy's error state is per thread
-                    _rounded(rows, ah, al, at[lo:hi], k, slack, out[lo:hi], ok[lo:hi])
+    def scan(lo: int, hi: int) -> None:
+        _rounded_nb(Ahi, Alo, bhi, blo, split, ah, al, at[lo:hi], k, slack, out[lo:hi],
+                    ok[lo:hi])
 
-        on_threads(scan, P, THREAD_CHUNKS if P >= THREADS_MIN else 1)
+    on_threads(scan, P, THREAD_CHUNKS if P >= THREADS_MIN else 1)
     return out, ok
 
 
@@ -106,7 +117,9 @@ def _rounded(rows: tuple, ah: np.ndarray, al: np.ndarray, at: np.ndarray, k: int
              slack: float, out: np.ndarray, ok: np.ndarray) -> None:
     """:func:`rounded_points` for the proposals ``at``, writing into ``out`` and ``ok``
     (views): ``rows`` from :func:`_row_floats`, (ah, al) the split of its Ahi's
-    columns."""
+    columns — in numpy, all proposals at once: the reference of the compiled
+    :func:`_rounded_nb` (tests compare them, and weaken a step of this one to show the
+    oracle catches it)."""
     Ahi, Alo, bhi, blo, _, split = rows
     split = split & _in_range(Ahi, True) & _in_range(Alo, True)
     Af = Ahi[at]  # (P, k, k)
@@ -153,6 +166,211 @@ def _rounded(rows: tuple, ah: np.ndarray, al: np.ndarray, at: np.ndarray, k: int
     good &= _in_range(f, False) & ((Eb + np.abs(tw)) * (1.0 + 4.0 * _U) < gap).all(axis=1)
     out[idx[good]] = f[good]
     ok[idx[good]] = True
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _inr(x, zero_ok):
+    """|x| in [2^-LIMIT, 2^LIMIT], or x = 0 with ``zero_ok`` (:func:`_in_range` for one
+    float); NaN fails."""
+    a = abs(x)
+    return (a >= 2.0**-LIMIT and a <= 2.0**LIMIT) or (zero_ok and a == 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _invert(Af, R, M):
+    """R ≈ Af⁻¹ (k × k) by Gauss–Jordan elimination with partial pivoting on a copy M;
+    False where a pivot is exactly 0. Only a guess: β checks it (like :func:`_inverses`,
+    whose LAPACK inverse it need not equal)."""
+    k = Af.shape[0]
+    for i in range(k):
+        for j in range(k):
+            M[i, j] = Af[i, j]
+            R[i, j] = 1.0 if i == j else 0.0
+    for c in range(k):
+        piv = c
+        big = abs(M[c, c])
+        for i in range(c + 1, k):
+            if abs(M[i, c]) > big:
+                piv, big = i, abs(M[i, c])
+        if not big > 0.0:  # 0 or NaN
+            return False
+        if piv != c:
+            for j in range(k):
+                M[c, j], M[piv, j] = M[piv, j], M[c, j]
+                R[c, j], R[piv, j] = R[piv, j], R[c, j]
+        inv = 1.0 / M[c, c]
+        for j in range(k):
+            M[c, j] *= inv
+            R[c, j] *= inv
+        for i in range(k):
+            f = M[i, c]
+            if i != c and f != 0.0:
+                for j in range(k):
+                    M[i, j] -= f * M[c, j]
+                    R[i, j] -= f * R[c, j]
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _rounded_nb(Ahi, Alo, bhi, blo, split, ah, al, at, k, slack, out, ok):
+    """:func:`_rounded`, compiled, one proposal at a time: the same steps and bounds
+    (module docstring), each float operation of the proof in the order :func:`_rounded`
+    performs it — numba compiles without fastmath, so no contraction into fused
+    multiply-adds and no reassociation: TwoSum, Veltkamp's split, Dekker's product and
+    Sum2 stay error-free transformations — and where :func:`_rounded` leaves the order
+    to numpy (the matrix products and row sums, the bounds of which hold for any order
+    and with or without fused multiply-adds) a plain loop. R comes from
+    :func:`_invert`, not LAPACK: R is only a guess (any R with β ≤ 1/2 gives a proof), so
+    a proposal may be proven here and not there or conversely, never with another
+    float (correct rounding is a function of the point). ``split``: per row, split
+    and its hi and lo parts in range; ``ah``, ``al``: the split of Ahi, (rows, k)."""
+    n = 3 * k + 2
+    c_rho = 2.0 * n * n * _U * _U
+    grow = 1.0 + 4.0 * (k + 4) * _U
+    c_sum = 2.0 * (k + 2) * _U
+    c_beta = 1.0 + 2.0 * (k + 8) * _U
+    Af = np.empty((k, k))
+    R = np.empty((k, k))
+    M = np.empty((k, k))
+    z0 = np.empty(k)
+    rf = np.empty(k)
+    T = np.empty(k)
+    Q = np.empty(k)
+    rs = np.empty(k)
+    rho = np.empty(k)
+    G = np.empty(k)
+    Hr = np.empty(k)
+    for p in range(len(at)):
+        good = True
+        for i in range(k):
+            good = good and split[at[p, i]]
+        if not good:
+            continue
+        for i in range(k):
+            for j in range(k):
+                Af[i, j] = Ahi[at[p, i], j]
+        if not _invert(Af, R, M):
+            continue
+        for i in range(k):
+            s = 0.0
+            for j in range(k):
+                h = at[p, j]
+                s += R[i, j] * (bhi[h] + blo[h])
+            z0[i] = s
+            good = good and _inr(s, True)
+            for j in range(k):
+                good = good and _inr(R[i, j], True)
+        if not good:
+            continue
+        # 1. the residual (:func:`_residual`, term by term in its order), scaled by 2^σ
+        for i in range(k):
+            h = at[p, i]
+            s = bhi[h]
+            err = 0.0
+            x = blo[h]  # the terms: blo, −p_j, −e_j, −q_j (j = 0..k−1), by Sum2
+            s1 = s + x
+            bb = s1 - s
+            err = err + ((s - (s1 - bb)) + (x - bb))
+            s = s1
+            tp = 0.0
+            tq = 0.0
+            for part in range(3):
+                for j in range(k):
+                    pj = Ahi[h, j] * z0[j]
+                    if part == 0:
+                        x = -pj
+                    elif part == 1:
+                        c = 134217729.0 * z0[j]
+                        zh = c - (c - z0[j])
+                        zl = z0[j] - zh
+                        x = -((((ah[h, j] * zh - pj) + ah[h, j] * zl) + al[h, j] * zh)
+                              + al[h, j] * zl)
+                        # T's term j: |p_j| + |e_j| + |q_j|, summed over j in turn
+                        tp += (abs(pj) + abs(x)) + abs(Alo[h, j] * z0[j])
+                    else:
+                        x = -(Alo[h, j] * z0[j])
+                        tq += abs(x)
+                    s1 = s + x
+                    bb = s1 - s
+                    err = err + ((s - (s1 - bb)) + (x - bb))
+                    s = s1
+            rf[i] = s + err
+            T[i] = (abs(bhi[h]) + abs(blo[h])) + tp
+            Q[i] = abs(blo[h]) + tq
+        top = 0.0
+        for i in range(k):
+            if abs(rf[i]) > top or rf[i] != rf[i]:
+                top = abs(rf[i])
+        sigma = -math.frexp(top)[1] if top > 0.0 else 0
+        good = abs(sigma) <= LIMIT
+        for i in range(k):
+            rs[i] = math.ldexp(rf[i], sigma)
+            ts = math.ldexp(T[i], sigma)
+            qs = math.ldexp(Q[i], sigma)
+            good = good and _inr(rs[i], True) and _inr(ts, True) and _inr(qs, True)
+            rho[i] = (2.0 * _U * abs(rs[i]) + c_rho * ts + 3.0 * _U * qs) * grow
+        if not good:
+            continue
+        # 2. β: the row sums of |I − R Af|, bounded
+        beta = 0.0
+        for i in range(k):
+            sD = 0.0
+            sN = 0.0
+            for j in range(k):
+                cij = 0.0
+                nij = 0.0
+                for m in range(k):
+                    cij += R[i, m] * Af[m, j]
+                    nij += abs(R[i, m]) * abs(Af[m, j])
+                sD += abs((1.0 if i == j else 0.0) - cij)
+                sN += nij
+            b = (sD + c_sum * sN) * c_beta
+            if b < FLOOR:
+                b = FLOOR
+            if not b <= 0.5:  # NaN too
+                good = False
+            elif b > beta:
+                beta = b
+        if not good:
+            continue
+        # 3. the correction and its bound, in units 2^-σ
+        gh = 0.0
+        for i in range(k):
+            g = 0.0
+            hr = 0.0
+            for j in range(k):
+                g += abs(R[i, j]) * abs(rs[j])
+                hr += abs(R[i, j]) * rho[j]
+            G[i] = g
+            Hr[i] = hr
+            if g + hr > gh or g + hr != g + hr:
+                gh = g + hr
+        for i in range(k):
+            ds = 0.0
+            for j in range(k):
+                ds += R[i, j] * rs[j]
+            es = 2.5 * beta * gh + 2.0 * Hr[i] + c_sum * G[i]
+            if es < FLOOR:
+                es = FLOOR
+            es = es * (1.0 + 8.0 * _U) * slack
+            if not (_inr(ds, True) and es <= 2.0**300):
+                good = False
+                break
+            # 4. f = fl(z0 + δ), t = z0 + δ − f (TwoSum), against the half gaps at f
+            delta = math.ldexp(ds, -sigma)
+            eb = math.ldexp(es, -sigma)
+            f = z0[i] + delta
+            bb = f - z0[i]
+            tw = (z0[i] - (f - bb)) + (delta - bb)
+            gap = min(f - np.nextafter(f, -np.inf), np.nextafter(f, np.inf) - f) * 0.5
+            if not (_inr(f, False) and (eb + abs(tw)) * (1.0 + 4.0 * _U) < gap):
+                good = False
+                break
+            rf[i] = f
+        if good:
+            for i in range(k):
+                out[p, i] = rf[i]
+            ok[p] = True
 
 
 def _row_floats(E: np.ndarray, scale: int, k: int):

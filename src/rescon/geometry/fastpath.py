@@ -618,19 +618,18 @@ def _outside_feasible(H, scale: int, verts: list[tuple[int, ...]], W: np.ndarray
 def _tight_sets(vs: np.ndarray, hs: np.ndarray, n: int, width: int
                 ) -> tuple[list[int], tuple[np.ndarray, np.ndarray]]:
     """For each of n vertices the bitset (a Python int) of the positions hs[i] < width
-    paired with it (vs[i]): a boolean table packed to bytes, one int per row; and the
-    distinct pairs (vertex, position) ordered by vertex then position, read off the
-    packed table (what :func:`.polytope.tight_pairs` gives for the bitsets)."""
+    paired with it (vs[i]): the bitsets packed to bytes
+    (:func:`._certify_nb.packed_pairs`), one int per vertex; and the distinct pairs
+    (vertex, position) ordered by vertex then position, read off the packed bytes
+    (what :func:`.polytope.tight_pairs` gives for the bitsets)."""
+    from ._certify_nb import packed_pairs
+
     nbytes = max((width + 7) // 8, 1)
-    table = np.zeros((n, 8 * nbytes), dtype=np.bool_)
-    table[vs, hs] = True
-    packed = np.packbits(table, axis=1, bitorder="little").ravel()
+    packed, pv, ph = packed_pairs(np.asarray(vs, dtype=np.int64),
+                                  np.asarray(hs, dtype=np.int64), n, nbytes)
     buf = packed.tobytes()
     tight = [int.from_bytes(buf[i:i + nbytes], "little") for i in range(0, n * nbytes, nbytes)]
-    at = np.flatnonzero(packed)  # vertex · nbytes + byte, increasing
-    bits = np.flatnonzero(np.unpackbits(packed[at], bitorder="little"))
-    at = at[bits >> 3]
-    return tight, (at // nbytes, at % nbytes * 8 + (bits & 7))
+    return tight, (pv, ph)
 
 
 def _closed(tight: list[int], basis: list[list[int]], normals: list[tuple[int, ...]],
