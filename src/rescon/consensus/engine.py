@@ -34,6 +34,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from .._rounding import MIN_SUBNORMAL
 from ..errors import InputError
 from ..geometry.centroid import hull_centroid
 from ..geometry.kernel import safe_kernel
@@ -436,13 +437,14 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
     QP, a KKT certificate with rigorous rounding bounds); a batch point is used only if
     its certified error bound is within :func:`_allowance` (ACCEPT_REL of its own
     magnitude and of the size of the box Ψ lies in), so neither a far value in the set
-    nor a far origin can loosen it. The sets they decline and every other case are
+    nor a far origin can loosen it. Sets declined thus are tried once more moved next
+    to the origin (:func:`_batch_points_moved`): converged states, whose Ψ is ulps of
+    its magnitude wide, were all declined (their bounds are ulps of the magnitude),
+    and computing each exactly made a step of 1000 converged agents take seconds.
+    The sets still declined and every other case are
     computed exactly, once per distinct set in a run (``cache``: held values and
     converged states repeat the same sets). "project-exact" computes everything
     exactly."""
-    from ..geometry._small2d import ACCEPT_REL, OK, project_small_2d
-    from ..geometry._small3d import project_small_3d
-
     if not len(problems):
         return np.empty((0, 0))
     out = np.empty((len(problems), problems[0].shape[1]))
@@ -454,15 +456,13 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
             Ys = np.ascontiguousarray(problems[idx] if isinstance(problems, np.ndarray)
                                       else np.stack([problems[k] for k in idx]),
                                       dtype=np.float64)
-            if d == 2:
-                pts = np.empty((len(idx), 2))
-                err = np.empty(len(idx))
-                status = np.empty(len(idx), dtype=np.int64)
-                project_small_2d(Ys, F, pts, err, status)
-                found = (status == OK) & (err <= ACCEPT_REL * np.abs(pts).max(axis=1))
-            else:
-                pts, err, found = project_small_3d(Ys, F)
+            pts, err, found = _batch_points(Ys, F)
             found &= err <= _allowance(Ys, F, pts)
+            rest = np.flatnonzero(~found)
+            if len(rest):  # e.g. converged sets, Ψ a few ulps wide: moved next to 0
+                moved, bound, ok = _batch_points_moved(Ys[rest], F)
+                ok &= bound <= _allowance(Ys[rest], F, moved)
+                pts[rest[ok]], found[rest[ok]] = moved[ok], True
             out[idx[found]] = pts[found]
             done[idx[found]] = True
     exact = "project" if method == "project-exact" else method
@@ -473,6 +473,88 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
             cache[key] = safe_kernel(X, F).point(exact)[0]
         out[k] = cache[key]
     return out
+
+
+def _batch_points(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The batch paths' points of Ψ(Y, F) nearest the mean of Y for sets Ys (B, m, d),
+    d = 2 or 3: the points (B, d), bounds on their distances to the exact ones, and
+    whether each is certified within ACCEPT_REL of its magnitude.
+
+    A set in space that the 3-d path declines with one coordinate j the same in every
+    point (converging states reach it: one coordinate agrees exactly while the others
+    still differ by ulps; the 3-d path takes full-dimensional kernels only) lies in
+    the plane x_j = a, so Ψ(Y, F) = {a} × Ψ(Y', F) (Y' the other two coordinates) and
+    the point nearest the mean is (a, the planar point of Y'): the planar path's
+    answer, its ∞-norm bound times 1.5 ≥ √2 as a bound in the 2-norm."""
+    from ..geometry._small2d import ACCEPT_REL, OK, project_small_2d
+    from ..geometry._small3d import project_small_3d
+
+    if Ys.shape[2] == 3:
+        pts, err, found = project_small_3d(Ys, F)
+        same = (Ys == Ys[:, :1, :]).all(axis=1)  # (B, 3): coordinates constant per set
+        for j in range(3):
+            flat = np.flatnonzero(~found & same[:, j] & (same.sum(axis=1) == 1))
+            if not len(flat):
+                continue
+            others = [i for i in range(3) if i != j]
+            p2, e2, ok2 = _batch_points(np.ascontiguousarray(Ys[flat][:, :, others]), F)
+            pts[flat[:, None], others], pts[flat, j] = p2, Ys[flat, 0, j]
+            err[flat] = 1.5 * e2
+            found[flat] = ok2 & (err[flat] <= ACCEPT_REL * np.abs(pts[flat]).max(axis=1))
+        return pts, err, found
+    pts = np.empty((len(Ys), 2))
+    err = np.empty(len(Ys))
+    status = np.empty(len(Ys), dtype=np.int64)
+    project_small_2d(Ys, F, pts, err, status)
+    return pts, err, (status == OK) & (err <= ACCEPT_REL * np.abs(pts).max(axis=1))
+
+
+def _batch_points_moved(Ys: np.ndarray, F: int
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_batch_points` of the sets moved next to the origin: per set a point c of
+    its own coordinates (the median of each) is subtracted and the differences scaled
+    by a power of two 2^−e to unit size; Ψ((Y − c) 2^−e, F) = (Ψ(Y, F) − c) 2^−e and
+    the point nearest the mean moves with it, so 2^e q + c is the point sought for q
+    the batch point of the moved set. Only sets whose moved entries are all exact
+    (y − c a float: TwoSum's error 0, no overflow; the scaling undone exactly) are
+    taken — converged states, whose Ψ is a few ulps of its magnitude wide, then
+    become sets of unit scale, whose points the batch paths certify to ulps of Ψ's
+    width instead of ulps of the magnitude. Returns the points fl(2^e q + c) (2^e q
+    exact: a power of two; its bound scaled alike), bounds on their distances to the exact
+    points — the batch bound for q plus the rounding of the sum (at most half the
+    spacing of the largest |coordinate| per coordinate: ≤ one spacing in 2-norm for
+    d ≤ 4) and, where 2^e q or 2^e times the bound is subnormal, their roundings (< 2
+    of the smallest subnormal in 2-norm), the float sum enlarged by 2⁻⁵⁰ — and
+    whether each is certified."""
+    from ..geometry._small2d import ACCEPT_REL
+
+    B, m, d = Ys.shape
+    c = np.sort(Ys, axis=1)[:, m // 2]  # (B, d): a coordinate of the set per axis
+    with np.errstate(all="ignore"):
+        moved = Ys - c[:, None, :]
+        back = moved - Ys
+        exact = ((Ys - (moved - back)) + (-c[:, None, :] - back) == 0.0).all(axis=(1, 2))
+    pts = np.zeros((B, d))
+    bound = np.full(B, np.inf)
+    found = np.zeros(B, dtype=bool)
+    # ... and of unit scale: times 2^−e, e the exponent of the largest |y − c| (exact
+    # unless an entry then falls below the normal range: such sets are left out)
+    top = np.abs(moved).max(axis=(1, 2))
+    e = np.frexp(np.where((top > 0.0) & np.isfinite(top), top, 1.0))[1]
+    unit = np.ldexp(moved, -e[:, None, None])
+    exact &= (np.ldexp(unit, e[:, None, None]) == moved).all(axis=(1, 2))
+    idx = np.flatnonzero(exact & np.isfinite(moved).all(axis=(1, 2)))
+    if not len(idx):
+        return pts, bound, found
+    q, err, ok = _batch_points(np.ascontiguousarray(unit[idx]), F)
+    with np.errstate(all="ignore"):
+        q, err = np.ldexp(q, e[idx, None]), np.ldexp(err, e[idx])
+        p = q + c[idx]
+        size = np.abs(p).max(axis=1)
+        b = (err + np.spacing(size) + 2.0 * MIN_SUBNORMAL) * (1.0 + 2.0**-50)
+    pts[idx], bound[idx] = p, b
+    found[idx] = ok & np.isfinite(p).all(axis=1) & (b <= ACCEPT_REL * size)
+    return pts, bound, found
 
 
 #: a batch point may be off by at most this share of the widest side of the box Ψ
