@@ -841,8 +841,9 @@ def _row_table(H, Ts: list[list[int]], k: int) -> tuple[np.ndarray, np.ndarray, 
     rows in B (:func:`_homogeneous`, the row at infinity last) and the position in E of
     each entry of B."""
     B = np.asarray(Ts, dtype=np.int64).reshape(len(Ts), k)
-    used, at = np.unique(B, return_inverse=True)
-    return B, at.reshape(B.shape), _homogeneous(H, used.tolist(), k)
+    # np.unique(B, return_inverse=True) by a table over the rows of H (no sort)
+    used = np.flatnonzero(np.bincount(B.ravel()))
+    return B, _positions(used)[B], _homogeneous(H, used.tolist(), k)
 
 
 def _one_per_point(H, Ts: list[list[int]], k: int) -> np.ndarray:
