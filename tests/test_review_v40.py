@@ -539,15 +539,13 @@ def test_subnormal_01_cloud_kernel_and_other_points_hold(monkeypatch):
         assert rescon.check_certificate(cert).verdict == "valid"
 
 
-@pytest.mark.xfail(strict=True, reason="V40: point('chebyshev') raises SolverError on a "
-                   "nonempty flat d = 5 kernel of 0/1 multiples of 2^-1074: points._frame "
-                   "computes o = sum(V / len(V)) and ext = max|V/4 - o/4| in floats, which "
-                   "underflow to 0, so e = 0 and the LP sees a kernel 2^-1074 wide")
 def test_chebyshev_point_of_a_subnormal_flat_d5_kernel():
-    """The same integer cloud × 1 or × 2^-1000 gives a Chebyshev point; × 2^-1074 the
-    kernel is still a nonempty 4-dimensional polytope of exact rationals, so a point of
-    it exists and the method must return one (it raised "the Chebyshev centre returned
-    by the backend is not in the kernel")."""
+    """Fixed (was a bug: point('chebyshev') raised SolverError "the Chebyshev centre
+    returned by the backend is not in the kernel" — points._frame's float mean and
+    extent of the vertices underflowed to 0, and the centre mapped back to floats fell
+    on the subnormal grid, outside Ψ). The same integer cloud × 1 or × 2^-1000 gives a
+    Chebyshev point; × 2^-1074 the kernel is still a nonempty 4-dimensional polytope of
+    exact rationals, so a point of it exists and the method must return one."""
     X = SUBNORMAL_01 * 5e-324
     K = rescon.safe_kernel(X, 1)
     assert not K.is_empty

@@ -22,7 +22,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._rounding import MAX_FINITE
 from .._validate import check_point
 from ..errors import EmptyKernel, InputError, SolverError
 from .exact import exact_sum, fraction_str, solve_exact
@@ -135,13 +134,23 @@ def _frame(K: SafeKernel, m: np.ndarray | None = None) -> tuple[np.ndarray, int]
     work in y = (x − o) / 2^e (:func:`_to_frame`), where Ψ has unit size whatever its
     magnitude (HiGHS reads |b| ≥ 1e20 as infinite; absolute tolerances swamp a
     kernel at 1e-300; nothing overflows near the largest floats) — and, 2^e a power
-    of two, on the same numbers for X and 2^j X."""
+    of two, on the same numbers for X and 2^j X. The mean and the extent are taken of
+    the vertices times 2^−s (s: the exponent of their largest |coordinate|), so
+    neither underflows: of a kernel a few subnormals wide both were 0 (V40: the
+    Chebyshev LP then saw it 2^-1074 wide, and its centre was refused)."""
     V = K.vertices
-    o = (V / len(V)).sum(axis=0)
-    ext = float(np.abs(V / 4 - o / 4).max())
+    top = float(np.abs(V).max())
+    s = math.frexp(top)[1] if 0 < top < math.inf else 0
+    Vs = np.ldexp(V, -s)
+    os = (Vs / len(Vs)).sum(axis=0)
+    o = np.ldexp(os, s)
+    ext = float(np.abs(Vs / 4 - os / 4).max())
+    e = math.frexp(ext)[1] + 2 + s if ext > 0 else None
     if m is not None:
-        ext = max(ext, math.ldexp(float(np.abs(m / 4 - o / 4).max()), -FAR_TARGET))
-    return o, (math.frexp(ext)[1] + 2 if ext > 0 else 0)
+        far = math.ldexp(float(np.abs(m / 4 - o / 4).max()), -FAR_TARGET)
+        if far > 0:
+            e = max(e, math.frexp(far)[1] + 2) if e is not None else math.frexp(far)[1] + 2
+    return o, (e if e is not None else 0)
 
 
 def _to_frame(x: np.ndarray, c: np.ndarray, e: int) -> np.ndarray:
@@ -151,9 +160,15 @@ def _to_frame(x: np.ndarray, c: np.ndarray, e: int) -> np.ndarray:
                      for a, b in zip(x, c, strict=True)])
 
 
-def _from_frame(y: np.ndarray, o: np.ndarray, e: int) -> np.ndarray:
-    """o + 2^e y, held within the finite floats."""
-    return np.clip(o + np.ldexp(y, e), -MAX_FINITE, MAX_FINITE)
+def _from_frame(y: np.ndarray, o: np.ndarray, e: int) -> Vec:
+    """o + 2^e y, exactly: rounded to floats, the centre of a kernel a few subnormals
+    wide fell on the subnormal grid, outside it (V40). A non-finite y is a
+    SolverError."""
+    if not np.isfinite(y).all():
+        raise SolverError("the backend returned a non-finite Chebyshev centre")
+    scale = Fraction(2) ** e
+    return tuple(Fraction(float(a)) + Fraction(float(b)) * scale
+                 for a, b in zip(o, y, strict=True))
 
 
 def _framed(K: SafeKernel, o: np.ndarray, e: int):
@@ -391,7 +406,7 @@ def _chebyshev(K: SafeKernel, backend: str) -> Vec:
                 centre, radius = chebyshev(*framed, backend=CHEBYSHEV_AUTO[1])
         else:
             centre, radius = chebyshev(*framed, backend=backend)
-        c0 = _onto_hull(ex.kernel_eqs, tuple(Fraction(float(v)) for v in _from_frame(centre, o, e)))
+        c0 = _onto_hull(ex.kernel_eqs, _from_frame(centre, o, e))
         x = _inside(K, c0)
         unsure = x is not c0 or not radius >= THIN
     except SolverError:
