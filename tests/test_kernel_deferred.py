@@ -21,6 +21,7 @@ import pytest
 import rescon
 from rescon.geometry import _vertex_floats as vf
 from rescon.geometry import fastpath
+from tests import vertex_floats_reference as ref
 from tests.test_kernel_d45_around2 import _cloud
 
 
@@ -143,10 +144,11 @@ def test_singular_and_overflowing_systems_are_not_proven():
 
 
 def test_a_singular_proposal_does_not_invert_the_stack_one_by_one(monkeypatch):
-    """A stack with exactly singular members (dependent rows: common on degenerate
-    clouds) is inverted in one call for the others — the same inverses as one at a
-    time, NaN for the singular ones (it was 28 k single inversions, 0.3 s, on
-    cube(5, 30, 3))."""
+    """The numpy reference of the proof (tests/vertex_floats_reference.py, the
+    oracle of the compiled one): a stack with exactly singular members (dependent
+    rows: common on degenerate clouds) is inverted in one call for the others — the
+    same inverses as one at a time, NaN for the singular ones (it was 28 k single
+    inversions, 0.3 s, on cube(5, 30, 3))."""
     rng = np.random.default_rng(5)
     Af = rng.normal(size=(300, 5, 5))
     Af[[3, 299], 4] = 0.0  # a zero row
@@ -158,7 +160,7 @@ def test_a_singular_proposal_does_not_invert_the_stack_one_by_one(monkeypatch):
     calls = []
     real = np.linalg.inv
     monkeypatch.setattr(np.linalg, "inv", lambda A: calls.append(A.shape) or real(A))
-    R = vf._inverses(Af)
+    R = ref._inverses(Af)
     assert len(calls) <= 2
     assert np.isnan(R[[3, 100, 299]]).all()
     assert np.array_equal(R, one_by_one, equal_nan=True)

@@ -1,11 +1,11 @@
 """R14: the fast path's certification, faster, with the same answers.
 
 * ``_vertex_floats._rounded_nb`` (the compiled proof of the vertices' floats) against
-  an exact oracle (Fractions) and against the numpy reference ``_rounded`` on random,
-  nearly singular, singular, huge, tiny and beyond-the-float-range systems: every
-  float it proves is the correctly rounded coordinate, it proves what the reference
-  proves (up to the few its own approximate inverse decides otherwise), and never a
-  system without a single point;
+  an exact oracle (Fractions) and against the numpy reference
+  (``tests/vertex_floats_reference.py``) on random, nearly singular, singular, huge,
+  tiny and beyond-the-float-range systems: every float it proves is the correctly
+  rounded coordinate, it proves what the reference proves (up to the few its own
+  approximate inverse decides otherwise), and never a system without a single point;
 * the compiled helpers against the numpy code they replace: ``_closure._radix_sorted``
   (np.sort), ``_certify_nb.packed_pairs`` (np.packbits of the boolean table),
   ``_closure._sorted_into``, ``_candidates._kept_pairs`` (rows with exactly
@@ -24,6 +24,7 @@ import pytest
 import rescon
 from rescon.geometry import _vertex_floats as vf
 from rescon.geometry import kernel as km
+from tests import vertex_floats_reference as ref
 
 
 def _solve(rows: list[tuple[int, ...]], scale: int) -> list[Fraction] | None:
@@ -88,16 +89,6 @@ def _table(systems, k: int):
     return E, np.arange(len(rows), dtype=np.int64).reshape(len(systems), k)
 
 
-def _reference(E, at, scale: int, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """The numpy reference ``_vertex_floats._rounded`` on all the proposals."""
-    out = np.full((len(at), k), np.nan)
-    ok = np.zeros(len(at), dtype=np.bool_)
-    with np.errstate(all="ignore"):
-        rows = vf._row_floats(E, scale, k)
-        vf._rounded(rows, *vf._split(rows[0].T), at, k, 1.0, out, ok)
-    return out, ok
-
-
 KINDS = ["random", "small", "near", "singular", "huge", "spread", "tiny"]
 
 
@@ -108,14 +99,14 @@ def test_compiled_proof_against_oracle_and_reference(kind, k, scale):
     systems = _systems(kind, rng, k, 120)
     E, at = _table(systems, k)
     got, ok = vf.rounded_points(E, at, scale, k)
-    ref, ref_ok = _reference(E, at, scale, k)
+    want, ref_ok = ref.rounded_points(E, at, scale, k)
     assert np.isnan(got[~ok]).all()
     for p in np.flatnonzero(ok).tolist():
         z = _solve(systems[p], scale)
         assert z is not None, p  # a proven proposal is a single point
         assert [_float(v) for v in z] == got[p].tolist(), p
     both = ok & ref_ok
-    assert np.array_equal(got[both], ref[both])  # correct rounding: one float each
+    assert np.array_equal(got[both], want[both])  # correct rounding: one float each
     # the inverses differ (Gauss-Jordan here, LAPACK there): the verdicts on a few
     # ill-conditioned systems may too, no more
     assert (ok != ref_ok).sum() <= max(2, len(systems) // 20)

@@ -11,7 +11,9 @@
   differ by 2^900, huge integers (500–3000 bits), scale 2^1000, dependent rows,
   entries beyond the float range.
 * weakened proofs (the ``slack`` factor, the unit roundoff, TwoSum's error dropped)
-  are caught by the same oracle — the oracle test can fail.
+  are caught by the same oracle — the oracle test can fail. The library's proof is
+  compiled; the weakenings inside a step are made in its numpy statement, the tests'
+  reference (``tests/vertex_floats_reference.py``), run through the same oracle.
 * the public answers against the pre-change commit (its source tree exported by
   ``git archive``, run in a subprocess), certificates checked by ``certificates``.
 * laziness: pickling before/after reading, threads, what a kernel keeps alive.
@@ -32,6 +34,7 @@ import pytest
 
 import rescon
 from rescon.geometry import _vertex_floats as vf
+from tests import vertex_floats_reference as ref
 
 U = 2.0**-53
 
@@ -73,13 +76,15 @@ def _table(systems: list[list[tuple[int, ...]]], k: int):
     return E, at
 
 
-def _check(systems, k: int, scale: int, slack: float = 1.0) -> tuple[int, int]:
-    """rounded_points on the systems against the oracle: (proven, wrong) counts; a
-    proven entry of a system without a single point counts as wrong."""
+def _check(systems, k: int, scale: int, slack: float = 1.0,
+           prove=None) -> tuple[int, int]:
+    """rounded_points (or ``prove``, the same signature: the numpy reference) on the
+    systems against the oracle: (proven, wrong) counts; a proven entry of a system
+    without a single point counts as wrong."""
     if not systems:
         return 0, 0
     E, at = _table(systems, k)
-    got, ok = vf.rounded_points(E, at, scale, k, slack)
+    got, ok = (prove or vf.rounded_points)(E, at, scale, k, slack)
     wrong = 0
     for p in np.flatnonzero(ok).tolist():
         z = _solve(systems[p], scale)
@@ -378,18 +383,23 @@ class _WideGaps:
 
 
 def test_a_full_gap_instead_of_the_half_gap_is_caught(monkeypatch):
-    """Accepting |z − f| < a whole gap (the halving forgotten): caught. (Shrinking the
-    unit roundoff in every constant is not: the β term, which is computed from
-    |I − R·Af| and not from u, dominates E on these systems.)"""
+    """Accepting |z − f| < a whole gap (the halving forgotten) in the numpy reference
+    of the proof: caught, where the reference as it is proves none wrongly.
+    (Shrinking the unit roundoff in every constant is not: the β term, which is
+    computed from |I − R·Af| and not from u, dominates E on these systems.)"""
     systems = _midpoint_systems()
-    monkeypatch.setattr(vf, "np", _WideGaps())
-    assert _check(systems, 4, 1)[1] > 0
+    assert _check(systems, 4, 1, prove=ref.rounded_points)[1] == 0
+    monkeypatch.setattr(ref, "np", _WideGaps())
+    assert _check(systems, 4, 1, prove=ref.rounded_points)[1] > 0
 
 
 def test_twosum_error_dropped_is_caught(monkeypatch):
-    """f = fl(z0 + δ) without TwoSum's exact error t (|z − f| ≤ E assumed): caught."""
+    """f = fl(z0 + δ) without TwoSum's exact error t (|z − f| ≤ E assumed) in the
+    numpy reference of the proof: caught, where the reference as it is proves none
+    wrongly."""
     systems = _midpoint_systems()
-    real = vf._two_sum
+    assert _check(systems, 4, 1, prove=ref.rounded_points)[1] == 0
+    real = ref._two_sum
 
     # the residual's Sum2 calls _two_sum on (P, k) arrays too: drop the error only in
     # step 4, recognised as the last call of each rounded_points
@@ -404,34 +414,34 @@ def test_twosum_error_dropped_is_caught(monkeypatch):
             s, t = real(a, b)
             return (s, np.zeros_like(t)) if state["n"] == 3 * k + 2 else (s, t)
 
-        monkeypatch.setattr(vf, "_two_sum", two_sum)
+        monkeypatch.setattr(ref, "_two_sum", two_sum)
         with np.errstate(all="ignore"):
             rows = vf._row_floats(E, scale, k)
-            vf._rounded(rows, *vf._split(rows[0].T), at, k, slack, out, ok)
-        monkeypatch.setattr(vf, "_two_sum", real)
+            ref._rounded(rows, *vf._split(rows[0].T), at, k, slack, out, ok)
+        monkeypatch.setattr(ref, "_two_sum", real)
         return out, ok
 
-    monkeypatch.setattr(vf, "rounded_points", patched)
-    assert _check(systems, 4, 1)[1] > 0
+    assert _check(systems, 4, 1, prove=patched)[1] > 0
 
 
 @pytest.mark.parametrize("name", ["random", "ill", "mid70", "powers", "beyond", "limits"])
 def test_the_residual_bound_holds(name):
-    """Step 1 alone: the doubled-precision residual rf (``_residual``) and the bound ρ
-    that ``_rounded`` puts on it, (2u|rf| + 2n²u²T + 3uQ)(1 + 4(k + 4)u), against the
-    exact residual b' − A z0 (Fractions), on every system whose rows split (the
-    proof's precondition), unscaled (σ = 0: the same relative bound)."""
+    """Step 1 alone: the doubled-precision residual rf (the numpy reference's
+    ``_residual``) and the bound ρ that the proof puts on it, (2u|rf| + 2n²u²T + 3uQ)
+    (1 + 4(k + 4)u), against the exact residual b' − A z0 (Fractions), on every system
+    whose rows split (the proof's precondition), unscaled (σ = 0: the same relative
+    bound)."""
     rng = np.random.default_rng([21, 7, FAMILIES.index(name)])
     k = 4
     systems = _family(name, rng, k, 150)[0]
     E, at = _table(systems, k)
     Ahi, Alo, bhi, blo, t, split = vf._row_floats(E, 1, k)
     with np.errstate(all="ignore"):
-        R = vf._inverses(Ahi[at])
+        R = ref._inverses(Ahi[at])
         z0 = (R @ (bhi[at] + blo[at])[:, :, None])[:, :, 0]
         ah, al = vf._split(Ahi.T)
-        rf, T, Q = vf._residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at], bhi[at],
-                                blo[at], z0)
+        rf, T, Q = ref._residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at],
+                                 bhi[at], blo[at], z0)
         n = 3 * k + 2
         rho = (2 * U * np.abs(rf) + 2 * n * n * U * U * T + 3 * U * Q) * (1 + 4 * (k + 4) * U)
     checked = 0
@@ -791,19 +801,18 @@ def test_entries_at_the_float_overflow_boundary():
 
 
 def _instrumented(old: str = "", new: str = ""):
-    """A copy of ``_vertex_floats._rounded`` recording, per call, the proposals it
-    kept, z0, δ, the bound E, β and R (source unchanged but for the recording line and
-    the optional replacement ``old`` -> ``new``; skipped if the source no longer has
-    the anchors)."""
+    """A copy of the numpy reference's ``_rounded`` recording, per call, the
+    proposals it kept, z0, δ, the bound E, β and R (source unchanged but for the
+    recording line and the optional replacement ``old`` -> ``new``; both anchors must
+    be in the source: the reference is the tests' own)."""
     import inspect
 
-    src = inspect.getsource(vf._rounded)
+    src = inspect.getsource(ref._rounded)
     anchor = "    # 4. f = fl(z0 + δ)"
-    if anchor not in src or old not in src:
-        pytest.skip("_rounded changed: no anchor for the instrumented copy")
+    assert anchor in src and old in src, "no anchor for the instrumented copy"
     src = src.replace(old, new) if old else src
     seen: list = []
-    ns = dict(vars(vf))
+    ns = dict(vars(ref))
     ns["_seen"] = seen
     exec(src.replace(anchor, "    _seen.append((idx, good.copy(), z0, delta, Eb, beta, R, at))\n"
                      + anchor), ns)

@@ -7,10 +7,19 @@ is A z = b' with A_{hj} = a_{hj} / 2^{t_h}, b'_h = b_h / (scale · 2^{t_h}), |A|
 Floats: Af = fl(A) (each entry int / int, correctly rounded, |A − Af| ≤ u|Af|, u =
 2^-53, in the normal range checked below), R ≈ Af⁻¹ and z0 ≈ Af⁻¹ fl(b'). Then:
 
-1. The residual r = b' − A z0 in doubled precision (:func:`_residual`: A and b' as
-   hi + lo pairs, the products by error-free transformations, the sum by Sum2) with a
-   rigorous bound ρ ≥ |r − rf|, both scaled by 2^σ (σ per proposal, so that
-   max |2^σ rf| ∈ [1/2, 1)): rs = 2^σ rf, ρ_s = 2^σ ρ, |2^σ r − rs| ≤ ρ_s.
+1. The residual r = b' − A z0 in doubled precision, with a rigorous bound ρ ≥
+   |r − rf|: A = Ahi + Alo and b' = bhi + blo (+ their roundings; ah + al = Ahi,
+   Veltkamp's split), Ahi_j z0_j = p_j + e_j exactly (Dekker's product on the splits,
+   exact as no partial product leaves the normal range), q_j = fl(Alo_j z0_j); the
+   n = 3k + 2 terms bhi, blo, −p_j (j = 0..k−1), −e_j, −q_j, in that order, summed by
+   Sum2 into rf (Ogita, Rump and Oishi 2005: a cascade of TwoSums, |res − s| ≤ u|s| +
+   γ_{n−1}² Σ|terms| — additions err only relatively, as an addition whose result is
+   subnormal is exact). With T = Σ|terms| and Q = |blo| + Σ_j |q_j| (as computed) the
+   total error is |r − rf| ≤ (1 + 2u)(u|rf| + γ_{n−1}² (1 + γ_n) T +
+   2u(1 + 2u)(1 + γ_n) Q) (the roundings of A and b', |ΔA| ≤ u|Alo|(1 + 2u), and of
+   the q_j added) ≤ ρ = (2u|rf| + 2n²u² T + 3u Q)(1 + 4(k + 4)u). All scaled by 2^σ
+   (σ per proposal, so that max |2^σ rf| ∈ [1/2, 1); ρ evaluated on rs, 2^σ T and
+   2^σ Q): rs = 2^σ rf, ρ_s = 2^σ ρ, |2^σ r − rs| ≤ ρ_s.
 2. β_i ≥ Σ_j |I − R A|_{ij}: |I − RA| ≤ |I − C| + |C − R Af| + |R| |A − Af| with
    C = fl(R Af), |C − R Af| ≤ γ_k |R||Af| (γ_k = ku / (1 − ku); any summation order,
    with or without fused multiply-adds), so, with sD = fl(row sums of fl|I − C|) and
@@ -41,13 +50,15 @@ lies in [2^-800, 2^800]: no overflow and no underflow anywhere (sums of normal n
 that fall below the normal range are exact), so the relative bounds above hold;
 δ_s / 2^σ and E_s / 2^σ are exact (normal, ≥ 2^-900). The doubled-precision residual
 also needs its rows' lo parts 0 or normal with an exact or normal remainder, and
-2^σ T, 2^σ Q (:func:`_residual`) 0 or in [2^-400, 2^400]. Anything non-finite fails
+2^σ T, 2^σ Q (step 1) 0 or in [2^-400, 2^400]. Anything non-finite fails
 every comparison (NaN) or the range checks (inf): not certified.
 
 The proofs run compiled, a proposal at a time (:func:`_rounded_nb`, the float
-operations of each step in the order of the numpy reference :func:`_rounded`, without
-fastmath: no fused multiply-adds, no reassociation); the approximate inverse R, which
-the proof does not trust, is its own Gauss–Jordan elimination.
+operations of each step in the order stated above, without fastmath: no fused
+multiply-adds, no reassociation); the approximate inverse R, which the proof does not
+trust, is its own Gauss–Jordan elimination. The tests keep a numpy statement of the
+same steps, all proposals at once (tests/vertex_floats_reference.py), as their oracle
+and as the proof they weaken to show the oracle catches it.
 """
 
 from __future__ import annotations
@@ -113,61 +124,6 @@ def rounded_points(E: np.ndarray, at: np.ndarray, scale: int, k: int,
     return out, ok
 
 
-def _rounded(rows: tuple, ah: np.ndarray, al: np.ndarray, at: np.ndarray, k: int,
-             slack: float, out: np.ndarray, ok: np.ndarray) -> None:
-    """:func:`rounded_points` for the proposals ``at``, writing into ``out`` and ``ok``
-    (views): ``rows`` from :func:`_row_floats`, (ah, al) the split of its Ahi's
-    columns — in numpy, all proposals at once: the reference of the compiled
-    :func:`_rounded_nb` (tests compare them, and weaken a step of this one to show the
-    oracle catches it)."""
-    Ahi, Alo, bhi, blo, _, split = rows
-    split = split & _in_range(Ahi, True) & _in_range(Alo, True)
-    Af = Ahi[at]  # (P, k, k)
-    R = _inverses(Af)
-    z0 = (R @ (bhi[at] + blo[at])[:, :, None])[:, :, 0]
-    good = split[at].all(axis=1) & _in_range(R, True) & _in_range(z0, True)
-    if not good.any():
-        return
-    idx = np.flatnonzero(good)
-    Af, R, z0, at = Af[idx], R[idx], z0[idx], at[idx]
-    # 1. the residual with its error bound, scaled by 2^σ
-    rf, T, Q = _residual(Ahi.T[:, at], ah[:, at], al[:, at], Alo.T[:, at], bhi[at],
-                         blo[at], z0)
-    top = np.abs(rf).max(axis=1)
-    sigma = np.where(top > 0.0, -np.frexp(top)[1], 0).astype(np.int64)
-    rs = np.ldexp(rf, sigma[:, None])
-    Ts, Qs = np.ldexp(T, sigma[:, None]), np.ldexp(Q, sigma[:, None])
-    n = 3 * k + 2
-    rho = (2.0 * _U * np.abs(rs) + 2.0 * n * n * _U * _U * Ts + 3.0 * _U * Qs) * (
-        1.0 + 4.0 * (k + 4) * _U)
-    good = ((np.abs(sigma) <= LIMIT) & _in_range(rs, True) & _in_range(Ts, True)
-            & _in_range(Qs, True))
-    # 2. β: the row sums of |I − RA|, bounded
-    C = R @ Af
-    D = np.abs(np.eye(k) - C)
-    absR = np.abs(R)
-    sN = (absR @ np.abs(Af)).sum(axis=2)
-    beta = (D.sum(axis=2) + 2.0 * (k + 2) * _U * sN) * (1.0 + 2.0 * (k + 8) * _U)
-    beta = np.maximum(beta, FLOOR).max(axis=1)
-    good &= beta <= 0.5
-    # 3. the correction and its bound, in units 2^-σ
-    ds = (R @ rs[:, :, None])[:, :, 0]
-    G = (absR @ np.abs(rs)[:, :, None])[:, :, 0]
-    Hr = (absR @ rho[:, :, None])[:, :, 0]
-    Es = (2.5 * beta * (G + Hr).max(axis=1))[:, None] + 2.0 * Hr + 2.0 * (k + 2) * _U * G
-    Es = np.maximum(Es, FLOOR) * (1.0 + 8.0 * _U) * slack
-    good &= _in_range(ds, True) & (Es <= 2.0**300).all(axis=1)
-    sig = np.where(good, sigma, 0)[:, None]
-    delta = np.ldexp(ds, -sig)
-    Eb = np.ldexp(Es, -sig)
-    # 4. f = fl(z0 + δ), t = z0 + δ − f (TwoSum), and the half gaps around f
-    f, tw = _two_sum(z0, delta)
-    gap = np.minimum(f - np.nextafter(f, -np.inf), np.nextafter(f, np.inf) - f) * 0.5
-    good &= _in_range(f, False) & ((Eb + np.abs(tw)) * (1.0 + 4.0 * _U) < gap).all(axis=1)
-    out[idx[good]] = f[good]
-    ok[idx[good]] = True
-
-
 @njit(cache=True, nogil=True, inline="always")
 def _inr(x, zero_ok):
     """|x| in [2^-LIMIT, 2^LIMIT], or x = 0 with ``zero_ok`` (:func:`_in_range` for one
@@ -179,8 +135,8 @@ def _inr(x, zero_ok):
 @njit(cache=True, nogil=True)
 def _invert(Af, R, M):
     """R ≈ Af⁻¹ (k × k) by Gauss–Jordan elimination with partial pivoting on a copy M;
-    False where a pivot is exactly 0. Only a guess: β checks it (like :func:`_inverses`,
-    whose LAPACK inverse it need not equal)."""
+    False where a pivot is exactly 0. Only a guess: β checks it (the tests' numpy
+    reference takes LAPACK's inverse, which it need not equal)."""
     k = Af.shape[0]
     for i in range(k):
         for j in range(k):
@@ -213,14 +169,15 @@ def _invert(Af, R, M):
 
 @njit(cache=True, nogil=True)
 def _rounded_nb(Ahi, Alo, bhi, blo, split, ah, al, at, k, slack, out, ok):
-    """:func:`_rounded`, compiled, one proposal at a time: the same steps and bounds
-    (module docstring), each float operation of the proof in the order :func:`_rounded`
-    performs it — numba compiles without fastmath, so no contraction into fused
-    multiply-adds and no reassociation: TwoSum, Veltkamp's split, Dekker's product and
-    Sum2 stay error-free transformations — and where :func:`_rounded` leaves the order
-    to numpy (the matrix products and row sums, the bounds of which hold for any order
-    and with or without fused multiply-adds) a plain loop. R comes from
-    :func:`_invert`, not LAPACK: R is only a guess (any R with β ≤ 1/2 gives a proof), so
+    """The proof of the module docstring, compiled, one proposal at a time: its steps
+    and bounds, each float operation in the order the steps state it (the order the
+    tests' numpy reference performs them in, all proposals at once) — numba compiles
+    without fastmath, so no contraction into fused multiply-adds and no reassociation:
+    TwoSum, Veltkamp's split, Dekker's product and Sum2 stay error-free
+    transformations — and where the steps leave the order open (the matrix products
+    and row sums, the bounds of which hold for any order and with or without fused
+    multiply-adds) a plain loop. R comes from :func:`_invert`, not LAPACK (the
+    reference's): R is only a guess (any R with β ≤ 1/2 gives a proof), so
     a proposal may be proven here and not there or conversely, never with another
     float (correct rounding is a function of the point). ``split``: per row, split
     and its hi and lo parts in range; ``ah``, ``al``: the split of Ahi, (rows, k)."""
@@ -262,7 +219,7 @@ def _rounded_nb(Ahi, Alo, bhi, blo, split, ah, al, at, k, slack, out, ok):
                 good = good and _inr(R[i, j], True)
         if not good:
             continue
-        # 1. the residual (:func:`_residual`, term by term in its order), scaled by 2^σ
+        # 1. the residual (step 1, term by term in its Sum2 order), scaled by 2^σ
         for i in range(k):
             h = at[p, i]
             s = bhi[h]
@@ -431,79 +388,9 @@ def _row_floats_slow(rows: np.ndarray, t: np.ndarray, scale: int, k: int):
             np.array(blo, dtype=np.float64), t, np.array(split, dtype=np.bool_))
 
 
-def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """s = fl(a + b) and the exact error a + b − s (Knuth's TwoSum: exact in binary
-    floating point with rounding to nearest, barring overflow)."""
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
-
-
 def _split(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Veltkamp's split a = ah + al exactly, each half of at most 26 significant bits
     (|a| < 2^995, no underflow: the callers' range checks)."""
     c = 134217729.0 * a
     ah = c - (c - a)
     return ah, a - ah
-
-
-def _residual(Ahi: np.ndarray, ah: np.ndarray, al: np.ndarray, Alo: np.ndarray,
-              bhi: np.ndarray, blo: np.ndarray, z0: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """rf ≈ r = b' − A z0 for A = Ahi + Alo (+ its rounding; ah + al = Ahi, its split;
-    these four as (column, proposal, row) arrays),
-    b' = bhi + blo (+ its rounding): the n = 3k + 2 terms bhi, blo, −p_j, −e_j
-    (Ahi_j z0_j = p_j + e_j exactly: Dekker's product on the splits, exact as no
-    partial product leaves the normal range) and −q_j = −fl(Alo_j z0_j), summed by
-    Sum2 (Ogita, Rump and Oishi 2005: a cascade of TwoSums, |res − s| ≤ u|s| +
-    γ_{n−1}² Σ|terms| — additions err only relatively, as an addition whose result is
-    subnormal is exact). With T = Σ|terms| and Q = |blo| + Σ_j |q_j| (as computed) the
-    total error is |r − rf| ≤ (1 + 2u)(u|rf| + γ_{n−1}² (1 + γ_n) T + 2u(1 + 2u)(1 + γ_n) Q)
-    (the roundings of A and b', |ΔA| ≤ u|Alo|(1 + 2u), and of the q_j added), which
-    :func:`_rounded` bounds by ρ = (2u|rf| + 2n²u² T + 3u Q)(1 + 4(k + 4)u)."""
-    z = z0.T[:, :, None]  # the arrays are (column j, proposal, row h)
-    p = Ahi * z
-    zh, zl = _split(z)
-    e = ((ah * zh - p) + ah * zl + al * zh) + al * zl
-    q = Alo * z
-    s = bhi
-    err = np.zeros_like(s)
-    for x in (blo, *(-p), *(-e), *(-q)):
-        s, d = _two_sum(s, x)
-        err = err + d
-    aq = np.abs(q)
-    T = np.abs(bhi) + np.abs(blo) + (np.abs(p) + np.abs(e) + aq).sum(axis=0)
-    Q = np.abs(blo) + aq.sum(axis=0)
-    return s + err, T, Q
-
-
-def _inverses(Af: np.ndarray) -> np.ndarray:
-    """Approximate inverses of the (P, k, k) float matrices (NaN where numpy finds one
-    singular): only a guess, which the bound β of :func:`rounded_points` checks.
-
-    numpy inverts a stack matrix by matrix but raises for the whole stack when one is
-    exactly singular in its LU factorisation (common on degenerate clouds: the k rows
-    a proposal chose are dependent) — those, found by the same factorisation
-    (det = 0; a determinant that underflows to 0 only leaves its proposal unproven),
-    are swapped for the identity and their inverses set to NaN, so the others are
-    inverted in one call (one matrix at a time, 28 k calls, took 0.3 s on
-    cube(5, 30, 3))."""
-    with np.errstate(all="ignore"):
-        try:
-            return np.linalg.inv(Af)
-        except np.linalg.LinAlgError:
-            pass
-        singular = np.linalg.det(Af) == 0.0
-        try:
-            R = np.linalg.inv(np.where(singular[:, None, None], np.eye(Af.shape[1]), Af))
-            R[singular] = np.nan
-            return R
-        except np.linalg.LinAlgError:
-            pass
-        R = np.full(Af.shape, np.nan)
-        for p in range(len(Af)):
-            try:
-                R[p] = np.linalg.inv(Af[p])
-            except np.linalg.LinAlgError:
-                pass
-        return R
