@@ -229,20 +229,20 @@ def test_subnormal_lattice_moved_bound_covers_its_rounding(base):
     assert n_ok >= 8
 
 
-@pytest.mark.xfail(strict=True, reason="V41: the spatial batch path rounds its bound to "
-                   "nearest when scaling it back to a subnormal magnitude (bound 0, the "
-                   "exact point ~2e-327 away); _small3d.py:435 np.ldexp(err, exps)")
 def test_spatial_batch_bound_covers_subnormal_rounding():
-    """12 points of {−1, 0, 1}·2^-1074 in space, F = 2: the spatial path certifies
-    (0, 0, −0) with the bound 0 (accepted: the allowance is 0 too), but the exact
-    point is (5, 1, −2)/2^1077-ish — a fraction of a subnormal, not 0."""
+    """Fixed (was a bug: 12 points of {−1, 0, 1}·2^-1074 in space, F = 2: the spatial
+    path certified (0, 0, −0) with the bound 0 — accepted, the allowance is 0 too — but
+    the exact point is (5, 1, −2)/2^1077-ish, a fraction of a subnormal, not 0: the
+    point and its bound scaled back into the subnormal range were rounded, and the
+    rounding was not in the bound). The bound now covers the exact point; such a
+    set is no longer certified (two subnormals are more than ACCEPT_REL of it)."""
     K = np.array([[0, 1, 1], [0, 1, 1], [1, 1, -1], [1, -1, -1], [1, 0, 0], [1, -1, -1],
                   [0, 1, -1], [0, -1, -1], [1, -1, 1], [1, 1, 0], [0, 0, 0], [-1, 0, 0]],
                  float)
     Y = K * TINY
     p, err, ok = engine._batch_points(Y[None], 2)
-    assert ok[0]
     assert within(p[0], exact_point(Y, 2), err[0], 3)
+    assert not ok[0]
 
 
 # --- _kernel_points end to end -------------------------------------------------------

@@ -49,7 +49,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .._rounding import MIN_NORMAL
+from .._rounding import MIN_NORMAL, MIN_SUBNORMAL
 from .._rounding import UNIT_ROUNDOFF as EPS
 from ._expansions import TINY, det3, mean_two, normal3, orient3
 from ._small2d import ACCEPT_REL, cluster_box
@@ -310,12 +310,27 @@ def project_small_3d(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np
         Zs, exps = _scaled(Ys[rest])
         pts, bounds = np.zeros((len(rest), 3)), np.full(len(rest), np.inf)
         radon5_all(Zs, pts, bounds)
-        out[rest], err[rest] = np.ldexp(pts, exps[:, None]), np.ldexp(bounds, exps)
+        out[rest], err[rest] = _unscaled(pts, bounds, exps)
         found = err <= ACCEPT_REL * np.abs(out).max(axis=1)
     rest = np.flatnonzero(~found)
     if len(rest):
         out[rest], err[rest], found[rest] = _project(Ys[rest], F)
     return out, err, found
+
+
+def _unscaled(pts: np.ndarray, err: np.ndarray, exps: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """The points and their 2-norm bounds of the sets scaled by :func:`_scaled`, times
+    2^e again. Where a coordinate or the bound falls below the normal range, the
+    scaling rounds (to the subnormal grid, or to 0): each coordinate by at most half
+    the smallest subnormal, the bound down by as much, so 2 of the smallest subnormal
+    are added to the bound there (V41: a set of ±2^-1074 got the point 0 with the
+    bound 0, its exact point ~2e-327 away)."""
+    out, bound = np.ldexp(pts, exps[:, None]), np.ldexp(err, exps)
+    with np.errstate(invalid="ignore"):
+        low = (np.abs(out) < MIN_NORMAL).any(axis=1) | (bound < MIN_NORMAL)
+    bound[low] = (bound[low] + 2.0 * MIN_SUBNORMAL) * (1.0 + 2.0**-50)
+    return out, bound
 
 
 def _scaled(Ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -431,8 +446,8 @@ def _project(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
         certify_all(Zs[retry], F, tuple(a[retry] for a in planes), count[retry],
                     status[retry], origin[retry] + scale[retry, None] * hints, scale[retry],
                     have, out[retry], err[retry])
-    found = np.isfinite(err) & (err <= ACCEPT_REL * np.abs(out).max(axis=1))
-    return np.ldexp(out, exps[:, None]), np.ldexp(err, exps), found
+    out, err = _unscaled(out, err, exps)
+    return out, err, np.isfinite(err) & (err <= ACCEPT_REL * np.abs(out).max(axis=1))
 
 
 def by_qp(normals, offsets, count, sets) -> np.ndarray:
