@@ -156,3 +156,18 @@ def test_moved_answers_match_the_exact_path_in_a_run():
     a, b = np.asarray(fast.states), np.asarray(slow.states)
     assert a.shape == b.shape
     assert np.allclose(a, b, rtol=2.0**-40, atol=0.0)
+
+
+def test_the_exact_fallback_builds_no_certificate():
+    """Sets the batch paths decline are computed exactly without the kernel-point
+    certificate the engine never reads (a fifth of each such set's time; the paper's
+    example computes 270): the same floats as ``SafeKernel.point``."""
+    from rescon.geometry import points
+
+    rng = np.random.default_rng(3)
+    sets = [np.vstack([6.3 + rng.integers(-3, 4, size=(6, 2)) * ULP_UNIT, [[-1.26, 13.5]]])
+            for _ in range(5)]
+    want = [rescon.safe_kernel(Y, 2).point("project")[0] for Y in sets]
+    with mock.patch.object(points, "point_certificate", side_effect=AssertionError("built")):
+        got = engine._kernel_points(sets, 2, "project", {})
+    assert np.array_equal(got, np.array(want))

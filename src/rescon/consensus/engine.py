@@ -38,6 +38,7 @@ from .._rounding import MIN_SUBNORMAL
 from ..errors import InputError
 from ..geometry.centroid import hull_centroid
 from ..geometry.kernel import safe_kernel
+from ..geometry.points import exact_point
 from .adversaries import StepView, adversary_messages
 from .dos import blocked_mask
 from .metrics import ValidityMonitor, diameter, monitor_names, spread
@@ -470,7 +471,8 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
         X = problems[k]
         key = (X.shape, X[np.lexsort(X.T[::-1])].tobytes())  # Ψ ignores the order
         if key not in cache:
-            cache[key] = safe_kernel(X, F).point(exact)[0]
+            x = exact_point(safe_kernel(X, F), method=exact)
+            cache[key] = np.array([float(v) for v in x])
         out[k] = cache[key]
     return out
 
