@@ -25,30 +25,7 @@ import rescon
 from rescon.geometry import _vertex_floats as vf
 from rescon.geometry import kernel as km
 from tests import vertex_floats_reference as ref
-
-
-def _solve(rows: list[tuple[int, ...]], scale: int) -> list[Fraction] | None:
-    """z = x / scale where the rows (−b, a) (a·x = b) meet, exactly; None if they do
-    not meet in one point."""
-    k = len(rows)
-    M = [[Fraction(v) for v in r[1:]] + [Fraction(-r[0])] for r in rows]
-    for c in range(k):
-        p = next((i for i in range(c, k) if M[i][c] != 0), None)
-        if p is None:
-            return None
-        M[c], M[p] = M[p], M[c]
-        for i in range(k):
-            if i != c and M[i][c] != 0:
-                f = M[i][c] / M[c][c]
-                M[i] = [x - f * y for x, y in zip(M[i], M[c], strict=True)]
-    return [M[i][k] / (M[i][i] * scale) for i in range(k)]
-
-
-def _float(z: Fraction) -> float:
-    try:
-        return float(z)
-    except OverflowError:
-        return float("inf") if z > 0 else float("-inf")
+from tests.test_review_v21 import _rounded, _solve
 
 
 def _systems(kind: str, rng, k: int, count: int) -> list[list[tuple[int, ...]]]:
@@ -104,7 +81,7 @@ def test_compiled_proof_against_oracle_and_reference(kind, k, scale):
     for p in np.flatnonzero(ok).tolist():
         z = _solve(systems[p], scale)
         assert z is not None, p  # a proven proposal is a single point
-        assert [_float(v) for v in z] == got[p].tolist(), p
+        assert [_rounded(v) for v in z] == got[p].tolist(), p
     both = ok & ref_ok
     assert np.array_equal(got[both], want[both])  # correct rounding: one float each
     # the inverses differ (Gauss-Jordan here, LAPACK there): the verdicts on a few
@@ -139,9 +116,9 @@ def test_compiled_proof_refuses_what_it_cannot_prove():
     E, at = _table(mids, 4)
     got, ok = vf.rounded_points(E, at, 1, 4)
     for p in np.flatnonzero(ok).tolist():
-        assert [_float(v) for v in _solve(mids[p], 1)] == got[p].tolist()
+        assert [_rounded(v) for v in _solve(mids[p], 1)] == got[p].tolist()
     weak, weak_ok = vf.rounded_points(E, at, 1, 4, slack=2.0**-40)
-    wrong = sum([_float(v) for v in _solve(mids[p], 1)] != weak[p].tolist()
+    wrong = sum([_rounded(v) for v in _solve(mids[p], 1)] != weak[p].tolist()
                 for p in np.flatnonzero(weak_ok).tolist())
     assert wrong > 0
 
