@@ -168,6 +168,7 @@ def test_the_exact_fallback_builds_no_certificate():
     sets = [np.vstack([6.3 + rng.integers(-3, 4, size=(6, 2)) * ULP_UNIT, [[-1.26, 13.5]]])
             for _ in range(5)]
     want = [rescon.safe_kernel(Y, 2).point("project")[0] for Y in sets]
-    with mock.patch.object(points, "point_certificate", side_effect=AssertionError("built")):
+    with mock.patch.object(points, "point_certificate", side_effect=AssertionError("built")), \
+            mock.patch.object(engine, "PLANAR_EXACT_MAX", 0):  # the general exact path
         got = engine._kernel_points(sets, 2, "project", {})
     assert np.array_equal(got, np.array(want))
