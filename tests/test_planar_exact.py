@@ -134,3 +134,27 @@ def test_non_finite_sets_keep_the_general_paths_error():
     with pytest.raises(InputError):
         engine._kernel_points([np.array([[0.0, 0.0], [1.0, np.inf], [2.0, 1.0],
                                          [0.0, 3.0]])], 1, "project", {})
+
+
+def test_spatial_sets_in_an_axis_plane_take_the_planar_construction():
+    """Converged states in space reach sets with one coordinate the same in every point
+    (the 3-d batch path declines them: their kernel is flat; the planar batch path then
+    declines flat kernels too). Their exact point is (a, the planar point of the other
+    coordinates): the same floats as the general path, without a kernel (failed
+    before: every such set built one)."""
+    rng = np.random.default_rng(5)
+    base = np.array([5.04033371, 4.79010105, 5.14637996])
+    sets = []
+    for j in range(3):
+        for _ in range(20):
+            Y = base + rng.integers(-2, 3, size=(5, 3)) * np.spacing(base)
+            Y[:, j] = base[j]
+            sets.append(Y)
+    sets.append(np.tile(base, (5, 1)))  # every coordinate constant
+    want = np.array([[float(v) for v in general(Y, 1)] for Y in sets])
+    calls: list[int] = []
+    real = engine.safe_kernel
+    with mock.patch.object(engine, "safe_kernel", lambda X, F: calls.append(1) or real(X, F)):
+        got = engine._kernel_points(sets, 1, "project-exact", {})
+    assert calls == []
+    assert np.array_equal(got, want)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from fractions import Fraction
 from typing import Any, Protocol
 
 import numpy as np
@@ -479,15 +480,40 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
         X = problems[k]
         key = (X.shape, X[np.lexsort(X.T[::-1])].tobytes())  # Ψ ignores the order
         if key not in cache:
-            x = None
-            if exact == "project" and X.shape[1] == 2 and len(X) <= PLANAR_EXACT_MAX \
-                    and np.isfinite(X).all():
-                x = nearest_to_mean(X, F)  # None: Ψ empty, reported by the general path
+            x = _planar_exact_point(X, F) if exact == "project" else None
             if x is None:
                 x = exact_point(safe_kernel(X, F), method=exact)
             cache[key] = np.array([float(v) for v in x])
         out[k] = cache[key]
     return out
+
+
+def _planar_exact_point(X: np.ndarray, F: int) -> list[Fraction] | None:
+    """The exact point of Ψ(X, F) nearest the mean of X by the planar construction
+    (:func:`rescon.geometry._planar_exact.nearest_to_mean`) for finite sets of at most
+    PLANAR_EXACT_MAX points in the plane, or in space with a coordinate j the same in
+    every point: X lies in the plane x_j = a, so Ψ(X, F) = {a} × Ψ(X', F) (X' the
+    other coordinates; a halfspace meets the plane in a halfplane, and every halfplane
+    is such a meet) and the mean is (a, mean X'), so the point sought is (a, the planar
+    point of X') — converged states reach such sets, where the batch paths decline
+    flat kernels. None otherwise, or when Ψ is empty (the general path reports it)."""
+    m, d = X.shape
+    if m > PLANAR_EXACT_MAX or d not in (2, 3) or not np.isfinite(X).all():
+        return None
+    if d == 2:
+        x = nearest_to_mean(X, F)
+        return None if x is None else list(x)
+    same = np.flatnonzero((X == X[0]).all(axis=0))
+    if not len(same):
+        return None
+    j = int(same[0])
+    others = [i for i in range(3) if i != j]
+    x = nearest_to_mean(np.ascontiguousarray(X[:, others]), F)
+    if x is None:
+        return None
+    point = [Fraction(0)] * 3
+    point[j], point[others[0]], point[others[1]] = Fraction(float(X[0, j])), *x
+    return point
 
 
 def _batch_points(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

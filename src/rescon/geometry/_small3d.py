@@ -322,14 +322,18 @@ def _unscaled(pts: np.ndarray, err: np.ndarray, exps: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray]:
     """The points and their 2-norm bounds of the sets scaled by :func:`_scaled`, times
     2^e again. Where a coordinate or the bound falls below the normal range, the
-    scaling rounds (to the subnormal grid, or to 0): each coordinate by at most half
+    scaling may round (to the subnormal grid, or to 0): each coordinate by at most half
     the smallest subnormal, the bound down by as much, so 2 of the smallest subnormal
-    are added to the bound there (V41: a set of ±2^-1074 got the point 0 with the
-    bound 0, its exact point ~2e-327 away)."""
+    are added to the bound where it did (V41: a set of ±2^-1074 got the point 0 with
+    the bound 0, its exact point ~2e-327 away). It did not where scaling back by 2^-e
+    gives the scaled values again (a product by a power of two that does not round is
+    exact), e.g. a point 0 with the bound 0 — a converged cluster moved next to the
+    origin (``engine._batch_points_moved``) — which the unconditional term declined."""
     out, bound = np.ldexp(pts, exps[:, None]), np.ldexp(err, exps)
-    with np.errstate(invalid="ignore"):
-        low = (np.abs(out) < MIN_NORMAL).any(axis=1) | (bound < MIN_NORMAL)
-    bound[low] = (bound[low] + 2.0 * MIN_SUBNORMAL) * (1.0 + 2.0**-50)
+    with np.errstate(invalid="ignore", over="ignore"):
+        rounded = ((np.ldexp(out, -exps[:, None]) != pts) & ~np.isnan(pts)).any(axis=1) \
+            | ((np.ldexp(bound, -exps) != err) & ~np.isnan(err))
+    bound[rounded] = (bound[rounded] + 2.0 * MIN_SUBNORMAL) * (1.0 + 2.0**-50)
     return out, bound
 
 
