@@ -143,10 +143,12 @@ def _clip(ring: list[Vertex], a1: int, a2: int, b: int) -> list[Vertex]:
 
 def _collinear_kernel(P: tuple[tuple[int, ...], ...], F: int) -> list[Vertex]:
     """Ψ of points on one line: from the (F + 1)-th to the (n − F)-th in their order
-    along it (lexicographic order is an order along any line); empty when F + 1 > n − F."""
+    along it (lexicographic order is an order along any line) — when F + 1 > n − F,
+    nonempty only if those two points coincide (then every point between them in the
+    order is that point, which lies in the hull of any n − F points: V42)."""
     order = sorted(P)
     lo, hi = F, len(P) - 1 - F
-    if lo > hi:
+    if lo > hi and order[lo] != order[hi]:
         return []
     ends = [order[lo], order[hi]] if order[lo] != order[hi] else [order[lo]]
     return [(1, x, y) for x, y in ends]
