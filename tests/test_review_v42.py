@@ -331,13 +331,15 @@ def test_complete_graph_runs_bit_identical(adv, algorithm):
 @pytest.mark.slow
 @pytest.mark.parametrize("adv", ["far", "twofaced", "bait"])
 def test_sets_of_exactly_32_points_bit_identical(adv):
-    """K33, F = 3, algorithm "kernel": every set is the 32 received values."""
+    """K33, F = 3, algorithm "kernel": every set is the 32 received values (with the
+    far or two-faced adversaries' values they span > PLANAR_EXACT_BITS binary orders
+    of magnitude: the general path's, by the engine's guard since V42)."""
     rng = np.random.default_rng(6)
     sc = Scenario(graph=nx.complete_graph(33), x0=rng.normal(size=(33, 2)), F=3, steps=4,
                   adversaries=adversaries(adv, 3, rng), algorithm="kernel",
                   kernel_point="project-exact", check_robustness=False)
     same, on, off, calls = same_run(sc)
-    assert same and calls > 0, (on, off)
+    assert same and (calls == 0 if adv in ("far", "twofaced") else calls > 0), (on, off, calls)
 
 
 def test_error_runs_unchanged():
