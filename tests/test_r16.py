@@ -7,7 +7,8 @@
 * ``fastpath._qhull`` reads only the dual facets and equations (``fastpath._lean``: no
   volume and area of the dual hull): the same floats and facets as scipy's
   HalfspaceIntersection; a stand-in that is not such a class is used as it is;
-* ``fastpath._halves`` (vectorised) against the per-vertex loop it replaces;
+* ``fastpath._halves`` (vectorised; the float ranks of the cut's vertices batched)
+  against the per-vertex loops it replaces;
 * the kernels of sphere(5, 30, 1) and sphere(5, 30, 3) pinned to those of the code
   before (floats bit for bit, exact vertices and constraints).
 """
@@ -104,7 +105,8 @@ def test_lean_intersection_skips_the_volume_and_equals_scipy():
 
 
 def _halves_by_loop(A, b, x0, r, options, axis):
-    """fastpath._halves as it was: the halves' vertices one by one."""
+    """fastpath._halves as it was: the halves' vertices one by one, the vertices on
+    the cut by :func:`_on_the_cut_by_loop`."""
     k, m = A.shape[1], len(A)
     cut = np.zeros(k)
     cut[axis] = 1.0
@@ -124,7 +126,7 @@ def _halves_by_loop(A, b, x0, r, options, axis):
                 facets.append(f)
         at = np.flatnonzero(on)
         cuts.append((V[at], [[h for h in dual[i] if h != m] for i in at.tolist()]))
-    more = fastpath._on_the_cut(A, k, *cuts[0], *cuts[1])
+    more = _on_the_cut_by_loop(A, k, *cuts[0], *cuts[1])
     if more is None:
         return None
     for p, f in more:
@@ -133,11 +135,35 @@ def _halves_by_loop(A, b, x0, r, options, axis):
     return (np.array(points), facets) if facets else None
 
 
+def _on_the_cut_by_loop(A, k, V0, rows0, V1, rows1):
+    """fastpath._on_the_cut as it was: one float rank per set of rows."""
+    from scipy.spatial import cKDTree
+
+    if len(V0) != len(V1):
+        return None
+    if not len(V0):
+        return []
+    tol = 1e-9 * (1.0 + max(np.abs(V0).max(), np.abs(V1).max()))
+    gap, match = cKDTree(V1).query(V0, p=np.inf)
+    if not (gap <= tol).all() or len(np.unique(match)) != len(V0):
+        return None
+    out, seen = [], set()
+    for i, j in enumerate(match.tolist()):
+        rows = sorted(set(rows0[i]).union(rows1[j]))
+        if len(rows) < k or tuple(rows) in seen:
+            continue
+        seen.add(tuple(rows))
+        if np.linalg.matrix_rank(A[rows]) == k:
+            out.append((V0[i], rows))
+    return out
+
+
 @pytest.mark.parametrize(("seed", "axis"), list(itertools.product(range(4), range(2))))
 def test_vectorised_halves_equal_the_loop(seed, axis):
     """Random polytopes (tangent planes of a sphere, some through a common point, and
-    the cross-polytope, whose vertices lie on the cut): the same points, bit for bit,
-    and the same rows, in the same order."""
+    the cross-polytope, whose vertices lie on the cut — each proposed from the union of
+    both halves' rows, rank k): the same points, bit for bit, and the same rows, in the
+    same order."""
     rng = np.random.default_rng([16, seed])
     if seed == 3:
         A = np.array(list(itertools.product((-1.0, 1.0), repeat=5)))
