@@ -54,7 +54,6 @@ whose floats are not proven, or the first read of the exact vertices
 from __future__ import annotations
 
 import contextlib
-import functools
 import gc
 import itertools
 import operator
@@ -103,10 +102,8 @@ def _chebyshev(A: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 #: on all 6 d = 5, n = 30 and 8 of 9 n = 20 bench clouds, 1.2–2.4× faster than qhull's
 #: default "Qx" where both completed — "Qx" failed with a duplicate ridge (QH6271) or
 #: a precision error on 3 of the 6 n = 30 clouds, whose proposals then came joggled
-#: (3× as many pieces to certify). Only proposals: the certification decides. With
-#: "Q5" (as in MERGED_OPTIONS_4D: no final pass over the outer planes, the same dual
-#: facets and intersections bit for bit)
-MERGED_OPTIONS_5D = ("C-0 Q14 Q5", None)
+#: (3× as many pieces to certify). Only proposals: the certification decides.
+MERGED_OPTIONS_5D = ("C-0 Q14", None)
 #: the merged proposal in dimension 4: qhull's default ("" below 5 dimensions) with
 #: "Q5", which leaves out qhull's final pass over the outer planes (it computes the
 #: largest distance of a point above its facet, for precision reports; the facets
@@ -133,8 +130,8 @@ SPLIT_MAX_OFFSET = 64.0
 #: with these options (qhull's initial simplex from all points): 2 of the 72 halves
 #: (both axes) of 18 d = 5, n = 24–30 bench-family clouds failed with "C-0 Q14", both
 #: succeeded thus (sphere(5, 30, 3)'s lower half across x_0: 0.08 s, where both halves
-#: across x_1 took 0.09 s wall, 0.14 CPU-s, after the failure); "Q5" as above
-HALF_RETRY_OPTIONS = "Qs C-0 Q14 Q5"
+#: across x_1 took 0.09 s wall, 0.14 CPU-s, after the failure)
+HALF_RETRY_OPTIONS = "Qs C-0 Q14"
 
 
 def _propose(H, sel: np.ndarray, options: str | None = None, split: _Split | None = None
@@ -224,37 +221,13 @@ def _qhull(A: np.ndarray, b: np.ndarray, x0: np.ndarray, options: str | None
 
     try:  # a flat kernel can make qhull divide by zero: a proposal, checked exactly
         with np.errstate(divide="ignore", invalid="ignore"):
-            hs = _lean(HalfspaceIntersection)(np.hstack([A, -b[:, None]]), x0,
-                                              qhull_options=options)
+            hs = HalfspaceIntersection(np.hstack([A, -b[:, None]]), x0,
+                                       qhull_options=options)
     except (QhullError, ValueError):
         return None
     if not np.isfinite(hs.intersections).all():
         return None
     return hs.intersections, hs.dual_facets
-
-
-@functools.cache
-def _lean(base):
-    """scipy's HalfspaceIntersection ``base`` reading from qhull only what :func:`_qhull`
-    reads: the dual facets and equations, and the intersections from them by scipy's own
-    formula (the same floats, bit for bit) — without the dual hull's volume and area
-    (qh_getarea over every dual facet: 5–10 % of qhull's time in d = 5) or the copies of
-    the input. Where ``base`` is not such a class (e.g. a test's stand-in), or its qhull
-    object lacks the facets reader, it is ``base`` itself."""
-    if not (isinstance(base, type) and hasattr(base, "_update")):
-        return base
-
-    class Lean(base):
-        def _update(self, qhull):
-            facets = getattr(qhull, "get_hull_facets", None)
-            if facets is None:
-                return super()._update(qhull)
-            self.dual_facets, self.dual_equations = facets()
-            self.intersections = (self.dual_equations[:, :-1] / -self.dual_equations[:, -1:]
-                                  + self.interior_point)
-            return None
-
-    return Lean
 
 
 def _halves(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float, options: str | None,
@@ -296,19 +269,22 @@ def _halves(A: np.ndarray, b: np.ndarray, x0: np.ndarray, r: float, options: str
     facets: list[list[int]] = []
     cuts = []  # per half: its vertices on the cut (points) and their other rows
     for V, dual in found:
-        on = np.fromiter((m in f for f in dual), dtype=np.bool_, count=len(dual))
-        points.append(V[~on])
-        facets.extend(itertools.compress(dual, (~on).tolist()))
+        on = [m in f for f in dual]
+        for i, f in enumerate(dual):
+            if not on[i]:
+                points.append(V[i])
+                facets.append(f)
         at = np.flatnonzero(on)
         cuts.append((V[at], [[h for h in dual[i] if h != m] for i in at.tolist()]))
     more = _on_the_cut(A, k, *cuts[0], *cuts[1])
     if more is None:
         return None
-    points.append(np.array([p for p, _ in more]).reshape(len(more), k))
-    facets.extend(f for _, f in more)
+    for p, f in more:
+        points.append(p)
+        facets.append(f)
     if not facets:
         return None
-    return np.vstack(points), facets
+    return np.array(points), facets
 
 
 def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
@@ -335,17 +311,15 @@ def _on_the_cut(A: np.ndarray, k: int, V0: np.ndarray, rows0: list[list[int]],
     gap, match = cKDTree(V1).query(V0, p=np.inf)
     if not (gap <= tol).all() or len(np.unique(match)) != len(V0):
         return None
-    found: dict[tuple[int, ...], int] = {}  # each set of rows once, at its first point
+    out, seen = [], set()
     for i, j in enumerate(match.tolist()):
-        rows = tuple(sorted(set(rows0[i]).union(rows1[j])))
-        if len(rows) >= k:
-            found.setdefault(rows, i)
-    full: dict[tuple[int, ...], bool] = {}  # the float ranks, all sets of a size at once
-    for t in {len(rows) for rows in found}:
-        sets = [rows for rows in found if len(rows) == t]
-        ranks = np.linalg.matrix_rank(A[np.array(sets, dtype=np.int64)])
-        full.update(zip(sets, (ranks == k).tolist(), strict=True))
-    return [(V0[i], list(rows)) for rows, i in found.items() if full[rows]]
+        rows = sorted(set(rows0[i]).union(rows1[j]))
+        if len(rows) < k or tuple(rows) in seen:
+            continue
+        seen.add(tuple(rows))
+        if np.linalg.matrix_rank(A[rows]) == k:
+            out.append((V0[i], rows))
+    return out
 
 
 def certified_kernel(H, k: int, scale: int, first: np.ndarray) -> ExactPolytope | None:
@@ -653,8 +627,8 @@ def _tight_sets(vs: np.ndarray, hs: np.ndarray, n: int, width: int
     nbytes = max((width + 7) // 8, 1)
     packed, pv, ph = packed_pairs(np.asarray(vs, dtype=np.int64),
                                   np.asarray(hs, dtype=np.int64), n, nbytes)
-    rows = packed.view(f"V{nbytes}").tolist()  # one bytes object per vertex
-    tight = list(map(int.from_bytes, rows, itertools.repeat("little", len(rows))))
+    buf = packed.tobytes()
+    tight = [int.from_bytes(buf[i:i + nbytes], "little") for i in range(0, n * nbytes, nbytes)]
     return tight, (pv, ph)
 
 
