@@ -352,7 +352,8 @@ def write(rows: list[dict], out: Path, seconds: float) -> None:
          "states are ulps apart; met = ≥ 2 steps/s with every monitor on, validity 0, "
          "final diameter ≤ 1e-12. Checked first on N = 200: the trajectory equals, to "
          "2^-40 of the states, the one with every set the batch paths decline computed "
-         "exactly. Kernel sets left to the exact path (csv `exact_sets`): "
+         "exactly. Kernel sets left to the whole exact kernel (csv `exact_sets`; sets "
+         "the exact planar construction answers are not counted): "
          + ", ".join(f"{r['exact_sets']}" for r in rows if "exact_sets" in r) + ".")],
         rows, out)
 
