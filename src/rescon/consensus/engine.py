@@ -623,15 +623,21 @@ def _allowance(Ys: np.ndarray, F: int, pts: np.ndarray) -> np.ndarray:
     closed halfspace {y_j ≤ x_j} or {y_j ≥ x_j} with ≤ F points), so the allowance
     also follows the size of Ψ, not only its distance from the origin: 1e15 + a spread
     of 1 was allowed ~900 by its magnitude alone, and states left their benign hull
-    (V36); converged states (Ψ 1e-6 of its magnitude wide) keep ACCEPT_REL."""
+    (V36); converged states (Ψ 1e-6 of its magnitude wide) keep ACCEPT_REL. The
+    rounding slack is of the coordinates in which that box has room (in the others the
+    exact coordinate is a float)."""
     from ..geometry._small2d import ACCEPT_REL
 
     Z = np.sort(Ys, axis=1)
     m = Ys.shape[1]
     with np.errstate(over="ignore", invalid="ignore"):  # ±inf widths: the magnitude's
-        width = (Z[:, m - 1 - F] - Z[:, F]).max(axis=1)
+        widths = Z[:, m - 1 - F] - Z[:, F]
     size = np.abs(pts).max(axis=1)
-    return np.fmin(ACCEPT_REL * size, WIDTH_REL * width) + ROUNDING_SLACK * size
+    # the rounding slack only of coordinates where Ψ has room: where the box is one
+    # value, the exact coordinate is that float (a constant 1e140 licensed errors of
+    # 4e124 in the others, V43)
+    spread = np.where(widths != 0, np.abs(pts), 0.0).max(axis=1)
+    return np.fmin(ACCEPT_REL * size, WIDTH_REL * widths.max(axis=1)) + ROUNDING_SLACK * spread
 
 
 def _same_shape(problems: list[np.ndarray] | np.ndarray) -> dict[tuple[int, ...], np.ndarray]:

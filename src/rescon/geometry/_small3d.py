@@ -338,12 +338,19 @@ def _unscaled(pts: np.ndarray, err: np.ndarray, exps: np.ndarray
 
 
 def _scaled(Ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each set times 2^−e (exact), e its largest |coordinate|'s exponent (0 for a set
-    with a non-finite one, which the numba passes then decline): (scaled sets, e)."""
+    """Each set times 2^−e, e its largest |coordinate|'s exponent (0 for a set with a
+    non-finite one, which the numba passes then decline): (scaled sets, e). A set in
+    which the scaling rounds — a coordinate below 2^(e−1075) underflows, e.g. 1e-30
+    beside 1e300 — is returned as NaN, so the numba passes decline it too (its point
+    would have lost that coordinate with the bound 0, V43)."""
     with np.errstate(invalid="ignore", over="ignore"):
         big = np.abs(Ys).max(axis=(1, 2)) if Ys.shape[1] else np.zeros(len(Ys))
     exps = np.where(np.isfinite(big), np.frexp(np.where(np.isfinite(big), big, 1.0))[1], 0)
-    return np.ldexp(Ys, -exps[:, None, None]), exps
+    Zs = np.ldexp(Ys, -exps[:, None, None])
+    with np.errstate(invalid="ignore", over="ignore"):
+        rounded = ((np.ldexp(Zs, exps[:, None, None]) != Ys) & np.isfinite(Ys)).any(axis=(1, 2))
+    Zs[rounded] = np.nan
+    return Zs, exps
 
 
 @njit(cache=True, nogil=True)
@@ -424,7 +431,7 @@ def cluster_boxes(Ys, F, out, err):
 def _project(Ys: np.ndarray, F: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """project_small_3d by the certified KKT route (module docstring)."""
     B, m, _ = Ys.shape
-    Zs, exps = _scaled(Ys)  # exact; max |coordinate| in [1/2, 1)
+    Zs, exps = _scaled(Ys)  # exact (else NaN); max |coordinate| in [1/2, 1)
     H = m * (m - 1) * (m - 2) // 3
     normals = np.empty((B, H, 3))
     offsets = np.empty((B, H))
