@@ -456,11 +456,11 @@ def _kernel_points(problems: list[np.ndarray] | np.ndarray, F: int, method: str,
     and computing each exactly made a step of 1000 converged agents take seconds.
     The sets still declined and every other case are
     computed exactly, once per distinct set in a run (``cache``: held values and
-    converged states repeat the same sets) — planar sets of at most PLANAR_EXACT_MAX
-    points by :func:`rescon.geometry._planar_exact.nearest_to_mean` (the same exact
-    point, ~10× faster than building the kernel: converged states beside far
-    adversary values leave the nearest feature to exact arithmetic). "project-exact"
-    computes everything exactly."""
+    converged states repeat the same sets) — the sets :func:`_planar_exact_point` takes
+    by the exact planar construction (the same exact point, ~10× faster than building
+    the kernel: converged states beside far adversary values leave the nearest feature
+    to exact arithmetic), the others through the kernel. "project-exact" computes
+    everything exactly."""
     if not len(problems):
         return np.empty((0, 0))
     out = np.empty((len(problems), problems[0].shape[1]))
@@ -502,7 +502,9 @@ def _planar_exact_point(X: np.ndarray, F: int) -> list[Fraction] | None:
     other coordinates; a halfspace meets the plane in a halfplane, and every halfplane
     is such a meet) and the mean is (a, mean X'), so the point sought is (a, the planar
     point of X') — converged states reach such sets, where the batch paths decline
-    flat kernels. None otherwise, or when Ψ is empty (the general path reports it)."""
+    flat kernels. None otherwise — also for sets of more than PLANAR_EXACT_WIDE points
+    spanning more than PLANAR_EXACT_BITS binary orders of magnitude (a constant
+    coordinate counted too) — or when Ψ is empty: the general path decides."""
     m, d = X.shape
     if m > PLANAR_EXACT_MAX or d not in (2, 3) or not np.isfinite(X).all():
         return None
