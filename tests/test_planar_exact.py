@@ -158,3 +158,14 @@ def test_spatial_sets_in_an_axis_plane_take_the_planar_construction():
         got = engine._kernel_points(sets, 1, "project-exact", {})
     assert calls == []
     assert np.array_equal(got, want)
+
+
+def test_a_far_constant_coordinate_does_not_count_for_the_wide_guard():
+    """The wide-integer guard reads only the coordinates the planar construction uses:
+    13 converged points with the constant third coordinate 1e300 keep the construction
+    (V43 noticed the constant's exponent sent them to the general path), and give the
+    general path's point."""
+    rng = np.random.default_rng(9)
+    Y = np.c_[5.0 + rng.integers(-2, 3, size=(13, 2)) * 2.0**-50, np.full(13, 1e300)]
+    got = engine._planar_exact_point(Y, 4)
+    assert got is not None and tuple(got) == general(Y, 4)

@@ -503,27 +503,24 @@ def _planar_exact_point(X: np.ndarray, F: int) -> list[Fraction] | None:
     is such a meet) and the mean is (a, mean X'), so the point sought is (a, the planar
     point of X') — converged states reach such sets, where the batch paths decline
     flat kernels. None otherwise — also for sets of more than PLANAR_EXACT_WIDE points
-    spanning more than PLANAR_EXACT_BITS binary orders of magnitude (a constant
-    coordinate counted too) — or when Ψ is empty: the general path decides."""
+    whose planar coordinates span more than PLANAR_EXACT_BITS binary orders of
+    magnitude — or when Ψ is empty: the general path decides."""
     m, d = X.shape
     if m > PLANAR_EXACT_MAX or d not in (2, 3) or not np.isfinite(X).all():
         return None
-    exponents = np.frexp(X[X != 0])[1]
+    fixed = [int(j) for j in np.flatnonzero((X == X[0]).all(axis=0))][:1] if d == 3 else []
+    if d == 3 and not fixed:
+        return None
+    Y = np.ascontiguousarray(np.delete(X, fixed, axis=1))
+    exponents = np.frexp(Y[Y != 0])[1]
     if len(exponents) and m > PLANAR_EXACT_WIDE and np.ptp(exponents) > PLANAR_EXACT_BITS:
         return None  # O(m³) orientations on integers that wide: the general path is faster
-    if d == 2:
-        x = nearest_to_mean(X, F)
-        return None if x is None else list(x)
-    same = np.flatnonzero((X == X[0]).all(axis=0))
-    if not len(same):
-        return None
-    j = int(same[0])
-    others = [i for i in range(3) if i != j]
-    x = nearest_to_mean(np.ascontiguousarray(X[:, others]), F)
+    x = nearest_to_mean(Y, F)
     if x is None:
         return None
-    point = [Fraction(0)] * 3
-    point[j], point[others[0]], point[others[1]] = Fraction(float(X[0, j])), *x
+    point = list(x)
+    for j in fixed:  # the constant coordinate back in its place
+        point.insert(j, Fraction(float(X[0, j])))
     return point
 
 
